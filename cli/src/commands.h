@@ -1,0 +1,17 @@
+#pragma once
+// Every subcommand registers itself on the root app; main() calls these in order.
+// Each command runs through CLI11's callback and reports errors by throwing; main() turns
+// an exception into one line on stderr and exit status 1.
+
+namespace CLI {
+class App;
+}
+
+namespace mneedle::cli {
+
+void add_scene_command(CLI::App& app);
+void add_plugins_command(CLI::App& app);
+void add_generate_command(CLI::App& app);
+void add_inspect_command(CLI::App& app);
+
+}  // namespace mneedle::cli

@@ -1,0 +1,1 @@
+// placeholder: the plugin loader is being written (issue 2 §4)
