@@ -13,5 +13,6 @@ void add_scene_command(CLI::App& app);
 void add_plugins_command(CLI::App& app);
 void add_generate_command(CLI::App& app);
 void add_inspect_command(CLI::App& app);
+void add_strength_command(CLI::App& app);
 
 }  // namespace mneedle::cli

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   mneedle::cli::add_plugins_command(app);
   mneedle::cli::add_generate_command(app);
   mneedle::cli::add_inspect_command(app);
+  mneedle::cli::add_strength_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
