@@ -1,0 +1,102 @@
+#pragma once
+// Geometry kit shared by the built-in tip plugins: welded triangle meshes, prisms cut by a
+// piecewise-planar bottom, solids of revolution, and analytic cross-section formulas.
+// Plain C++ (no CGAL, no mneedle::core) so each plugin stays small and self-contained.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <stdexcept>
+#include <tuple>
+#include <vector>
+
+namespace mneedle::shape_kit {
+
+struct Point3 {
+  double x, y, z;
+};
+
+/// A parameter combination the shape cannot build; becomes MNEEDLE_STATUS_INVALID_PARAMETER.
+class ParameterError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Collects triangles, joining vertices closer than the weld tolerance and dropping
+/// triangles that collapse to a point or a line.
+class MeshBuilder {
+ public:
+  explicit MeshBuilder(double weld_tolerance_m);
+
+  std::uint32_t vertex(Point3 p);
+  void add_triangle(Point3 a, Point3 b, Point3 c);
+  /// Fan-triangulates a convex polygon given counter-clockwise as seen from its outside.
+  void add_convex_polygon(const std::vector<Point3>& polygon);
+
+  /// Reverses every triangle, turning an inward-oriented closed mesh outward.
+  void flip();
+  double signed_volume() const;
+
+  const std::vector<Point3>& vertices() const { return vertices_; }
+  const std::vector<std::array<std::uint32_t, 3>>& triangles() const { return triangles_; }
+
+ private:
+  using Key = std::tuple<long long, long long, long long>;
+  Key key_of(Point3 p) const;
+
+  double tolerance_;
+  std::vector<Point3> vertices_;
+  std::vector<std::array<std::uint32_t, 3>> triangles_;
+  std::map<Key, std::uint32_t> index_;
+};
+
+/// A straight prism around the z axis (outer radius, optional bore) between a bottom
+/// surface z = bottom(x) and the plane z = top_z. bottom must be linear in x between the
+/// sorted crease positions, so every generated bottom triangle lies in one plane.
+struct CutPrism {
+  double outer_radius_m = 0;
+  double bore_radius_m = 0;  // 0: solid
+  int segments = 64;         // polygon sides around the circumference
+  double top_z_m = 0;
+  std::vector<double> creases_x_m;
+  std::function<double(double)> bottom_z_m;
+};
+
+MeshBuilder build_cut_prism(const CutPrism& prism);
+
+struct ProfilePoint {
+  double r, z;
+};
+
+/// Revolves a closed profile loop in the (r >= 0, z) half-plane around the z axis. Points
+/// with r = 0 become single axis vertices. The result is oriented outward.
+MeshBuilder build_revolved(const std::vector<ProfilePoint>& loop, int segments);
+
+/// Integrals over the part x >= b of a disc of radius r centred on the axis.
+struct SegmentMoments {
+  double area;  // ∫ dA
+  double sx;    // ∫ x dA
+  double ixx;   // ∫ x² dA
+  double iyy;   // ∫ y² dA
+};
+SegmentMoments disc_segment(double radius, double b);
+
+struct SectionProperties {
+  double area_m2;
+  double i_min_m4;
+};
+
+/// Area and smaller principal centroidal second moment of the region x >= b of an annulus
+/// (outer radius, bore radius; bore 0 = solid). The region is symmetric about the x axis,
+/// so x and y are principal directions.
+SectionProperties annulus_segment_properties(double outer_radius, double bore_radius, double b);
+
+/// Full annulus (or disc when bore_radius = 0).
+SectionProperties annulus_properties(double outer_radius, double bore_radius);
+
+/// Reads an integral polygon side count from a parameter value.
+int segment_count(double value);
+
+}  // namespace mneedle::shape_kit

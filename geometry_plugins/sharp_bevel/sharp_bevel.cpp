@@ -1,0 +1,76 @@
+// Built-in tip shape: a tube cut by one plane at bevel_angle to the axis (paper A's sharp
+// bevel). The tip is the rim point on +x at z = 0.
+#include <cmath>
+#include <iterator>
+#include <numbers>
+
+#include "plugin_glue.h"
+
+namespace {
+
+using namespace mneedle::shape_kit;
+
+constexpr mneedle_parameter kParameters[] = {
+    kDiameterParameter,
+    kLengthParameter,
+    kBoreParameter,
+    kResolutionParameter,
+    {"bevel_angle", "rad", std::numbers::pi / 6, 5 * std::numbers::pi / 180,
+     85 * std::numbers::pi / 180, "angle between the bevel face and the needle axis"},
+};
+constexpr std::size_t kParameterCount = std::size(kParameters);
+
+struct Bevel {
+  TubeParameters tube;
+  double tan_angle;
+};
+
+Bevel read(const double* params) {
+  const Bevel bevel{read_tube_parameters(params), std::tan(params[4])};
+  if (!(bevel.tan_angle > 0)) throw ParameterError("bevel_angle must lie in (0, 90) degrees");
+  return bevel;
+}
+
+MeshBuilder make_mesh(const double* params) {
+  const Bevel bevel = read(params);
+  const double r = bevel.tube.radius_m;
+  CutPrism prism;
+  prism.outer_radius_m = r;
+  prism.bore_radius_m = bevel.tube.bore_radius_m;
+  prism.segments = bevel.tube.segments;
+  prism.top_z_m = bevel.tube.length_m;
+  prism.bottom_z_m = [r, t = bevel.tan_angle](double x) { return (r - x) / t; };
+  if (!(2 * r / bevel.tan_angle < bevel.tube.length_m)) {
+    throw ParameterError("the bevel (diameter / tan(bevel_angle)) is longer than length");
+  }
+  return build_cut_prism(prism);
+}
+
+// At height h the bevel plane has moved h·tanθ in from the rim: the section is the part
+// x >= R - h·tanθ of the annulus.
+SectionProperties section(const double* params, double h) {
+  const Bevel bevel = read(params);
+  if (h < 0 || h > bevel.tube.length_m) return {0, 0};
+  const double b = bevel.tube.radius_m - h * bevel.tan_angle;
+  return annulus_segment_properties(bevel.tube.radius_m, bevel.tube.bore_radius_m, b);
+}
+
+constexpr mneedle_shape kShapes[] = {{
+    "sharp_bevel",
+    "tube cut by one plane at bevel_angle to the axis; the tip is a point on the rim",
+    kParameters,
+    kParameterCount,
+    1,
+    generate_hook<make_mesh, kParameterCount>,
+    section_area_hook<section, kParameterCount>,
+    section_properties_hook<section, kParameterCount>,
+}};
+
+constexpr mneedle_plugin kPlugin{MNEEDLE_PLUGIN_ABI_MAJOR, MNEEDLE_PLUGIN_ABI_MINOR,
+                                 "mneedle.builtin.sharp_bevel", kShapes, std::size(kShapes)};
+
+}  // namespace
+
+MNEEDLE_PLUGIN_EXPORT const mneedle_plugin* mneedle_plugin_entry(void) {
+  return &kPlugin;
+}

@@ -1,0 +1,122 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "mneedle/cross_section.h"
+#include "mneedle/error.h"
+#include "shape_test_support.h"
+
+namespace mneedle::test {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kRadius = 115e-6;
+constexpr double kLength = 1000e-6;
+constexpr double kFlat = 50e-6;
+const double kTan30 = std::tan(kPi / 6);
+
+// Antiderivative of the segment area A(b) = R² acos(b/R) - b√(R² - b²), zero at b = R.
+double segment_antiderivative(double b) {
+  const double r2 = kRadius * kRadius;
+  return r2 * b * std::acos(b / kRadius) - r2 * std::sqrt(r2 - b * b) +
+         std::pow(r2 - b * b, 1.5) / 3;
+}
+
+// The sharp bevel lengthened by the cut-off height s = w/tanθ, minus the cut-off tip
+// (∫ of the segment from b = R - w to R, divided by tanθ). Valid while the flat stays
+// outside the bore.
+double analytic_volume(double bore_radius) {
+  const double s = kFlat / kTan30;
+  const double sharp =
+      kPi * (kRadius * kRadius - bore_radius * bore_radius) * (kLength + s - kRadius / kTan30);
+  const double cut_off = -segment_antiderivative(kRadius - kFlat) / kTan30;
+  return sharp - cut_off;
+}
+
+TEST(BluntBevel, DefaultMeshIsValidClosedAndOutward) {
+  const MeshValidation v = validate_mesh(builtin_registry().generate("blunt_bevel", {}));
+  EXPECT_TRUE(v.valid) << (v.errors.empty() ? "" : v.errors.front());
+  EXPECT_TRUE(v.outward);
+}
+
+TEST(BluntBevel, FlatAtZeroHasTheSegmentAreaOfItsWidth) {
+  const TriangleMesh mesh = builtin_registry().generate("blunt_bevel", {});
+  double flat_area = 0;
+  double min_x = kRadius;
+  for (const auto& t : mesh.triangles) {
+    const auto &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    if (a[2] < 1e-12 && b[2] < 1e-12 && c[2] < 1e-12) {
+      flat_area += std::abs((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])) / 2;
+      min_x = std::min({min_x, a[0], b[0], c[0]});
+    }
+  }
+  EXPECT_NEAR(min_x, kRadius - kFlat, 1e-12);  // the flat is flat_width wide
+  const double expected = builtin_registry().section_area("blunt_bevel", {}, 0).value();
+  EXPECT_LT(relative_error(flat_area, expected), 0.005);
+  EXPECT_NEAR(bounding_box(mesh).max[2], kLength, 1e-12);
+}
+
+TEST(BluntBevel, SolidVolumeWithinHalfPercentAtDefaultResolution) {
+  const double volume = signed_volume(builtin_registry().generate("blunt_bevel", {}));
+  EXPECT_LT(relative_error(volume, analytic_volume(0)), 0.005);
+}
+
+TEST(BluntBevel, HollowVolumeWithinHalfPercentAtDefaultResolution) {
+  const TriangleMesh mesh = builtin_registry().generate("blunt_bevel", {{"bore", 90e-6}});
+  EXPECT_TRUE(validate_mesh(mesh).valid);
+  EXPECT_LT(relative_error(signed_volume(mesh), analytic_volume(45e-6)), 0.005);
+}
+
+TEST(BluntBevel, FlatReachingIntoTheBoreStillMakesAValidMesh) {
+  const Parameters p{{"bore", 150e-6}, {"flat_width", 100e-6}};
+  const TriangleMesh mesh = builtin_registry().generate("blunt_bevel", p);
+  EXPECT_TRUE(validate_mesh(mesh).valid);
+  EXPECT_LT(
+      relative_error(signed_volume(mesh), integrated_section_volume("blunt_bevel", p, kLength)),
+      0.005);
+}
+
+TEST(BluntBevel, VolumeConvergesAsResolutionRises) {
+  double previous = 1;
+  for (const double n : {16.0, 64.0, 256.0}) {
+    const double error = relative_error(
+        signed_volume(builtin_registry().generate("blunt_bevel", {{"resolution", n}})),
+        analytic_volume(0));
+    EXPECT_LT(error, previous / 4) << "resolution " << n;
+    previous = error;
+  }
+  EXPECT_LT(previous, 2e-4);
+}
+
+TEST(BluntBevel, SectionAreaIsTheSharpBevelShiftedByTheCutOffHeight) {
+  const double shift = kFlat / kTan30;
+  for (const double h : {0.0, 50e-6, 200e-6}) {
+    EXPECT_NEAR(builtin_registry().section_area("blunt_bevel", {}, h).value(),
+                builtin_registry().section_area("sharp_bevel", {}, h + shift).value(), 1e-20);
+  }
+}
+
+TEST(BluntBevel, SectionAreaIntegratesToTheAnalyticVolume) {
+  for (const double bore : {0.0, 90e-6}) {
+    const double integral = integrated_section_volume("blunt_bevel", {{"bore", bore}}, kLength);
+    EXPECT_LT(relative_error(integral, analytic_volume(bore / 2)), 1e-6) << "bore " << bore;
+  }
+}
+
+TEST(BluntBevel, FlatWiderThanTheNeedleIsAnInputError) {
+  EXPECT_THROW(builtin_registry().generate("blunt_bevel", {{"flat_width", 230e-6}}), InputError);
+}
+
+// Paper A's b = R - h·tanθ is a reconstruction: check the hook against the sliced mesh.
+TEST(BluntBevel, SectionAreaMatchesTheSlicedMesh) {
+  const Parameters fine{{"resolution", 256}};
+  const CrossSectionSlicer slicer(builtin_registry().generate("blunt_bevel", fine));
+  for (const double h : {50e-6, 100e-6, 200e-6, 300e-6, 600e-6}) {
+    const double analytic = builtin_registry().section_area("blunt_bevel", fine, h).value();
+    EXPECT_LT(relative_error(slicer.slice(h).area_m2, analytic), 0.005) << "h " << h;
+  }
+}
+
+}  // namespace
+}  // namespace mneedle::test
