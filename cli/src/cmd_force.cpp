@@ -1,0 +1,137 @@
+// `mneedle force SCENE [--json|--csv] [--step 10um]`: paper A's post-puncture force curve of
+// every needle of a scene, as if it had punctured at the surface.
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "mneedle/design_source.h"
+#include "mneedle/error.h"
+#include "mneedle/plugin_host.h"
+#include "mneedle/scene.h"
+#include "mneedle/surface_loads.h"
+#include "mneedle/units.h"
+
+namespace mneedle::cli {
+namespace {
+
+struct ForceOptions {
+  std::string scene;
+  bool json = false;
+  bool csv = false;
+  std::string step = "10um";
+  std::vector<std::filesystem::path> plugin_dirs;
+};
+
+struct NeedleCurve {
+  std::string name;
+  std::vector<LoadSample> curve;
+};
+
+// 0, step, 2 step, ... up to the scene's insertion depth, which is always the last point.
+std::vector<double> depth_grid(double max_depth, double step) {
+  std::vector<double> depths;
+  const auto count = static_cast<long>(std::floor(max_depth / step * (1.0 + 1e-12)));
+  for (long i = 0; i <= count; ++i) depths.push_back(static_cast<double>(i) * step);
+  if (max_depth - depths.back() > 1e-9 * step) depths.push_back(max_depth);
+  return depths;
+}
+
+bool needs_plugins(const Scene& scene) {
+  for (const NeedleSpec& n : scene.needles) {
+    if (std::holds_alternative<PluginGeometry>(n.geometry)) return true;
+  }
+  return false;
+}
+
+std::vector<NeedleCurve> compute(const ForceOptions& options) {
+  const Scene scene = load_scene(options.scene);
+  const double step = parse_quantity(options.step, Dimension::Length);
+  if (!(step > 0.0)) throw InputError("--step " + options.step + ": must be a positive length");
+  if (!(scene.insertion.depth > 0.0)) {
+    throw InputError(scene.source_name + ": insertion.depth must be positive for a force curve");
+  }
+  const std::vector<double> depths = depth_grid(scene.insertion.depth, step);
+  const LoadConstants constants = load_constants(scene);
+  // Plugins are searched only when a needle needs one, so STL-only scenes run without them.
+  const PluginRegistry registry =
+      needs_plugins(scene) ? PluginRegistry::discover(options.plugin_dirs) : PluginRegistry();
+  std::vector<NeedleCurve> curves;
+  for (const NeedleSpec& spec : scene.needles) {
+    const NeedleSource needle = needle_from_scene(registry, spec);
+    const SurfaceLoadModel model(needle.mesh, constants);
+    curves.push_back({spec.name, model.curve(depths)});
+  }
+  return curves;
+}
+
+void print_json(const std::vector<NeedleCurve>& curves) {
+  nlohmann::json needles = nlohmann::json::array();
+  for (const NeedleCurve& c : curves) {
+    nlohmann::json points = nlohmann::json::array();
+    for (const LoadSample& s : c.curve) {
+      points.push_back({{"depth_m", s.depth_m},
+                        {"force_N", s.force_N},
+                        {"alpha_N", s.alpha_N},
+                        {"beta_N", s.beta_N},
+                        {"friction_N", s.friction_N}});
+    }
+    needles.push_back({{"name", c.name}, {"curve", points}});
+  }
+  std::cout << nlohmann::json{{"needles", needles}}.dump(2) << "\n";
+}
+
+void print_csv(const std::vector<NeedleCurve>& curves) {
+  std::cout << "needle,depth_m,force_N,alpha_N,beta_N,friction_N\n" << std::setprecision(10);
+  for (const NeedleCurve& c : curves) {
+    for (const LoadSample& s : c.curve) {
+      std::cout << c.name << ',' << s.depth_m << ',' << s.force_N << ',' << s.alpha_N << ','
+                << s.beta_N << ',' << s.friction_N << '\n';
+    }
+  }
+}
+
+void print_table(const std::vector<NeedleCurve>& curves) {
+  for (const NeedleCurve& c : curves) {
+    std::cout << c.name << "\n  depth_um    force_mN    alpha_mN     beta_mN  friction_mN\n";
+    for (const LoadSample& s : c.curve) {
+      std::cout << std::fixed << std::setprecision(4) << std::setw(10) << s.depth_m * 1e6
+                << std::setw(12) << s.force_N * 1e3 << std::setw(12) << s.alpha_N * 1e3
+                << std::setw(12) << s.beta_N * 1e3 << std::setw(13) << s.friction_N * 1e3 << "\n";
+    }
+  }
+}
+
+}  // namespace
+
+void add_force_command(CLI::App& app) {
+  auto options = std::make_shared<ForceOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "force", "Post-puncture force curve of each needle of a scene (paper A distributed loads)");
+  cmd->add_option("SCENE", options->scene, "Scene file (TOML)")->required();
+  auto* json = cmd->add_flag("--json", options->json, "Print JSON");
+  cmd->add_flag("--csv", options->csv,
+                "Print CSV: needle,depth_m,force_N,alpha_N,beta_N,friction_N")
+      ->excludes(json);
+  cmd->add_option("--step", options->step, "Depth step with a unit (default 10um)");
+  cmd->add_option("--plugin-dir", options->plugin_dirs, "Extra folder to search for plugins");
+  cmd->callback([options] {
+    const std::vector<NeedleCurve> curves = compute(*options);
+    if (options->json) {
+      print_json(curves);
+    } else if (options->csv) {
+      print_csv(curves);
+    } else {
+      print_table(curves);
+    }
+  });
+}
+
+}  // namespace mneedle::cli
