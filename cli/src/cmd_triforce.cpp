@@ -1,0 +1,519 @@
+// mneedle fit / predict / stats: paper B's tri-force model fitted to a user's recordings,
+// predictions at other speeds and angles, and ANOVA/Tukey between groups (issue 8).
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+
+#include "commands.h"
+#include "mneedle/anova.h"
+#include "mneedle/curve_metrics.h"
+#include "mneedle/error.h"
+#include "mneedle/force_curve.h"
+#include "mneedle/layer_boundaries.h"
+#include "mneedle/triforce_fit.h"
+#include "mneedle/triforce_model.h"
+#include "mneedle/units.h"
+
+namespace mneedle::cli {
+namespace {
+
+struct CurveArgs {
+  std::string depth_col;
+  std::string force_col;
+  std::string depth_unit;
+  std::string force_unit;
+  std::string speed;  // empty = from the time column
+  std::string angle = "90deg";
+};
+
+void add_curve_options(CLI::App* cmd, CurveArgs& a) {
+  cmd->add_option("--depth-col", a.depth_col,
+                  "Depth/travel column (default: depth*, travel*, ...)");
+  cmd->add_option("--force-col", a.force_col, "Force column (default: force*, fz*, ...)");
+  cmd->add_option("--depth-unit", a.depth_unit, "Unit of the depth column (default: its suffix)");
+  cmd->add_option("--force-unit", a.force_unit, "Unit of the force column (default: its suffix)");
+  cmd->add_option("--speed", a.speed,
+                  "Insertion speed, e.g. 1mm/s (default: from the time column)");
+  cmd->add_option("--angle", a.angle,
+                  "Needle-to-surface angle, paper B's convention (90deg = perpendicular)")
+      ->capture_default_str();
+}
+
+struct LoadedCurve {
+  LoadingBranch branch;
+  FitCurve curve;
+};
+
+LoadedCurve load_curve(const std::string& file, const CurveArgs& a) {
+  const CurveColumns columns{a.depth_col, a.force_col, "", a.depth_unit, a.force_unit};
+  LoadedCurve out;
+  out.branch = extract_loading_branch(read_force_curve_csv(file, columns));
+  out.curve.name = std::filesystem::path(file).filename().string();
+  out.curve.depth_m = out.branch.curve.depth_m;
+  out.curve.force_N = out.branch.curve.force_N;
+  out.curve.conditions.speed_m_per_s =
+      a.speed.empty() ? loading_speed(out.branch) : parse_quantity(a.speed, Dimension::Speed);
+  out.curve.conditions.angle_rad = parse_quantity(a.angle, Dimension::Angle);
+  return out;
+}
+
+Dimension parameter_dimension(const std::string& name) {
+  const auto base =
+      name.substr(0, name.rfind("_L") == std::string::npos ? name.size() : name.rfind("_L"));
+  const auto ends = [&](std::string_view s) {
+    return base.size() >= s.size() && base.compare(base.size() - s.size(), s.size(), s) == 0;
+  };
+  if (ends("_per_m") || ends("_per_m2") || ends("_Ns")) return Dimension::Dimensionless;
+  if (ends("_N")) return Dimension::Force;
+  if (ends("_m")) return Dimension::Length;
+  if (ends("_s")) return Dimension::Time;
+  return Dimension::Dimensionless;
+}
+
+std::pair<std::string, double> parse_fix(const std::string& text) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw InputError("--fix '" + text + "': expected NAME=VALUE, e.g. mu=0.2");
+  }
+  const std::string name = text.substr(0, eq);
+  return {name, parse_quantity(text.substr(eq + 1), parameter_dimension(name))};
+}
+
+nlohmann::json finite_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
+// ---------------------------------------------------------------- fit
+struct FitArgs {
+  std::vector<std::string> files;
+  std::string model = "triforce";
+  CurveArgs curve;
+  std::vector<std::string> fix;
+  std::vector<std::string> free;
+  std::vector<std::string> layer_starts;
+  std::size_t detect_layers = 0;
+  int starts = 8;
+  bool json = false;
+  std::string out_dir;
+};
+
+nlohmann::json fit_json(const TriforceFit& fit, const std::vector<LoadedCurve>& curves) {
+  nlohmann::json params = nlohmann::json::object(), errors = nlohmann::json::object();
+  nlohmann::json fixed = nlohmann::json::array();
+  for (const auto& p : fit.parameters) {
+    params[p.name] = p.value;
+    if (p.fitted) {
+      errors[p.name] = finite_or_null(p.standard_error);
+    } else {
+      fixed.push_back(p.name);
+    }
+  }
+  nlohmann::json list = nlohmann::json::array();
+  for (std::size_t i = 0; i < curves.size(); ++i) {
+    const auto& c = fit.curves[i];
+    const auto& loaded = curves[i];
+    list.push_back({{"file", c.name},
+                    {"rmse_N", c.metrics.rmse_N},
+                    {"r2", c.metrics.r2},
+                    {"max_error_N", c.metrics.max_error_N},
+                    {"samples", c.metrics.samples},
+                    {"offset_m", c.offset_m},
+                    {"offset_stderr_m", finite_or_null(c.offset_standard_error_m)},
+                    {"contact_travel_m", loaded.branch.contact_travel_m},
+                    {"speed_m_per_s", loaded.curve.conditions.speed_m_per_s},
+                    {"angle_rad", loaded.curve.conditions.angle_rad},
+                    {"peak_force_N",
+                     *std::max_element(loaded.curve.force_N.begin(), loaded.curve.force_N.end())},
+                    {"loading_branch", loaded.branch.summary}});
+  }
+  return {{"model", "triforce"},
+          {"params", params},
+          {"stderr", errors},
+          {"fixed", fixed},
+          {"curves", list},
+          {"residual_sd_N", fit.residual_sd_N},
+          {"samples_fitted", fit.samples},
+          {"converged", fit.converged},
+          {"starts", fit.starts}};
+}
+
+void print_fit(const TriforceFit& fit, const std::vector<LoadedCurve>& curves) {
+  for (const auto& c : curves) std::cout << c.branch.summary << "\n";
+  std::cout << "\ntri-force fit (" << fit.samples << " samples, " << fit.starts << " starts, "
+            << (fit.converged ? "converged" : "NOT converged") << ", residual sd "
+            << fit.residual_sd_N << " N)\n";
+  for (const auto& p : fit.parameters) {
+    std::cout << "  " << std::left << std::setw(14) << p.name << std::right << std::setw(14)
+              << p.value;
+    if (!p.fitted) {
+      std::cout << "  (fixed)\n";
+    } else if (std::isfinite(p.standard_error)) {
+      std::cout << "  +/- " << p.standard_error << "\n";
+    } else {
+      std::cout << "  +/- not identifiable\n";
+    }
+  }
+  for (const auto& c : fit.curves) {
+    std::cout << "  " << c.name << ": RMSE " << c.metrics.rmse_N << " N, R2 " << c.metrics.r2
+              << ", max error " << c.metrics.max_error_N << " N, contact offset "
+              << c.offset_m * 1e3 << " mm\n";
+  }
+}
+
+void write_fit_files(const std::string& dir, const nlohmann::json& report, const TriforceFit& fit,
+                     const std::vector<LoadedCurve>& curves) {
+  std::filesystem::create_directories(dir);
+  std::ofstream(std::filesystem::path(dir) / "fit.json") << report.dump(2) << "\n";
+  const TriforceModel model(fit.params);
+  for (std::size_t i = 0; i < curves.size(); ++i) {
+    const auto& c = curves[i].curve;
+    const auto predicted = predict_loading(model, c, fit.curves[i].offset_m);
+    std::ofstream csv(std::filesystem::path(dir) /
+                      (std::filesystem::path(c.name).stem().string() + "_fit.csv"));
+    csv << "depth_m,measured_N,model_N\n" << std::setprecision(8);
+    for (std::size_t j = 0; j < c.depth_m.size(); ++j) {
+      csv << c.depth_m[j] << "," << c.force_N[j] << "," << predicted[j] << "\n";
+    }
+  }
+}
+
+void run_fit(const FitArgs& args) {
+  if (args.model != "triforce")
+    throw InputError("fit: unknown --model '" + args.model + "' (known: triforce)");
+  std::vector<LoadedCurve> curves;
+  std::vector<FitCurve> data;
+  for (const auto& f : args.files) {
+    curves.push_back(load_curve(f, args.curve));
+    data.push_back(curves.back().curve);
+  }
+  TriforceFitOptions options;
+  options.starts = args.starts;
+  for (const auto& s : args.layer_starts) {
+    TriforceLayer layer = options.initial.layers.back();
+    layer.start_m = parse_quantity(s, Dimension::Length);
+    options.initial.layers.push_back(layer);
+  }
+  if (args.detect_layers > 1) {
+    // Boundaries from the slope changes of the first curve (paper B's layer reading).
+    const auto& first = curves.front().curve;
+    for (double start : detect_layer_boundaries(first.depth_m, first.force_N, args.detect_layers)) {
+      TriforceLayer layer = options.initial.layers.back();
+      layer.start_m = start;
+      options.initial.layers.push_back(layer);
+    }
+    std::sort(options.initial.layers.begin(), options.initial.layers.end(),
+              [](const auto& a, const auto& b) { return a.start_m < b.start_m; });
+    if (!args.json) {
+      std::cout << "layers start at (mm):";
+      for (const auto& l : options.initial.layers) std::cout << " " << l.start_m * 1e3;
+      std::cout << "\n";
+    }
+  }
+  for (const auto& text : args.fix) options.fixed.insert(parse_fix(text));
+  options.free = args.free;
+  const auto fit = fit_triforce(data, options);
+  const auto report = fit_json(fit, curves);
+  if (!args.out_dir.empty()) write_fit_files(args.out_dir, report, fit, curves);
+  if (args.json) {
+    std::cout << report.dump(2) << "\n";
+  } else {
+    print_fit(fit, curves);
+  }
+}
+
+// ---------------------------------------------------------------- predict
+struct PredictArgs {
+  std::string model = "triforce";
+  std::string params_file;
+  std::string speed = "1mm/s";
+  std::string angle = "90deg";
+  std::string depth;
+  std::string hold = "0s";
+  std::string retract_speed;
+  std::string step = "0.05s";
+  std::string amplitude = "0m";
+  double frequency_Hz = 1000.0;
+  std::string compare;
+  CurveArgs curve;
+  bool csv = false;
+  bool json = false;
+};
+
+TriforceParams read_params(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file + ": cannot open the file");
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(file + ": not JSON: " + e.what());
+  }
+  if (!j.contains("params") || !j["params"].is_object()) {
+    throw InputError(file + ": no \"params\" object (write it with mneedle fit --json)");
+  }
+  TriforceParams p;
+  for (const auto& [name, value] : j["params"].items()) {
+    if (!value.is_number()) throw InputError(file + ": params." + name + ": not a number");
+    set_parameter(p, name, value.get<double>());
+  }
+  TriforceModel{p};  // validates
+  return p;
+}
+
+// Mean contact offset of the fitted curves: detected contact + offset is where the model starts.
+double mean_fitted_offset(const std::string& file) {
+  std::ifstream in(file);
+  const auto j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.contains("curves") || !j["curves"].is_array()) return 0.0;
+  double sum = 0.0;
+  int n = 0;
+  for (const auto& c : j["curves"]) {
+    if (c.contains("offset_m") && c["offset_m"].is_number()) {
+      sum += c["offset_m"].get<double>();
+      ++n;
+    }
+  }
+  return n > 0 ? sum / n : 0.0;
+}
+
+const char* phase_name(InsertionPhase p) {
+  switch (p) {
+    case InsertionPhase::Insertion:
+      return "insertion";
+    case InsertionPhase::Hold:
+      return "hold";
+    case InsertionPhase::Retraction:
+      return "retraction";
+  }
+  return "?";
+}
+
+void run_predict(const PredictArgs& args) {
+  if (args.model != "triforce")
+    throw InputError("predict: unknown --model '" + args.model + "' (known: triforce)");
+  if (args.params_file.empty()) throw InputError("predict: --params FIT.json is required");
+  if (!(args.frequency_Hz > 0.0)) throw InputError("predict: --perturb-frequency must be > 0 Hz");
+  const TriforceModel model(read_params(args.params_file));
+  InsertionProtocol protocol;
+  protocol.conditions.speed_m_per_s = parse_quantity(args.speed, Dimension::Speed);
+  protocol.conditions.angle_rad = parse_quantity(args.angle, Dimension::Angle);
+  protocol.conditions.perturbation_amplitude_m = parse_quantity(args.amplitude, Dimension::Length);
+  protocol.conditions.perturbation_frequency_Hz = args.frequency_Hz;
+  protocol.hold_s = parse_quantity(args.hold, Dimension::Time);
+  protocol.time_step_s = parse_quantity(args.step, Dimension::Time);
+  if (!args.retract_speed.empty()) {
+    protocol.retraction_speed_m_per_s = parse_quantity(args.retract_speed, Dimension::Speed);
+  }
+  std::optional<LoadedCurve> measured;
+  if (!args.compare.empty()) {
+    CurveArgs c = args.curve;
+    c.speed = args.speed;
+    c.angle = args.angle;
+    measured = load_curve(args.compare, c);
+  }
+  if (!args.depth.empty()) {
+    protocol.max_depth_m = parse_quantity(args.depth, Dimension::Length);
+  } else if (measured) {
+    protocol.max_depth_m = measured->curve.depth_m.back();
+  } else {
+    throw InputError("predict: give --depth (or --compare CURVE.csv to use its depth)");
+  }
+  const auto samples = model.simulate(protocol);
+  nlohmann::json comparison;
+  if (measured) {
+    const double offset = mean_fitted_offset(args.params_file);
+    const auto predicted = predict_loading(model, measured->curve, offset);
+    const auto m = compare_curves(measured->curve.force_N, predicted);
+    comparison = {{"file", measured->curve.name},
+                  {"rmse_N", m.rmse_N},
+                  {"r2", m.r2},
+                  {"max_error_N", m.max_error_N},
+                  {"samples", m.samples},
+                  {"loading_branch", measured->branch.summary}};
+    if (!args.json) {
+      std::cerr << measured->branch.summary << "\nprediction vs " << measured->curve.name
+                << ": RMSE " << m.rmse_N << " N, R2 " << m.r2 << ", max error " << m.max_error_N
+                << " N\n";
+    }
+  }
+  if (args.json) {
+    nlohmann::json t = nlohmann::json::array(), z = t, ph = t, f = t, fc = t, fs = t, ff = t,
+                   fv = t;
+    for (const auto& s : samples) {
+      t.push_back(s.time_s);
+      z.push_back(s.depth_m);
+      ph.push_back(phase_name(s.phase));
+      f.push_back(s.force.total_N());
+      fc.push_back(s.force.cutting_N);
+      fs.push_back(s.force.stiffness_N);
+      ff.push_back(s.force.friction_N);
+      fv.push_back(s.force.viscous_N);
+    }
+    nlohmann::json out = {
+        {"model", "triforce"},
+        {"conditions",
+         {{"speed_m_per_s", protocol.conditions.speed_m_per_s},
+          {"angle_rad", protocol.conditions.angle_rad},
+          {"depth_m", protocol.max_depth_m},
+          {"hold_s", protocol.hold_s},
+          {"perturbation_amplitude_m", protocol.conditions.perturbation_amplitude_m},
+          {"perturbation_frequency_Hz", protocol.conditions.perturbation_frequency_Hz}}},
+        {"time_s", t},
+        {"depth_m", z},
+        {"phase", ph},
+        {"force_N", f},
+        {"cutting_N", fc},
+        {"stiffness_N", fs},
+        {"friction_N", ff},
+        {"viscous_N", fv}};
+    if (measured) out["comparison"] = comparison;
+    std::cout << out.dump(2) << "\n";
+    return;
+  }
+  std::cout << "time_s,depth_m,phase,force_N,cutting_N,stiffness_N,friction_N,viscous_N\n"
+            << std::setprecision(8);
+  for (const auto& s : samples) {
+    std::cout << s.time_s << "," << s.depth_m << "," << phase_name(s.phase) << ","
+              << s.force.total_N() << "," << s.force.cutting_N << "," << s.force.stiffness_N << ","
+              << s.force.friction_N << "," << s.force.viscous_N << "\n";
+  }
+}
+
+// ---------------------------------------------------------------- stats
+struct StatsArgs {
+  std::string file;
+  std::string value = "value";
+  std::string group = "group";
+  double alpha = 0.05;
+  bool json = false;
+};
+
+void run_stats(const StatsArgs& args) {
+  std::vector<std::string> labels;
+  std::vector<double> values;
+  read_grouped_csv(args.file, args.value, args.group, labels, values);
+  const auto r = one_way_anova(labels, values, args.alpha);
+  if (args.json) {
+    nlohmann::json groups = nlohmann::json::array(), pairs = nlohmann::json::array();
+    for (const auto& g : r.groups)
+      groups.push_back({{"name", g.name}, {"n", g.n}, {"mean", g.mean}, {"sd", g.sd}});
+    for (const auto& c : r.tukey) {
+      pairs.push_back({{"group1", c.group1},
+                       {"group2", c.group2},
+                       {"meandiff", c.mean_difference},
+                       {"p_adj", c.p_adjusted},
+                       {"lower", c.ci_low},
+                       {"upper", c.ci_high},
+                       {"reject", c.reject}});
+    }
+    const auto& a = r.anova;
+    std::cout << nlohmann::json{{"value", args.value},
+                                {"groups", groups},
+                                {"anova",
+                                 {{"ss_between", a.ss_between},
+                                  {"ss_within", a.ss_within},
+                                  {"df_between", a.df_between},
+                                  {"df_within", a.df_within},
+                                  {"ms_between", a.ms_between},
+                                  {"ms_within", a.ms_within},
+                                  {"F", a.f},
+                                  {"p", a.p}}},
+                                {"alpha", r.alpha},
+                                {"q_critical", r.q_critical},
+                                {"tukey_hsd", pairs}}
+                     .dump(2)
+              << "\n";
+    return;
+  }
+  std::cout << "one-way ANOVA of '" << args.value << "' by '" << args.group << "'\n";
+  for (const auto& g : r.groups) {
+    std::cout << "  " << std::left << std::setw(16) << g.name << std::right << " n " << std::setw(3)
+              << g.n << "  mean " << std::setw(10) << g.mean << "  sd " << g.sd << "\n";
+  }
+  std::cout << "  F(" << r.anova.df_between << ", " << r.anova.df_within << ") = " << r.anova.f
+            << ", p = " << r.anova.p << "\n\nTukey HSD (alpha " << r.alpha << ", q_crit "
+            << r.q_critical << "); meandiff = mean(group1) - mean(group2)\n"
+            << "  group1 group2 meandiff p-adj lower upper reject\n";
+  for (const auto& c : r.tukey) {
+    std::cout << "  " << c.group1 << " " << c.group2 << " " << c.mean_difference << " "
+              << c.p_adjusted << " " << c.ci_low << " " << c.ci_high << " "
+              << (c.reject ? "True" : "False") << "\n";
+  }
+}
+
+}  // namespace
+
+void add_fit_command(CLI::App& app) {
+  auto args = std::make_shared<FitArgs>();
+  auto* cmd = app.add_subcommand("fit", "Fit paper B's tri-force model to force-depth recordings");
+  cmd->add_option("curves", args->files, "Force-depth CSV files (fitted jointly)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--model", args->model, "Force model")->capture_default_str();
+  add_curve_options(cmd, args->curve);
+  cmd->add_option("--fix", args->fix, "Hold a parameter, NAME=VALUE (e.g. beta=0, eta_Ns=0.5)");
+  cmd->add_option("--free", args->free,
+                  "Fit exactly these parameters (default: the material ones)");
+  cmd->add_option("--layer-start", args->layer_starts,
+                  "Add a layer starting at this travel (e.g. 8mm)");
+  cmd->add_option("--detect-layers", args->detect_layers,
+                  "Up to N layers, boundaries from slope changes of the first curve");
+  cmd->add_option("--starts", args->starts, "Number of Levenberg-Marquardt starts")
+      ->capture_default_str();
+  cmd->add_flag("--json", args->json, "Print the fit as JSON");
+  cmd->add_option("--out", args->out_dir, "Write fit.json and <curve>_fit.csv into this directory");
+  cmd->callback([args] { run_fit(*args); });
+}
+
+void add_predict_command(CLI::App& app) {
+  auto args = std::make_shared<PredictArgs>();
+  auto* cmd = app.add_subcommand(
+      "predict", "Predict force against depth and time: insertion, hold, retraction");
+  cmd->add_option("--model", args->model, "Force model")->capture_default_str();
+  cmd->add_option("--params", args->params_file, "Parameters written by `mneedle fit --json/--out`")
+      ->required();
+  cmd->add_option("--speed", args->speed, "Insertion speed")->capture_default_str();
+  cmd->add_option("--angle", args->angle, "Needle-to-surface angle (90deg = perpendicular)")
+      ->capture_default_str();
+  cmd->add_option("--depth", args->depth, "Insertion depth (travel from contact)");
+  cmd->add_option("--hold", args->hold, "Hold at depth before retraction")->capture_default_str();
+  cmd->add_option("--retract-speed", args->retract_speed, "Retraction speed (default: --speed)");
+  cmd->add_option("--step", args->step, "Output time step")->capture_default_str();
+  cmd->add_option("--perturb-amplitude", args->amplitude, "Lateral vibration amplitude A")
+      ->capture_default_str();
+  cmd->add_option("--perturb-frequency", args->frequency_Hz, "Lateral vibration frequency f, Hz")
+      ->capture_default_str();
+  cmd->add_option("--compare", args->compare,
+                  "Measured CSV: report RMSE, R2, max error of the prediction")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--depth-col", args->curve.depth_col, "Depth column of --compare");
+  cmd->add_option("--force-col", args->curve.force_col, "Force column of --compare");
+  auto* csv = cmd->add_flag("--csv", args->csv, "CSV output (the default)");
+  cmd->add_flag("--json", args->json, "JSON output")->excludes(csv);
+  cmd->callback([args] { run_predict(*args); });
+}
+
+void add_stats_command(CLI::App& app) {
+  auto args = std::make_shared<StatsArgs>();
+  auto* cmd = app.add_subcommand("stats", "One-way ANOVA and Tukey HSD between groups");
+  cmd->add_option("grouped", args->file, "CSV with a group column and a value column")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--value", args->value, "Value column")->capture_default_str();
+  cmd->add_option("--group", args->group, "Group column")->capture_default_str();
+  cmd->add_option("--alpha", args->alpha, "Family-wise significance level")->capture_default_str();
+  cmd->add_flag("--json", args->json, "Print JSON");
+  cmd->callback([args] { run_stats(*args); });
+}
+
+}  // namespace mneedle::cli

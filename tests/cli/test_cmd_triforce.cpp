@@ -1,0 +1,135 @@
+// Runs the built `mneedle fit`, `predict` and `stats` end to end and checks status and output.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include "mneedle/triforce_model.h"
+
+namespace {
+
+struct CommandRun {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+const std::filesystem::path kWork = std::filesystem::temp_directory_path() /
+                                    ("mneedle_test_triforce_" + std::to_string(::getpid()));
+
+// Removes the scratch directory when the test program ends.
+struct ScratchCleanup {
+  ~ScratchCleanup() {
+    std::error_code ignored;
+    std::filesystem::remove_all(kWork, ignored);
+  }
+} const kScratchCleanup;
+
+CommandRun run_mneedle(const std::string& arguments) {
+  std::filesystem::create_directories(kWork);
+  const std::string binary = std::string(MNEEDLE_BINARY_ROOT) + "/cli/mneedle";
+  const auto err_file = kWork / "stderr.txt";
+  const std::string command = "'" + binary + "' " + arguments + " 2>'" + err_file.string() + "'";
+  CommandRun run;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return run;
+  char buffer[4096];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;)
+    run.out.append(buffer, n);
+  const int status = ::pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(err_file);
+  std::stringstream s;
+  s << in.rdbuf();
+  run.err = s.str();
+  return run;
+}
+
+// A recording like the rig's: approach, loading at 1 mm/s from contact at 2 mm, hold, retraction.
+std::string write_recording() {
+  mneedle::TriforceParams p;
+  p.layers[0] = {0.0, 1.0, 500.0, 0.8, 0.5, 4e4};
+  const mneedle::TriforceModel model(p);
+  const mneedle::InsertionConditions c{1e-3, std::numbers::pi / 2.0};
+  std::mt19937 random(11);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  std::filesystem::create_directories(kWork);
+  const auto file = kWork / "recording.csv";
+  std::ofstream out(file);
+  out << "time_s,travel_mm,fz_N\n";
+  double t = 0.0;
+  for (; t <= 17.0; t += 0.02) {
+    const double travel = 1e-3 * t;
+    out << t << "," << travel * 1e3 << ","
+        << model.loading(travel - 2e-3, c).total_N() + noise(random) << "\n";
+  }
+  for (int i = 0; i < 100; ++i, t += 0.02) out << t << ",17," << 3.0 + noise(random) << "\n";
+  for (double travel = 17.0; travel > 0.0; travel -= 0.02, t += 0.02)
+    out << t << "," << travel << ",-0.5\n";
+  return file.string();
+}
+
+TEST(CmdTriforce, FitJsonReportsParametersErrorsAndCurveMetrics) {
+  const auto file = write_recording();
+  const auto run = run_mneedle("fit '" + file + "' --model triforce --json --starts 4 --out '" +
+                               (kWork / "fit").string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["model"], "triforce");
+  EXPECT_TRUE(j["params"].contains("K0_N"));
+  EXPECT_TRUE(j["stderr"].contains("K0_N"));
+  EXPECT_FALSE(j["stderr"].contains("mu"));  // fixed by default
+  ASSERT_EQ(j["curves"].size(), 1u);
+  EXPECT_GT(j["curves"][0]["r2"].get<double>(), 0.99);
+  EXPECT_LT(j["curves"][0]["rmse_N"].get<double>(), 0.02);
+  EXPECT_NEAR(j["curves"][0]["speed_m_per_s"].get<double>(), 1e-3, 1e-5);
+  EXPECT_TRUE(std::filesystem::exists(kWork / "fit" / "fit.json"));
+  EXPECT_TRUE(std::filesystem::exists(kWork / "fit" / "recording_fit.csv"));
+}
+
+TEST(CmdTriforce, PredictGoesInHoldsAndComesOut) {
+  const auto file = write_recording();
+  ASSERT_EQ(
+      run_mneedle("fit '" + file + "' --starts 2 --out '" + (kWork / "p").string() + "'").exit_code,
+      0);
+  const auto run =
+      run_mneedle("predict --model triforce --params '" + (kWork / "p" / "fit.json").string() +
+                  "' --speed 2mm/s --angle 90deg --depth 10mm --hold 1s --step 0.1s --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  const auto& phase = j["phase"];
+  EXPECT_EQ(phase.front(), "insertion");
+  EXPECT_EQ(phase.back(), "retraction");
+  EXPECT_NEAR(j["depth_m"].back().get<double>(), 0.0, 1e-12);
+  EXPECT_NEAR(j["time_s"].back().get<double>(), 5.0 + 1.0 + 5.0, 1e-6);
+  EXPECT_LT(j["force_N"].back().get<double>(), 1e-12);  // friction reversed or zero on the way out
+}
+
+TEST(CmdTriforce, StatsPrintsAnovaAndTukey) {
+  const auto run = run_mneedle("stats '" + std::string(MNEEDLE_TEST_ASSETS) +
+                               "/curves/grouped.csv' --value force_N --group group --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["anova"]["df_between"], 1);
+  EXPECT_EQ(j["anova"]["df_within"], 4);
+  ASSERT_EQ(j["tukey_hsd"].size(), 1u);
+  EXPECT_NEAR(j["tukey_hsd"][0]["meandiff"].get<double>(), 5.0666667 - 5.4666667, 1e-6);
+}
+
+TEST(CmdTriforce, BadCurveFailsWithFileAndLine) {
+  const auto run =
+      run_mneedle("fit '" + std::string(MNEEDLE_TEST_ASSETS) + "/curves/text_in_number.csv'");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("text_in_number.csv:4"), std::string::npos) << run.err;
+}
+
+}  // namespace
