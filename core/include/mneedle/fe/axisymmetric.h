@@ -1,0 +1,179 @@
+#pragma once
+// Axisymmetric (r, z) finite element model of a layered tissue cylinder indented along its axis
+// by a rigid axisymmetric needle: 6-node triangles, total Lagrangian, Newton-Raphson.
+// SI units throughout: metres, newtons, pascals, joules.
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "mneedle/fe/material.h"
+
+namespace mneedle::fe {
+
+/// One tissue layer, listed from the surface downward.
+struct AxisymmetricLayer {
+  double thickness_m = 0.0;
+  MaterialParameters material;
+};
+
+/// Rigid needle of revolution in its own frame: tip at height 0, body toward +h. The solid
+/// section at height h is the annulus bore_radius <= r <= outer radius(h), the outer radius
+/// piecewise linear and non-decreasing in h (a flat punch starts at its full radius).
+struct AxisymmetricNeedle {
+  std::vector<double> heights_m;  ///< ascending, first 0
+  std::vector<double> radii_m;    ///< outer radius at each height
+  double bore_radius_m = 0.0;     ///< 0 for a solid needle
+
+  static AxisymmetricNeedle flat_punch(double radius_m, double bore_radius_m = 0.0);
+  /// Cone of the given half-angle from the axis, widening to base_radius_m (then a cylinder).
+  static AxisymmetricNeedle cone(double half_angle_rad, double base_radius_m,
+                                 double bore_radius_m = 0.0);
+
+  double max_radius() const;
+  /// Lowest height at which the solid section reaches radius r; +infinity when it never does
+  /// (r beyond the outer radius or inside the bore).
+  double lowest_height_at(double r) const;
+};
+
+enum class Fidelity { Fast, Standard, Fine };
+enum class ContactMode { Sticking, Frictionless };
+
+/// Structured graded mesh controls. Element size h_m is used within fine_radius_m of the axis
+/// and down to fine_depth_m; beyond, sizes grow geometrically by `growth` up to max_size_m.
+struct AxisymmetricMeshOptions {
+  double radius_m = 0.0;  ///< tissue cylinder radius
+  double h_m = 0.0;
+  double fine_radius_m = 0.0;
+  double fine_depth_m = 0.0;
+  double growth = 1.25;
+  double max_size_m = std::numeric_limits<double>::infinity();
+  int min_elements_per_layer = 2;
+  std::vector<double> radial_breaks_m;  ///< radii that must be node columns (punch edge, bore)
+};
+
+/// Reference coordinates (r, z): z = 0 is the free surface, tissue at z < 0, axis at r = 0.
+struct AxisymmetricMesh {
+  std::vector<Eigen::Vector2d> nodes;
+  /// Corners counter-clockwise in (r, z), then mid-edge nodes 1-2, 2-3, 3-1.
+  std::vector<std::array<std::uint32_t, 6>> elements;
+  std::vector<int> element_layer;            ///< index into the layer list
+  std::vector<std::uint32_t> surface_nodes;  ///< z = 0, sorted by r
+  std::vector<std::uint32_t> axis_nodes;     ///< r = 0
+  std::vector<std::uint32_t> fixed_nodes;    ///< bottom and outer side (clamped)
+  double min_angle_deg = 0.0;                ///< smallest corner angle of any element
+  double max_aspect_ratio = 0.0;             ///< longest edge / shortest altitude
+};
+
+/// Layers meshed top to bottom; every interface is a row of element edges.
+AxisymmetricMesh make_axisymmetric_mesh(const std::vector<AxisymmetricLayer>& layers,
+                                        const AxisymmetricMeshOptions& options);
+
+/// Result of one equilibrium solve.
+struct Equilibrium {
+  Eigen::VectorXd displacement;  ///< 2 per node: u_r, u_z
+  Eigen::VectorXd reaction;      ///< internal force at every degree of freedom (N, full ring)
+  double strain_energy_J = 0.0;
+  int newton_iterations = 0;
+};
+
+/// Newton-Raphson settings.
+struct NewtonOptions {
+  int max_iterations = 25;
+  double residual_tolerance = 1e-8;  ///< on |R_free| relative to |reactions|
+  /// Also converged when |R_free| <= this * |reactions| and the last iteration did not halve it
+  /// (the round-off floor of the assembled forces, ~1e-7 relative near a punch edge).
+  double stagnation_tolerance = 1e-5;
+  /// Reuse the factorisation within a solve while the residual falls by 4x per iteration.
+  bool modified_newton = true;
+};
+
+/// Assembly and equilibrium on a fixed mesh; reuses the sparsity pattern and its symbolic
+/// factorisation across every solve.
+class AxisymmetricModel {
+ public:
+  AxisymmetricModel(AxisymmetricMesh mesh, const std::vector<MaterialParameters>& layer_materials);
+  ~AxisymmetricModel();
+  AxisymmetricModel(AxisymmetricModel&&) noexcept;
+  AxisymmetricModel& operator=(AxisymmetricModel&&) noexcept;
+
+  const AxisymmetricMesh& mesh() const;
+  std::size_t dof_count() const;
+  bool is_linear() const;
+  /// Numeric factorisations performed by solve() so far.
+  int factorization_count() const;
+
+  /// Internal force vector at displacement u; tangent stiffness when `tangent` is not null.
+  /// Throws SolverError on an inverted element.
+  Eigen::VectorXd internal_force(const Eigen::VectorXd& u, double* strain_energy_J,
+                                 Eigen::SparseMatrix<double>* tangent) const;
+
+  /// Equilibrium with u[dof] = value on `prescribed_dofs`, zero external force elsewhere,
+  /// Newton from `start`. Throws SolverError when Newton does not converge.
+  Equilibrium solve(const std::vector<std::uint32_t>& prescribed_dofs,
+                    const Eigen::VectorXd& prescribed_values, const Eigen::VectorXd& start,
+                    const NewtonOptions& options = {});
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// One converged depth of an insertion.
+struct InsertionStep {
+  double depth_m = 0.0;
+  double force_N = 0.0;          ///< axial force resisting the needle (positive)
+  double contact_area_m2 = 0.0;  ///< projected on the surface plane
+  double contact_pressure_Pa = 0.0;
+  double strain_energy_J = 0.0;
+  int newton_iterations = 0;  ///< summed over the sub-steps since the previous output
+  int contact_nodes = 0;
+};
+
+struct InsertionOptions {
+  double depth_m = 0.0;  ///< final tip depth below the undeformed surface
+  int output_steps = 20;
+  /// Frictionless: linear layers only (node-to-profile constraints on the condensed system).
+  ContactMode contact = ContactMode::Sticking;
+  NewtonOptions newton;
+};
+
+struct InsertionResult {
+  std::vector<InsertionStep> steps;
+  std::size_t nodes = 0;
+  std::size_t elements = 0;
+  int factorizations = 0;
+  double mesh_seconds = 0.0;
+  double solve_seconds = 0.0;
+};
+
+/// Presses the needle into the model to options.depth_m. A linear model factorises once and
+/// condenses the tissue's stiffness onto the surface nodes the needle can reach.
+InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle& needle,
+                              const InsertionOptions& options);
+
+/// The one-off case: mesh sized from the fidelity and the needle, then insert.
+/// Cylinder radius: the caller's choice (see docs/_parts/fe_model.md for the block equivalent).
+struct AxisymmetricProblem {
+  std::vector<AxisymmetricLayer> layers;
+  double radius_m = 0.0;
+  AxisymmetricNeedle needle;
+  double depth_m = 0.0;
+  Fidelity fidelity = Fidelity::Standard;
+  ContactMode contact = ContactMode::Sticking;
+  int output_steps = 0;  ///< 0: from the fidelity
+};
+
+InsertionResult simulate_axisymmetric(const AxisymmetricProblem& problem);
+
+/// Mesh controls used by simulate_axisymmetric for this problem.
+AxisymmetricMeshOptions mesh_options_for(const AxisymmetricProblem& problem);
+
+/// Radius of the cylinder whose cross-section has the area of a square block of side `width_m`.
+double equal_area_radius(double width_m);
+
+}  // namespace mneedle::fe

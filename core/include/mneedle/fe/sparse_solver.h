@@ -1,0 +1,46 @@
+#pragma once
+// Sparse symmetric direct solver shared by the finite element models. CHOLMOD stays inside
+// sparse_solver.cpp: including it costs seconds per translation unit.
+
+#include <Eigen/Sparse>
+#include <memory>
+#include <string>
+
+namespace mneedle::fe {
+
+/// SPD direct solver with a symmetric-indefinite fallback. CHOLMOD supernodal Cholesky when
+/// MNEEDLE_HAVE_CHOLMOD, else Eigen's SimplicialLLT; when the Cholesky factorisation fails
+/// (matrix not positive definite) it falls back to Eigen's SimplicialLDLT.
+/// analyze() once per sparsity pattern, factorize() per matrix, solve() per right-hand side.
+/// Only the lower triangle of the matrix is read.
+class SparseSolver {
+ public:
+  SparseSolver();
+  ~SparseSolver();
+  SparseSolver(SparseSolver&&) noexcept;
+  SparseSolver& operator=(SparseSolver&&) noexcept;
+  SparseSolver(const SparseSolver&) = delete;
+  SparseSolver& operator=(const SparseSolver&) = delete;
+
+  /// Symbolic analysis (fill-reducing ordering); reused by every factorize() of the same pattern.
+  void analyze(const Eigen::SparseMatrix<double>& matrix);
+  /// Numeric factorisation; calls analyze() itself when the pattern size changed.
+  void factorize(const Eigen::SparseMatrix<double>& matrix);
+  /// Solves matrix * x = rhs with the last factorisation; throws SolverError if none succeeded.
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const;
+  /// Several right-hand sides (columns) at once.
+  Eigen::MatrixXd solve_many(const Eigen::MatrixXd& rhs) const;
+  /// True when the last factorize() succeeded.
+  bool ok() const;
+  /// Which factorisation served the last factorize(): "cholmod-supernodal-llt",
+  /// "eigen-simplicial-llt" or "eigen-simplicial-ldlt".
+  std::string backend() const;
+  /// Number of symbolic analyses performed so far (to check that the pattern is reused).
+  int analysis_count() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mneedle::fe

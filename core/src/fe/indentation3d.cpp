@@ -1,0 +1,569 @@
+#include "mneedle/fe/indentation3d.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "fe/needle_shape.h"
+#include "mneedle/error.h"
+#include "mneedle/fe/solid3d.h"
+#include "mneedle/fe/sparse_solver.h"
+
+namespace mneedle::fe {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+struct CapturedNode {
+  int node;
+  int needle;
+  Eigen::Vector3d anchor;  // where it sits on the needle surface, needle frame
+};
+
+std::string micrometres(double metres) {
+  std::ostringstream out;
+  out.precision(4);
+  out << metres * 1e6 << " um";
+  return out.str();
+}
+
+constexpr int kMaxCaptureRounds = 60;
+constexpr int kMaxNewtonIterations = 40;
+constexpr int kMaxLineSearchHalvings = 6;
+constexpr int kMaxStepCuts = 12;
+
+}  // namespace
+
+struct Indentation3d::Impl {
+  Impl(const TetMesh& m, std::vector<Needle3d> n) : mesh(m), model(m), needles(std::move(n)) {}
+
+  const TetMesh& mesh;
+  SolidModel model;
+  std::vector<Needle3d> needles;
+  std::vector<NeedleShape> shapes;
+  std::vector<double> reach;         // horizontal reach radius per needle
+  std::vector<int> candidates;       // top-surface nodes a needle may capture
+  std::vector<int> candidate_index;  // node -> index in candidates or -1
+  std::vector<CapturedNode> captured;
+  std::vector<int> captured_by;  // node -> needle or -1
+  std::vector<char> fixed_dof;
+  SparseSolver solver;
+  Eigen::SparseMatrix<double> stiffness;
+  Timing3d timing;
+  double depth = 0.0;
+  int iterations = 0;
+  bool linear_factorized = false;
+  // Linear path: rows (candidate dofs) of K⁻¹ columns at captured dofs, and the multipliers.
+  Eigen::MatrixXd compliance;
+  Eigen::VectorXd multipliers;
+  // Nonlinear path.
+  Eigen::VectorXd u;
+  double step = 0.0;
+  Eigen::SparseMatrix<double> tangent;   // last factorised tangent before the Dirichlet rows
+  std::vector<char> factor_constraints;  // prescribed dofs of the current factorisation
+
+  Eigen::Vector3d tip(int needle, double at_depth) const {
+    const auto& n = needles[static_cast<std::size_t>(needle)];
+    return {n.x, n.y, -at_depth};
+  }
+  Eigen::Vector3d prescribed(const CapturedNode& c, double at_depth) const {
+    return c.anchor + tip(c.needle, at_depth) - mesh.nodes[static_cast<std::size_t>(c.node)];
+  }
+  Eigen::VectorXd prescribed_vector(double at_depth) const {
+    Eigen::VectorXd values(3 * static_cast<Eigen::Index>(captured.size()));
+    for (std::size_t i = 0; i < captured.size(); ++i)
+      values.segment<3>(3 * static_cast<Eigen::Index>(i)) = prescribed(captured[i], at_depth);
+    return values;
+  }
+
+  void select_candidates(double max_depth) {
+    candidate_index.assign(mesh.nodes.size(), -1);
+    for (std::size_t n = 0; n < needles.size(); ++n) {
+      shapes.emplace_back(needles[n].mesh);
+      // Margin: surface nodes move sideways a little before the needle reaches them.
+      reach.push_back(1.1 * shapes.back().max_radius_up_to(max_depth) + 1e-9);
+    }
+    for (const auto& face : mesh.top_faces)
+      for (int node : face) {
+        if (node < 0 || candidate_index[static_cast<std::size_t>(node)] >= 0) continue;
+        if (mesh.fixed[static_cast<std::size_t>(node)]) continue;
+        const Eigen::Vector3d& p = mesh.nodes[static_cast<std::size_t>(node)];
+        for (std::size_t n = 0; n < needles.size(); ++n)
+          if (std::hypot(p.x() - needles[n].x, p.y() - needles[n].y) <= reach[n]) {
+            candidate_index[static_cast<std::size_t>(node)] = static_cast<int>(candidates.size());
+            candidates.push_back(node);
+            break;
+          }
+      }
+    captured_by.assign(mesh.nodes.size(), -1);
+  }
+
+  // Candidates whose current position lies inside a needle at `at_depth` are captured onto the
+  // needle face right below them (the face that swept over them).
+  std::vector<CapturedNode> find_new_captures(double at_depth, const auto& displacement_of) const {
+    std::vector<CapturedNode> found;
+    for (int node : candidates) {
+      if (captured_by[static_cast<std::size_t>(node)] >= 0) continue;
+      const Eigen::Vector3d x = mesh.nodes[static_cast<std::size_t>(node)] + displacement_of(node);
+      for (std::size_t n = 0; n < needles.size(); ++n) {
+        const Eigen::Vector3d local = x - tip(static_cast<int>(n), at_depth);
+        if (local.head<2>().norm() > reach[n] || !shapes[n].contains(local)) continue;
+        found.push_back({node, static_cast<int>(n), shapes[n].lower_surface_below(local)});
+        break;
+      }
+    }
+    return found;
+  }
+
+  void add_captures(const std::vector<CapturedNode>& found) {
+    for (const auto& c : found) {
+      captured.push_back(c);
+      captured_by[static_cast<std::size_t>(c.node)] = c.needle;
+    }
+  }
+
+  // ---- linear path --------------------------------------------------------------------------
+  void factorize_linear() {
+    auto start = Clock::now();
+    stiffness = model.empty_stiffness();
+    model.assemble(Eigen::VectorXd::Zero(model.dof_count()), &stiffness, nullptr);
+    apply_dirichlet(&stiffness, fixed_dof);
+    timing.assembly_s += seconds_since(start);
+    start = Clock::now();
+    solver.analyze(stiffness);
+    solver.factorize(stiffness);
+    ++timing.factorizations;
+    timing.factorization_s += seconds_since(start);
+    if (!solver.ok()) throw SolverError("3-D solve: singular stiffness at depth 0 um");
+    linear_factorized = true;
+  }
+
+  void append_compliance_columns(const std::vector<CapturedNode>& found) {
+    const Eigen::Index old_columns = compliance.cols();
+    Eigen::MatrixXd unit =
+        Eigen::MatrixXd::Zero(model.dof_count(), 3 * static_cast<Eigen::Index>(found.size()));
+    for (std::size_t i = 0; i < found.size(); ++i)
+      for (int j = 0; j < 3; ++j)
+        unit(3 * found[i].node + j, 3 * static_cast<Eigen::Index>(i) + j) = 1.0;
+    const Eigen::MatrixXd columns = solver.solve_many(unit);
+    compliance.conservativeResize(3 * static_cast<Eigen::Index>(candidates.size()),
+                                  old_columns + columns.cols());
+    for (std::size_t c = 0; c < candidates.size(); ++c)
+      for (int j = 0; j < 3; ++j)
+        compliance.block(3 * static_cast<Eigen::Index>(c) + j, old_columns, 1, columns.cols()) =
+            columns.row(3 * candidates[c] + j);
+  }
+
+  Eigen::VectorXd candidate_displacement() const {
+    if (captured.empty())
+      return Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(candidates.size()));
+    return compliance * multipliers;
+  }
+
+  void solve_linear_contact(double at_depth) {
+    if (captured.empty()) {
+      multipliers.resize(0);
+      return;
+    }
+    const Eigen::Index m = 3 * static_cast<Eigen::Index>(captured.size());
+    Eigen::MatrixXd coupling(m, m);
+    for (std::size_t i = 0; i < captured.size(); ++i)
+      coupling.middleRows(3 * static_cast<Eigen::Index>(i), 3) =
+          compliance.middleRows(3 * candidate_index[static_cast<std::size_t>(captured[i].node)], 3);
+    Eigen::LLT<Eigen::MatrixXd> llt(coupling);
+    if (llt.info() != Eigen::Success)
+      throw SolverError("3-D solve: contact compliance not positive definite at depth " +
+                        micrometres(at_depth));
+    multipliers = llt.solve(prescribed_vector(at_depth));
+  }
+
+  int advance_linear(double at_depth) {
+    if (!linear_factorized) factorize_linear();
+    const auto start = Clock::now();
+    int solves = 0;
+    for (int round = 0; round < kMaxCaptureRounds; ++round) {
+      solve_linear_contact(at_depth);
+      ++solves;
+      const Eigen::VectorXd us = candidate_displacement();
+      const auto found = find_new_captures(at_depth, [&](int node) -> Eigen::Vector3d {
+        return us.segment<3>(3 * candidate_index[static_cast<std::size_t>(node)]);
+      });
+      if (found.empty()) {
+        timing.contact_s += seconds_since(start);
+        return solves;
+      }
+      append_compliance_columns(found);
+      add_captures(found);
+    }
+    throw SolverError("3-D solve: contact set did not settle at depth " + micrometres(at_depth));
+  }
+
+  Eigen::VectorXd linear_displacement() const {
+    Eigen::VectorXd load = Eigen::VectorXd::Zero(model.dof_count());
+    for (std::size_t i = 0; i < captured.size(); ++i)
+      load.segment<3>(3 * captured[i].node) =
+          multipliers.segment<3>(3 * static_cast<Eigen::Index>(i));
+    if (captured.empty()) return load;
+    return solver.solve(load);
+  }
+
+  // ---- nonlinear path -----------------------------------------------------------------------
+  std::vector<char> constrained_dofs() const {
+    std::vector<char> constrained = fixed_dof;
+    for (const auto& c : captured)
+      for (int j = 0; j < 3; ++j) constrained[static_cast<std::size_t>(3 * c.node + j)] = 1;
+    return constrained;
+  }
+
+  static Eigen::VectorXd free_part(const Eigen::VectorXd& v, const std::vector<char>& constrained) {
+    Eigen::VectorXd r = v;
+    for (Eigen::Index i = 0; i < r.size(); ++i)
+      if (constrained[static_cast<std::size_t>(i)]) r(i) = 0.0;
+    return r;
+  }
+
+  double reaction_norm(const Eigen::VectorXd& force) const {
+    double sum = 0.0;
+    for (const auto& c : captured) sum += force.segment<3>(3 * c.node).squaredNorm();
+    return std::sqrt(sum);
+  }
+
+  Eigen::VectorXd internal_force(const Eigen::VectorXd& at) {
+    const auto start = Clock::now();
+    Eigen::VectorXd force;
+    model.assemble(at, nullptr, &force);
+    timing.assembly_s += seconds_since(start);
+    return force;
+  }
+
+  // Factorises the assembled tangent in `stiffness` for this set of prescribed dofs; keeps the
+  // unconstrained copy for the predictor's coupling term.
+  void factorize_tangent(const std::vector<char>& constrained) {
+    tangent = stiffness;
+    apply_dirichlet(&stiffness, constrained);
+    const auto start = Clock::now();
+    solver.factorize(stiffness);
+    ++timing.factorizations;
+    timing.factorization_s += seconds_since(start);
+    if (!solver.ok()) throw SolverError("singular tangent stiffness");
+    factor_constraints = constrained;
+  }
+
+  bool factor_fits(const std::vector<char>& constrained) const {
+    return factor_constraints == constrained;
+  }
+
+  Eigen::VectorXd assemble_force(bool with_tangent) {
+    const auto start = Clock::now();
+    Eigen::VectorXd force;
+    model.assemble(u, with_tangent ? &stiffness : nullptr, &force);
+    timing.assembly_s += seconds_since(start);
+    return force;
+  }
+
+  // Linear extrapolation of the prescribed jump into the free dofs (K_ff du_f = -r_f - K_fc du_c):
+  // moving only the captured nodes would invert the thin elements around them. The last
+  // tangent is reused when the prescribed set has not changed (modified Newton across steps).
+  int predict(const Eigen::VectorXd& jump, const std::vector<char>& constrained) {
+    const bool reuse = factor_fits(constrained);
+    const Eigen::VectorXd force = assemble_force(!reuse);
+    if (!reuse) factorize_tangent(constrained);
+    const Eigen::VectorXd coupled = tangent.selfadjointView<Eigen::Lower>() * jump;
+    u += jump + solver.solve(Eigen::VectorXd(free_part(-(force + coupled), constrained)));
+    return 1;
+  }
+
+  int newton(double at_depth) {
+    const std::vector<char> constrained = constrained_dofs();
+    Eigen::VectorXd jump = Eigen::VectorXd::Zero(u.size());
+    for (const auto& c : captured)
+      jump.segment<3>(3 * c.node) = prescribed(c, at_depth) - u.segment<3>(3 * c.node);
+    const int predicted = jump.squaredNorm() > 0.0 ? predict(jump, constrained) : 0;
+    const double length_scale = (mesh.nodes.front() - mesh.nodes.back()).norm();
+    // Modified Newton: a factorisation is kept while it still shrinks the residual at least
+    // fourfold per iteration.
+    bool refactor = !factor_fits(constrained);
+    for (int iteration = 1 + predicted; iteration <= kMaxNewtonIterations; ++iteration) {
+      const Eigen::VectorXd force = assemble_force(refactor);
+      const Eigen::VectorXd residual = free_part(force, constrained);
+      const double residual_norm = residual.norm();
+      if (residual_norm <= 1e-8 * reaction_norm(force)) return iteration - 1;
+      if (refactor) factorize_tangent(constrained);
+      const Eigen::VectorXd delta = solver.solve(Eigen::VectorXd(-residual));
+      const double accepted = line_search(delta, residual_norm, constrained);
+      if (delta.lpNorm<Eigen::Infinity>() < 1e-13 * length_scale) return iteration;
+      refactor = !(accepted < 0.25 * residual_norm);
+    }
+    throw SolverError("Newton-Raphson did not converge in " + std::to_string(kMaxNewtonIterations) +
+                      " iterations");
+  }
+
+  // Backtracking on the residual norm; an inverted element at a trial point counts as a failure.
+  // Returns the residual norm at the accepted point.
+  double line_search(const Eigen::VectorXd& delta, double residual_norm,
+                     const std::vector<char>& constrained) {
+    double alpha = 1.0;
+    for (int halving = 0; halving <= kMaxLineSearchHalvings; ++halving, alpha *= 0.5) {
+      const Eigen::VectorXd trial = u + alpha * delta;
+      try {
+        const double trial_norm = free_part(internal_force(trial), constrained).norm();
+        if (trial_norm < (1.0 - 1e-4 * alpha) * residual_norm ||
+            halving == kMaxLineSearchHalvings) {
+          u = trial;
+          return trial_norm;
+        }
+      } catch (const SolverError&) {
+        if (halving == kMaxLineSearchHalvings) throw;
+      }
+    }
+    return residual_norm;
+  }
+
+  int solve_nonlinear_at(double at_depth) {
+    int total = 0;
+    for (int round = 0; round < kMaxCaptureRounds; ++round) {
+      total += newton(at_depth);
+      const auto start = Clock::now();
+      const auto found = find_new_captures(
+          at_depth, [&](int node) -> Eigen::Vector3d { return u.segment<3>(3 * node); });
+      timing.contact_s += seconds_since(start);
+      if (found.empty()) return total;
+      add_captures(found);
+    }
+    throw SolverError("contact set did not settle");
+  }
+
+  int advance_nonlinear(double target) {
+    if (u.size() == 0) {
+      u = Eigen::VectorXd::Zero(model.dof_count());
+      stiffness = model.empty_stiffness();
+      solver.analyze(stiffness);
+    }
+    if (step <= 0.0) step = target - depth;
+    int total = 0;
+    int cuts = 0;
+    while (depth < target) {
+      const double h = std::min(step, target - depth);
+      const Eigen::VectorXd saved_u = u;
+      const std::size_t saved_captured = captured.size();
+      try {
+        const int used = solve_nonlinear_at(depth + h);
+        total += used;
+        depth += h;
+        if (used <= 4) step = 1.5 * h;
+        cuts = 0;
+      } catch (const SolverError& error) {
+        u = saved_u;
+        for (std::size_t i = saved_captured; i < captured.size(); ++i)
+          captured_by[static_cast<std::size_t>(captured[i].node)] = -1;
+        captured.resize(saved_captured);
+        step = 0.5 * h;
+        factor_constraints.clear();  // a fresh tangent for the retry
+        if (++cuts > kMaxStepCuts)
+          throw SolverError("3-D solve: stopped at depth " + micrometres(depth) + ": " +
+                            error.what());
+      }
+    }
+    return total;
+  }
+
+  // ---- results ------------------------------------------------------------------------------
+  Eigen::VectorXd captured_forces() {
+    // Force of the needle on each captured node (N), 3 per captured node.
+    if (model.is_linear()) return multipliers;
+    const Eigen::VectorXd force = internal_force(u);
+    Eigen::VectorXd result(3 * static_cast<Eigen::Index>(captured.size()));
+    for (std::size_t i = 0; i < captured.size(); ++i)
+      result.segment<3>(3 * static_cast<Eigen::Index>(i)) = force.segment<3>(3 * captured[i].node);
+    return result;
+  }
+
+  // Projected area of the top faces touched by a needle, each face counted by the fraction of
+  // its nodes the needle holds (so the rim faces count in part, not all or nothing).
+  double contact_area(int needle, const Eigen::VectorXd& displacement) const {
+    double area = 0.0;
+    const int face_nodes = mesh.order == 1 ? 3 : 6;
+    for (const auto& face : mesh.top_faces) {
+      int held = 0;
+      for (int k = 0; k < face_nodes; ++k)
+        if (captured_by[static_cast<std::size_t>(face[static_cast<std::size_t>(k)])] == needle)
+          ++held;
+      if (held == 0) continue;
+      std::array<Eigen::Vector2d, 3> p;
+      for (int k = 0; k < 3; ++k) {
+        const int node = face[static_cast<std::size_t>(k)];
+        p[static_cast<std::size_t>(k)] = mesh.nodes[static_cast<std::size_t>(node)].head<2>() +
+                                         displacement.segment<2>(3 * node);
+      }
+      const Eigen::Vector2d a = p[1] - p[0], b = p[2] - p[0];
+      area += 0.5 * std::abs(a.x() * b.y() - a.y() * b.x()) * held / face_nodes;
+    }
+    return area;
+  }
+
+  Step3d report(double at_depth, int solves) {
+    Step3d result;
+    result.depth_m = at_depth;
+    result.newton_iterations = solves;
+    const Eigen::VectorXd forces = captured_forces();
+    const Eigen::VectorXd imposed = prescribed_vector(at_depth);
+    result.strain_energy_J = model.is_linear() ? 0.5 * forces.dot(imposed) : model.strain_energy(u);
+    const Eigen::VectorXd field = model.is_linear() ? linear_displacement() : u;
+    for (std::size_t n = 0; n < needles.size(); ++n) {
+      NeedleStep3d needle;
+      needle.name = needles[n].name;
+      Eigen::Vector3d total = Eigen::Vector3d::Zero();
+      for (std::size_t i = 0; i < captured.size(); ++i) {
+        if (captured[i].needle != static_cast<int>(n)) continue;
+        total -= forces.segment<3>(3 * static_cast<Eigen::Index>(i));  // tissue on needle
+        ++needle.captured_nodes;
+      }
+      needle.force_N = total.z();
+      needle.lateral_force_N = {total.x(), total.y()};
+      needle.contact_area_m2 = contact_area(static_cast<int>(n), field);
+      needle.contact_pressure_Pa =
+          needle.contact_area_m2 > 0.0 ? needle.force_N / needle.contact_area_m2 : 0.0;
+      result.needles.push_back(needle);
+    }
+    return result;
+  }
+};
+
+Indentation3d::Indentation3d(const TetMesh& mesh, std::vector<Needle3d> needles, double max_depth)
+    : impl_(std::make_unique<Impl>(mesh, std::move(needles))) {
+  if (impl_->needles.empty()) throw InputError("3-D indentation: no needle given");
+  if (!(max_depth > 0.0)) throw InputError("3-D indentation: depth must be positive");
+  impl_->select_candidates(max_depth);
+  impl_->fixed_dof.assign(static_cast<std::size_t>(impl_->model.dof_count()), 0);
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n)
+    if (mesh.fixed[n])
+      for (int j = 0; j < 3; ++j) impl_->fixed_dof[3 * n + static_cast<std::size_t>(j)] = 1;
+}
+
+Indentation3d::~Indentation3d() = default;
+
+Step3d Indentation3d::advance_to(double depth) {
+  if (!(depth >= impl_->depth) || !std::isfinite(depth))
+    throw InputError("3-D indentation: depths must grow (asked " + micrometres(depth) + " after " +
+                     micrometres(impl_->depth) + ")");
+  const auto start = Clock::now();
+  int solves = 0;
+  if (impl_->model.is_linear()) {
+    try {
+      solves = impl_->advance_linear(depth);
+    } catch (const SolverError& error) {
+      const std::string what = error.what();
+      if (what.rfind("3-D solve", 0) == 0) throw;
+      throw SolverError("3-D solve: stopped at depth " + micrometres(impl_->depth) + ": " + what);
+    }
+    impl_->depth = depth;
+  } else {
+    solves = impl_->advance_nonlinear(depth);
+  }
+  Step3d step = impl_->report(depth, solves);
+  impl_->timing.total_s += seconds_since(start);
+  return step;
+}
+
+Eigen::VectorXd Indentation3d::displacement() const {
+  return impl_->model.is_linear() ? impl_->linear_displacement() : impl_->u;
+}
+
+const Timing3d& Indentation3d::timing() const {
+  return impl_->timing;
+}
+
+std::string Indentation3d::solver_backend() const {
+  return impl_->solver.backend();
+}
+
+void Indentation3d::write_vtu(const std::string& path) const {
+  const TetMesh& mesh = impl_->mesh;
+  const Eigen::VectorXd u = displacement();
+  const std::vector<double> stress = impl_->model.von_mises(u);
+  const std::vector<double> energy = impl_->model.energy_density(u);
+  std::ofstream out(path);
+  if (!out) throw InputError(path + ": cannot open for writing");
+  out.precision(9);
+  const int per_element = mesh.nodes_per_element();
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
+      << "<UnstructuredGrid><Piece NumberOfPoints=\"" << mesh.nodes.size() << "\" NumberOfCells=\""
+      << mesh.elements.size() << "\">\n<Points>\n"
+      << "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (const auto& p : mesh.nodes) out << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+  out << "</DataArray>\n</Points>\n<Cells>\n"
+      << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+  for (const auto& e : mesh.elements) {
+    for (int a = 0; a < per_element; ++a) out << e[static_cast<std::size_t>(a)] << ' ';
+    out << '\n';
+  }
+  out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+  for (std::size_t e = 1; e <= mesh.elements.size(); ++e)
+    out << e * static_cast<std::size_t>(per_element) << '\n';
+  out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+  for (std::size_t e = 0; e < mesh.elements.size(); ++e)
+    out << (per_element == 4 ? 10 : 24) << '\n';
+  out << "</DataArray>\n</Cells>\n<PointData Vectors=\"displacement_m\">\n"
+      << "<DataArray type=\"Float64\" Name=\"displacement_m\" NumberOfComponents=\"3\" "
+         "format=\"ascii\">\n";
+  for (Eigen::Index i = 0; i < u.size(); i += 3)
+    out << u(i) << ' ' << u(i + 1) << ' ' << u(i + 2) << '\n';
+  out << "</DataArray>\n</PointData>\n<CellData>\n"
+      << "<DataArray type=\"Float64\" Name=\"von_mises_Pa\" format=\"ascii\">\n";
+  for (double s : stress) out << s << '\n';
+  out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"energy_density_J_per_m3\" "
+         "format=\"ascii\">\n";
+  for (double w : energy) out << w << '\n';
+  out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"layer\" format=\"ascii\">\n";
+  for (int layer : mesh.element_layer) out << layer << '\n';
+  out << "</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+  if (!out) throw InputError(path + ": write failed");
+}
+
+Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d>& needles,
+                               const Simulation3dOptions& options) {
+  if (!(options.depth > 0.0) || !std::isfinite(options.depth))
+    throw InputError("simulate_3d: depth must be positive");
+  if (options.steps < 1) throw InputError("simulate_3d: steps must be >= 1");
+  const auto start = Clock::now();
+  block.sites.clear();
+  for (const Needle3d& needle : needles)
+    block.sites.push_back(
+        {needle.x, needle.y, NeedleShape(needle.mesh).max_radius_up_to(options.depth)});
+  block.fidelity = options.fidelity;
+  block.order = options.order;
+  block.insertion_depth = options.depth;
+  const TetMesh mesh = generate_tissue_mesh(block);
+  const double meshing = seconds_since(start);
+
+  Simulation3dResult result;
+  result.nodes = static_cast<int>(mesh.nodes.size());
+  result.elements = static_cast<int>(mesh.elements.size());
+  result.order = mesh.order;
+  result.quality = mesh_quality(mesh);
+  Indentation3d run(mesh, needles, options.depth);
+  if (!options.vtu_directory.empty()) std::filesystem::create_directories(options.vtu_directory);
+  for (int k = 1; k <= options.steps; ++k) {
+    result.steps.push_back(run.advance_to(options.depth * k / options.steps));
+    if (!options.vtu_directory.empty())
+      run.write_vtu(
+          (std::filesystem::path(options.vtu_directory) / ("step_" + std::to_string(k) + ".vtu"))
+              .string());
+  }
+  result.timing = run.timing();
+  result.timing.meshing_s = meshing;
+  result.timing.total_s = seconds_since(start);
+  result.solver_backend = run.solver_backend();
+  return result;
+}
+
+}  // namespace mneedle::fe

@@ -1,0 +1,85 @@
+#include "fe/needle_shape.h"
+
+#include <CGAL/AABB_face_graph_triangle_primitive.h>
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Side_of_triangle_mesh.h>
+#include <CGAL/boost/graph/helpers.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "cgal_mesh.h"
+#include "mneedle/error.h"
+
+namespace mneedle::fe {
+
+namespace {
+using Primitive = CGAL::AABB_face_graph_triangle_primitive<SurfaceMesh>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<CgalKernel, Primitive>>;
+using Inside = CGAL::Side_of_triangle_mesh<SurfaceMesh, CgalKernel>;
+
+CgalPoint to_cgal(const Eigen::Vector3d& p) {
+  return {p.x(), p.y(), p.z()};
+}
+}  // namespace
+
+struct NeedleShape::Impl {
+  SurfaceMesh surface;
+  std::optional<Tree> tree;
+  std::optional<Inside> inside;
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<Triangle> triangles;
+};
+
+NeedleShape::NeedleShape(const TriangleMesh& mesh) : impl_(std::make_unique<Impl>()) {
+  if (mesh.triangles.empty()) throw InputError("needle mesh: no triangles");
+  impl_->surface = to_surface_mesh(mesh);
+  if (!CGAL::is_closed(impl_->surface))
+    throw InputError("needle mesh: surface is not closed (contact needs a solid needle)");
+  impl_->tree.emplace(faces(impl_->surface).first, faces(impl_->surface).second, impl_->surface);
+  impl_->tree->accelerate_distance_queries();
+  impl_->inside.emplace(impl_->surface);
+  for (const Vec3& v : mesh.vertices) impl_->vertices.emplace_back(v[0], v[1], v[2]);
+  impl_->triangles = mesh.triangles;
+}
+
+NeedleShape::~NeedleShape() = default;
+NeedleShape::NeedleShape(NeedleShape&&) noexcept = default;
+NeedleShape& NeedleShape::operator=(NeedleShape&&) noexcept = default;
+
+bool NeedleShape::contains(const Eigen::Vector3d& point) const {
+  return (*impl_->inside)(to_cgal(point)) != CGAL::ON_UNBOUNDED_SIDE;
+}
+
+Eigen::Vector3d NeedleShape::lower_surface_below(const Eigen::Vector3d& point) const {
+  // The needle travels along -z, so a tissue point it reaches enters through the face below it.
+  const CgalKernel::Ray_3 down(to_cgal(point), CgalKernel::Direction_3(0, 0, -1));
+  const auto hit = impl_->tree->first_intersection(down);
+  if (hit)
+    if (const CgalPoint* p = boost::get<CgalPoint>(&hit->first)) return {p->x(), p->y(), p->z()};
+  return closest_point(point);
+}
+
+Eigen::Vector3d NeedleShape::closest_point(const Eigen::Vector3d& point) const {
+  const CgalPoint q = impl_->tree->closest_point(to_cgal(point));
+  return {q.x(), q.y(), q.z()};
+}
+
+double NeedleShape::max_radius_up_to(double height) const {
+  // Every triangle that reaches below `height` counts whole, so the radius is never
+  // underestimated between two vertex rings.
+  double radius = 0.0;
+  for (const auto& t : impl_->triangles) {
+    double lowest = std::numeric_limits<double>::max();
+    for (auto v : t) lowest = std::min(lowest, impl_->vertices[v].z());
+    if (lowest > height) continue;
+    for (auto v : t) radius = std::max(radius, impl_->vertices[v].head<2>().norm());
+  }
+  return radius;
+}
+
+}  // namespace mneedle::fe

@@ -1,0 +1,413 @@
+#include "mneedle/fe/tissue_mesh.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <unordered_map>
+
+#include "mneedle/error.h"
+
+namespace mneedle::fe {
+
+namespace {
+
+constexpr int kEdgeNodes[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+
+[[noreturn]] void bad_spec(const std::string& field, const std::string& problem) {
+  throw InputError("tissue block: " + field + ": " + problem);
+}
+
+void validate(const TissueBlockSpec& spec) {
+  if (!(spec.size_x > 0.0) || !(spec.size_y > 0.0) || !std::isfinite(spec.size_x) ||
+      !std::isfinite(spec.size_y))
+    bad_spec("size", "block size must be positive and finite");
+  if (spec.layers.empty()) bad_spec("layers", "at least one layer is required");
+  for (const TissueLayer& layer : spec.layers)
+    if (!(layer.thickness > 0.0) || !std::isfinite(layer.thickness))
+      bad_spec("layers." + layer.name + ".thickness", "must be positive and finite");
+  if (spec.order != 1 && spec.order != 2) bad_spec("order", "must be 1 or 2");
+  if (!(spec.insertion_depth >= 0.0)) bad_spec("insertion_depth", "must be >= 0");
+  for (const NeedleSite& site : spec.sites) {
+    if (!(site.radius > 0.0)) bad_spec("needle radius", "must be positive");
+    if (std::abs(site.x) >= spec.size_x / 2 || std::abs(site.y) >= spec.size_y / 2)
+      bad_spec("needle position", "site lies outside the block");
+  }
+}
+
+// Element size as a function of the distance from the nearest fine zone: constant inside it,
+// then growing by `growth` per element (h' = (growth - 1) gives geometric grading).
+double graded_size(double distance_outside, const MeshSizing& sizing) {
+  const double size = sizing.fine_size + (sizing.growth - 1.0) * std::max(0.0, distance_outside);
+  return std::min(size, sizing.max_size);
+}
+
+// Places nodes on [lo, hi] so that each interval spans about one local element size, by
+// inverting the cumulative integral of 1 / size(x); min_cells forces a minimum count.
+template <typename SizeAt>
+std::vector<double> graded_coordinates(double lo, double hi, SizeAt size_at, int min_cells) {
+  constexpr int kSamples = 4000;
+  std::vector<double> cumulative(kSamples + 1, 0.0);
+  const double dx = (hi - lo) / kSamples;
+  for (int s = 0; s < kSamples; ++s) {
+    const double x0 = lo + s * dx;
+    cumulative[s + 1] = cumulative[s] + 0.5 * dx * (1.0 / size_at(x0) + 1.0 / size_at(x0 + dx));
+  }
+  const double total = cumulative.back();
+  const int cells = std::max(min_cells, static_cast<int>(std::ceil(total - 1e-6)));
+  std::vector<double> coordinates(static_cast<std::size_t>(cells) + 1);
+  coordinates.front() = lo;
+  coordinates.back() = hi;
+  int s = 0;
+  for (int m = 1; m < cells; ++m) {
+    const double target = total * m / cells;
+    while (cumulative[s + 1] < target) ++s;
+    const double t = (target - cumulative[s]) / (cumulative[s + 1] - cumulative[s]);
+    coordinates[static_cast<std::size_t>(m)] = lo + (s + t) * dx;
+  }
+  return coordinates;
+}
+
+std::vector<double> lateral_coordinates(double half, const std::vector<double>& centres,
+                                        const MeshSizing& sizing) {
+  auto size_at = [&](double x) {
+    double size = sizing.max_size;
+    for (double c : centres)
+      size = std::min(size, graded_size(std::abs(x - c) - sizing.fine_half_width, sizing));
+    return size;
+  };
+  // A grid line through every site, so a sharp tip meets a node the moment it touches.
+  std::vector<double> breaks{-half};
+  std::vector<double> sorted = centres;
+  std::sort(sorted.begin(), sorted.end());
+  for (double c : sorted)
+    if (c - breaks.back() > 0.25 * sizing.fine_size && half - c > 0.25 * sizing.fine_size)
+      breaks.push_back(c);
+  breaks.push_back(half);
+  std::vector<double> coordinates{-half};
+  for (std::size_t b = 0; b + 1 < breaks.size(); ++b) {
+    const std::vector<double> piece = graded_coordinates(breaks[b], breaks[b + 1], size_at, 1);
+    coordinates.insert(coordinates.end(), piece.begin() + 1, piece.end());
+  }
+  return coordinates;
+}
+
+// z coordinates from the bottom (-total) to the top surface (0), conforming to every layer
+// interface; element size grows with the distance below the fine depth.
+std::vector<double> vertical_coordinates(const std::vector<TissueLayer>& layers,
+                                         const MeshSizing& sizing, double fine_depth) {
+  auto size_at = [&](double z) { return graded_size(-z - fine_depth, sizing); };
+  std::vector<double> z_top_down{0.0};
+  double top = 0.0;
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    const double bottom = top - layers[i].thickness;
+    const int min_cells = i == 0 ? sizing.elements_through_top : 1;
+    std::vector<double> layer_z = graded_coordinates(bottom, top, size_at, min_cells);
+    for (auto it = layer_z.rbegin() + 1; it != layer_z.rend(); ++it) z_top_down.push_back(*it);
+    top = bottom;
+  }
+  z_top_down.back() = top;
+  return {z_top_down.rbegin(), z_top_down.rend()};
+}
+
+double signed_tet_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                         const Eigen::Vector3d& c, const Eigen::Vector3d& d) {
+  return (b - a).dot((c - a).cross(d - a)) / 6.0;
+}
+
+std::uint64_t edge_key(int a, int b) {
+  const auto lo = static_cast<std::uint64_t>(std::min(a, b));
+  const auto hi = static_cast<std::uint64_t>(std::max(a, b));
+  return (lo << 32) | hi;
+}
+
+std::uint64_t face_key(std::array<int, 3> f) {
+  std::sort(f.begin(), f.end());
+  return (static_cast<std::uint64_t>(f[0]) << 42) | (static_cast<std::uint64_t>(f[1]) << 21) |
+         static_cast<std::uint64_t>(f[2]);
+}
+
+std::array<int, 3> face_corners(const std::array<int, 10>& element, int opposite) {
+  std::array<int, 3> corners{};
+  int n = 0;
+  for (int i = 0; i < 4; ++i)
+    if (i != opposite)
+      corners[static_cast<std::size_t>(n++)] = element[static_cast<std::size_t>(i)];
+  return corners;
+}
+
+int local_edge(int a, int b) {
+  for (int e = 0; e < 6; ++e)
+    if ((kEdgeNodes[e][0] == a && kEdgeNodes[e][1] == b) ||
+        (kEdgeNodes[e][0] == b && kEdgeNodes[e][1] == a))
+      return e;
+  return -1;
+}
+
+// True for the cells left of (below) their nearest site along one axis: those cells take the
+// mirrored split, so the mesh is mirror-symmetric about every site and a symmetric needle feels
+// no lateral force from the mesh itself.
+std::vector<char> mirrored_cells(const std::vector<double>& axis,
+                                 const std::vector<double>& sites) {
+  std::vector<char> mirrored(axis.size() - 1, 0);
+  for (std::size_t i = 0; i + 1 < axis.size(); ++i) {
+    const double centre = 0.5 * (axis[i] + axis[i + 1]);
+    double nearest = sites.front();
+    for (double s : sites)
+      if (std::abs(centre - s) < std::abs(centre - nearest)) nearest = s;
+    mirrored[i] = centre < nearest ? 1 : 0;
+  }
+  return mirrored;
+}
+
+// Six tetrahedra per hexahedron, all sharing one main diagonal of the cell (Kuhn/Freudenthal).
+// The diagonal may be mirrored in x per column and in y per row: a face between two cells then
+// still gets the same diagonal from both sides, so the mesh stays conforming.
+void split_cells(TetMesh& mesh, const std::array<std::vector<double>, 3>& axes,
+                 const std::vector<int>& cell_layer, const std::vector<char>& mirror_x,
+                 const std::vector<char>& mirror_y) {
+  const int nx = static_cast<int>(axes[0].size()) - 1;
+  const int ny = static_cast<int>(axes[1].size()) - 1;
+  const int nz = static_cast<int>(axes[2].size()) - 1;
+  auto node = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
+  constexpr int kPermutations[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                       {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const int flip = (mirror_x[static_cast<std::size_t>(i)] ? 1 : 0) |
+                         (mirror_y[static_cast<std::size_t>(j)] ? 2 : 0);
+        std::array<int, 8> corner{};
+        for (int b = 0; b < 8; ++b) {
+          const int c = b ^ flip;
+          corner[static_cast<std::size_t>(b)] = node(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
+        }
+        for (const auto& perm : kPermutations) {
+          const int v1 = 1 << perm[0];
+          const int v2 = v1 | (1 << perm[1]);
+          std::array<int, 10> tet{};
+          tet.fill(-1);
+          tet[0] = corner[0];
+          tet[1] = corner[static_cast<std::size_t>(v1)];
+          tet[2] = corner[static_cast<std::size_t>(v2)];
+          tet[3] = corner[7];
+          const auto& x = mesh.nodes;
+          if (signed_tet_volume(x[tet[0]], x[tet[1]], x[tet[2]], x[tet[3]]) < 0.0)
+            std::swap(tet[1], tet[2]);
+          mesh.elements.push_back(tet);
+          mesh.element_layer.push_back(cell_layer[static_cast<std::size_t>(k)]);
+        }
+      }
+}
+
+void add_midside_nodes(TetMesh& mesh) {
+  std::unordered_map<std::uint64_t, int> edge_node;
+  edge_node.reserve(mesh.elements.size() * 2);
+  for (auto& tet : mesh.elements)
+    for (int e = 0; e < 6; ++e) {
+      const int a = tet[static_cast<std::size_t>(kEdgeNodes[e][0])];
+      const int b = tet[static_cast<std::size_t>(kEdgeNodes[e][1])];
+      auto [it, inserted] =
+          edge_node.try_emplace(edge_key(a, b), static_cast<int>(mesh.nodes.size()));
+      if (inserted) mesh.nodes.push_back(0.5 * (mesh.nodes[a] + mesh.nodes[b]));
+      tet[static_cast<std::size_t>(4 + e)] = it->second;
+    }
+}
+
+void link_neighbours_and_top(TetMesh& mesh) {
+  std::unordered_map<std::uint64_t, int> open_faces;
+  open_faces.reserve(mesh.elements.size() * 2);
+  mesh.neighbours.assign(mesh.elements.size(), {-1, -1, -1, -1});
+  for (std::size_t t = 0; t < mesh.elements.size(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      const std::uint64_t key = face_key(face_corners(mesh.elements[t], f));
+      auto it = open_faces.find(key);
+      if (it == open_faces.end()) {
+        open_faces.emplace(key, static_cast<int>(t) * 4 + f);
+        continue;
+      }
+      const int other = it->second / 4;
+      mesh.neighbours[t][static_cast<std::size_t>(f)] = other;
+      mesh.neighbours[static_cast<std::size_t>(other)][static_cast<std::size_t>(it->second % 4)] =
+          static_cast<int>(t);
+      open_faces.erase(it);
+    }
+  for (std::size_t t = 0; t < mesh.elements.size(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      if (mesh.neighbours[t][static_cast<std::size_t>(f)] >= 0) continue;
+      const auto& tet = mesh.elements[t];
+      std::array<int, 3> local{};
+      int n = 0;
+      for (int i = 0; i < 4; ++i)
+        if (i != f) local[static_cast<std::size_t>(n++)] = i;
+      const bool on_top = std::all_of(local.begin(), local.end(), [&](int i) {
+        return mesh.nodes[tet[static_cast<std::size_t>(i)]].z() == 0.0;
+      });
+      if (!on_top) continue;
+      std::array<int, 6> face{};
+      face.fill(-1);
+      for (int i = 0; i < 3; ++i) face[static_cast<std::size_t>(i)] = tet[local[i]];
+      if (mesh.order == 2)
+        for (int i = 0; i < 3; ++i)
+          face[static_cast<std::size_t>(3 + i)] =
+              tet[static_cast<std::size_t>(4 + local_edge(local[i], local[(i + 1) % 3]))];
+      mesh.top_faces.push_back(face);
+    }
+}
+
+void mark_fixed_nodes(TetMesh& mesh, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const double tolerance = 1e-9 * (hi - lo).norm();
+  mesh.fixed.assign(mesh.nodes.size(), 0);
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
+    const Eigen::Vector3d& p = mesh.nodes[n];
+    const bool side = std::abs(p.x() - lo.x()) < tolerance ||
+                      std::abs(p.x() - hi.x()) < tolerance ||
+                      std::abs(p.y() - lo.y()) < tolerance || std::abs(p.y() - hi.y()) < tolerance;
+    const bool bottom = std::abs(p.z() - lo.z()) < tolerance;
+    mesh.fixed[n] = side || bottom ? 1 : 0;
+  }
+}
+
+}  // namespace
+
+Fidelity parse_fidelity(const std::string& text, const std::string& field) {
+  if (text == "fast") return Fidelity::Fast;
+  if (text == "standard") return Fidelity::Standard;
+  if (text == "fine") return Fidelity::Fine;
+  throw InputError(field + ": unknown fidelity '" + text + "' (expected fast, standard or fine)");
+}
+
+std::string to_string(Fidelity fidelity) {
+  switch (fidelity) {
+    case Fidelity::Fast:
+      return "fast";
+    case Fidelity::Standard:
+      return "standard";
+    case Fidelity::Fine:
+      break;
+  }
+  return "fine";
+}
+
+MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, double block_size) {
+  // Elements per needle radius at the site, growth ratio and elements through the top layer;
+  // linear tetrahedra get twice the resolution of quadratic ones for a comparable answer.
+  struct Level {
+    double per_radius;
+    double growth;
+    int through_top;
+  };
+  const Level level = fidelity == Fidelity::Fast       ? Level{1.0, 2.0, 1}
+                      : fidelity == Fidelity::Standard ? Level{1.5, 1.6, 1}
+                                                       : Level{2.5, 1.35, 2};
+  const double refinement = order == 1 ? 2.0 : 1.0;
+  MeshSizing sizing;
+  sizing.fine_size = needle_radius / (level.per_radius * refinement);
+  sizing.fine_half_width = 1.25 * needle_radius;
+  sizing.growth = level.growth;
+  sizing.max_size = std::max(sizing.fine_size, block_size / 4.0);
+  sizing.elements_through_top = level.through_top * static_cast<int>(refinement);
+  return sizing;
+}
+
+TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
+  validate(spec);
+  double radius = 0.0;
+  for (const NeedleSite& site : spec.sites) radius = std::max(radius, site.radius);
+  double total = 0.0;
+  for (const TissueLayer& layer : spec.layers) total += layer.thickness;
+  if (radius == 0.0) radius = std::min(spec.size_x, spec.size_y) / 20.0;
+  const MeshSizing sizing =
+      mesh_sizing(spec.fidelity, spec.order, radius, std::max({spec.size_x, spec.size_y, total}));
+  std::vector<double> cx, cy;
+  for (const NeedleSite& site : spec.sites) {
+    cx.push_back(site.x);
+    cy.push_back(site.y);
+  }
+  if (spec.sites.empty()) cx = cy = {0.0};
+  std::vector<double> z = vertical_coordinates(spec.layers, sizing, spec.insertion_depth);
+  // A tensor grid carries the thinnest layer's cell height everywhere in x and y: cap the
+  // lateral size so those cells stay within kMaxCellAspect (the quality floor rests on it).
+  double thinnest = z.back() - z.front();
+  for (std::size_t k = 0; k + 1 < z.size(); ++k) thinnest = std::min(thinnest, z[k + 1] - z[k]);
+  MeshSizing lateral = sizing;
+  lateral.max_size =
+      std::max(sizing.fine_size, std::min(sizing.max_size, kMaxCellAspect * thinnest));
+  const std::array<std::vector<double>, 3> axes = {
+      lateral_coordinates(spec.size_x / 2, cx, lateral),
+      lateral_coordinates(spec.size_y / 2, cy, lateral), std::move(z)};
+
+  TetMesh mesh;
+  mesh.order = spec.order;
+  mesh.layers = spec.layers;
+  for (int a = 0; a < 3; ++a)
+    mesh.grid_cells[static_cast<std::size_t>(a)] =
+        static_cast<int>(axes[static_cast<std::size_t>(a)].size()) - 1;
+  for (double z : axes[2])
+    for (double y : axes[1])
+      for (double x : axes[0]) mesh.nodes.emplace_back(x, y, z);
+
+  std::vector<int> cell_layer;
+  for (std::size_t k = 0; k + 1 < axes[2].size(); ++k) {
+    const double centre_depth = -0.5 * (axes[2][k] + axes[2][k + 1]);
+    double top = 0.0;
+    int layer = 0;
+    for (std::size_t i = 0; i < spec.layers.size(); ++i) {
+      layer = static_cast<int>(i);
+      if (centre_depth < top + spec.layers[i].thickness) break;
+      top += spec.layers[i].thickness;
+    }
+    cell_layer.push_back(layer);
+  }
+  split_cells(mesh, axes, cell_layer, mirrored_cells(axes[0], cx), mirrored_cells(axes[1], cy));
+  if (mesh.order == 2) add_midside_nodes(mesh);
+  link_neighbours_and_top(mesh);
+  mark_fixed_nodes(mesh, {axes[0].front(), axes[1].front(), axes[2].front()},
+                   {axes[0].back(), axes[1].back(), 0.0});
+  return mesh;
+}
+
+MeshQuality mesh_quality(const TetMesh& mesh) {
+  MeshQuality quality{180.0, 0.0, std::numeric_limits<double>::max()};
+  for (const auto& tet : mesh.elements) {
+    std::array<Eigen::Vector3d, 4> p;
+    for (int i = 0; i < 4; ++i)
+      p[static_cast<std::size_t>(i)] = mesh.nodes[tet[static_cast<std::size_t>(i)]];
+    const double volume = signed_tet_volume(p[0], p[1], p[2], p[3]);
+    std::array<Eigen::Vector3d, 4> normal;  // outward unit normal of the face opposite corner i
+    double area_sum = 0.0;
+    for (int i = 0; i < 4; ++i) {
+      const auto& a = p[static_cast<std::size_t>((i + 1) % 4)];
+      const auto& b = p[static_cast<std::size_t>((i + 2) % 4)];
+      const auto& c = p[static_cast<std::size_t>((i + 3) % 4)];
+      Eigen::Vector3d n = (b - a).cross(c - a);
+      area_sum += 0.5 * n.norm();
+      if (n.dot(a - p[static_cast<std::size_t>(i)]) < 0.0) n = -n;
+      normal[static_cast<std::size_t>(i)] = n.normalized();
+    }
+    double longest = 0.0;
+    for (int e = 0; e < 6; ++e) {
+      const int a = kEdgeNodes[e][0], b = kEdgeNodes[e][1];
+      longest = std::max(longest,
+                         (p[static_cast<std::size_t>(a)] - p[static_cast<std::size_t>(b)]).norm());
+      // The edge ab is shared by the faces opposite the other two corners.
+      int others[2], n = 0;
+      for (int i = 0; i < 4; ++i)
+        if (i != a && i != b) others[n++] = i;
+      const double cosine = -normal[static_cast<std::size_t>(others[0])].dot(
+          normal[static_cast<std::size_t>(others[1])]);
+      const double angle = std::acos(std::clamp(cosine, -1.0, 1.0)) * 180.0 / std::numbers::pi;
+      quality.min_dihedral_deg = std::min(quality.min_dihedral_deg, angle);
+    }
+    const double inradius = 3.0 * volume / area_sum;
+    quality.max_aspect_ratio =
+        std::max(quality.max_aspect_ratio, longest / (2.0 * std::sqrt(6.0) * inradius));
+    quality.min_volume = std::min(quality.min_volume, volume);
+  }
+  return quality;
+}
+
+}  // namespace mneedle::fe

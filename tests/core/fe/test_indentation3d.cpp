@@ -1,0 +1,177 @@
+#include "mneedle/fe/indentation3d.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+
+#include "mneedle/error.h"
+#include "needle_meshes.h"
+
+namespace {
+
+using namespace mneedle::fe;
+using mneedle::test::cone_needle;
+using mneedle::test::cylinder_needle;
+
+// Homogeneous layer of thickness h on a rigid base, sides fixed, sized for a punch of radius a.
+TissueBlockSpec homogeneous_block(MaterialModel model, double E, double nu, double half_width,
+                                  double h) {
+  TissueBlockSpec spec;
+  spec.size_x = spec.size_y = 2 * half_width;
+  spec.layers = {{"block", h, {model, E, nu, 0.0, 0.0}}};
+  return spec;
+}
+
+TetMesh punch_mesh(const TissueBlockSpec& base, double radius, double depth, int order,
+                   Fidelity fidelity) {
+  TissueBlockSpec spec = base;
+  spec.sites = {{0.0, 0.0, radius}};
+  spec.order = order;
+  spec.fidelity = fidelity;
+  spec.insertion_depth = depth;
+  return generate_tissue_mesh(spec);
+}
+
+// Hayes et al. 1972 correction for a flat punch on a bonded layer, nu = 0.45, a/h = 0.4.
+constexpr double kHayesNu045Ratio04 = 1.599;
+
+// a = 90 um on a mesh graded for 100 um: no surface node lies within 0.5 um of the rim, so the
+// captured footprint does not hinge on round-off (docs/_parts/fe_3d_validation.md).
+void check_bonded_punch(int order, double tolerance) {
+  const double E = 1e5, nu = 0.45, a = 90e-6, h = 225e-6, d = 2e-6;
+  const TissueBlockSpec block = homogeneous_block(MaterialModel::Linear, E, nu, 675e-6, h);
+  const TetMesh mesh = punch_mesh(block, 100e-6, d, order, Fidelity::Standard);
+  Indentation3d run(mesh, {{"punch", cylinder_needle(a, 1e-3), 0.0, 0.0}}, 2 * d);
+  const Step3d step = run.advance_to(d);
+  const double expected = 2 * a * E / (1 - nu * nu) * kHayesNu045Ratio04 * d;
+  ASSERT_EQ(step.needles.size(), 1U);
+  EXPECT_NEAR(step.needles[0].force_N / expected, 1.0, tolerance) << "order " << order;
+  EXPECT_NEAR(step.needles[0].contact_area_m2 / (std::numbers::pi * a * a), 1.0, 0.5);
+  EXPECT_LT(std::abs(step.needles[0].lateral_force_N[0]), 0.01 * step.needles[0].force_N);
+  // Linear material and a flat punch: force proportional to depth, one factorisation.
+  const Step3d deeper = run.advance_to(2 * d);
+  EXPECT_NEAR(deeper.needles[0].force_N / step.needles[0].force_N, 2.0, 1e-9);
+  EXPECT_EQ(run.timing().factorizations, 1);
+  // Every captured node moved straight down by the depth: energy = F d / 2.
+  EXPECT_NEAR(deeper.strain_energy_J, 0.5 * deeper.needles[0].force_N * 2 * d,
+              1e-9 * deeper.strain_energy_J);
+}
+
+TEST(Indentation3d, BondedFlatPunchOnQuadraticTetsMatchesHayesLayerSolution) {
+  check_bonded_punch(2, 0.15);
+}
+
+TEST(Indentation3d, BondedFlatPunchOnLinearTetsMatchesHayesLayerSolution) {
+  check_bonded_punch(1, 0.15);
+}
+
+TEST(Indentation3d, StVenantKirchhoffPunchReducesToLinearAtSmallDepth) {
+  const double E = 1e5, nu = 0.4, a = 100e-6, h = 400e-6, d = 0.5e-6;
+  double force[2];
+  int k = 0;
+  for (MaterialModel model : {MaterialModel::Linear, MaterialModel::StVenantKirchhoff}) {
+    const TetMesh mesh =
+        punch_mesh(homogeneous_block(model, E, nu, 600e-6, h), a, d, 1, Fidelity::Fast);
+    Indentation3d run(mesh, {{"punch", cylinder_needle(a, 1e-3), 0.0, 0.0}}, d);
+    force[k++] = run.advance_to(d).needles[0].force_N;
+  }
+  EXPECT_GT(force[0], 0.0);
+  EXPECT_NEAR(force[1] / force[0], 1.0, 1e-2);
+}
+
+TEST(Indentation3d, NeoHookeanConeConvergesWithAdaptiveStepsAndStiffensWithDepth) {
+  // 60-degree cone, 150 um radius, on a mesh graded for 100 um: at 40 um the footprint already
+  // spans a few node rings, so the force follows the cone rather than one captured node.
+  const TetMesh mesh =
+      punch_mesh(homogeneous_block(MaterialModel::NeoHookean, 1e5, 0.45, 450e-6, 300e-6), 100e-6,
+                 80e-6, 1, Fidelity::Standard);
+  Indentation3d run(mesh, {{"cone", cone_needle(std::numbers::pi / 3, 150e-6, 1e-3), 0.0, 0.0}},
+                    80e-6);
+  const Step3d shallow = run.advance_to(40e-6);
+  const Step3d deep = run.advance_to(80e-6);
+  EXPECT_GT(shallow.needles[0].force_N, 0.0);
+  // A cone's force grows with the square of depth (Sneddon): the ratio for 2x depth is near 4
+  // (measured 4.04); the footprint is captured ring by ring, hence the band.
+  const double ratio = deep.needles[0].force_N / shallow.needles[0].force_N;
+  EXPECT_GT(ratio, 3.0);
+  EXPECT_LT(ratio, 5.5);
+  EXPECT_GT(deep.newton_iterations, 1);
+  EXPECT_GT(deep.needles[0].captured_nodes, shallow.needles[0].captured_nodes);
+  EXPECT_GT(deep.strain_energy_J, shallow.strain_energy_J);
+}
+
+TEST(Indentation3d, TwoNeedlesEachCarryTheirOwnForce) {
+  const double a = 80e-6, d = 5e-6;
+  TissueBlockSpec spec = homogeneous_block(MaterialModel::Linear, 1e5, 0.4, 800e-6, 400e-6);
+  spec.sites = {{-300e-6, 0.0, a}, {300e-6, 0.0, a}};
+  spec.order = 1;
+  spec.fidelity = Fidelity::Fast;
+  spec.insertion_depth = d;
+  const TetMesh mesh = generate_tissue_mesh(spec);
+  Indentation3d run(mesh,
+                    {{"left", cylinder_needle(a, 1e-3), -300e-6, 0.0},
+                     {"right", cylinder_needle(a, 1e-3), 300e-6, 0.0}},
+                    d);
+  const Step3d step = run.advance_to(d);
+  ASSERT_EQ(step.needles.size(), 2U);
+  EXPECT_EQ(step.needles[0].name, "left");
+  EXPECT_GT(step.needles[0].force_N, 0.0);
+  EXPECT_NEAR(step.needles[0].force_N, step.needles[1].force_N, 0.02 * step.needles[0].force_N);
+  // Mirror-image sites: lateral forces come only from the split's asymmetry and stay small.
+  for (const auto& needle : step.needles)
+    EXPECT_LT(std::hypot(needle.lateral_force_N[0], needle.lateral_force_N[1]),
+              0.02 * needle.force_N);
+}
+
+TEST(Indentation3d, WritesVtuThatNamesEveryField) {
+  const double a = 100e-6, d = 2e-6;
+  const TetMesh mesh = punch_mesh(
+      homogeneous_block(MaterialModel::Linear, 1e5, 0.4, 400e-6, 300e-6), a, d, 2, Fidelity::Fast);
+  Indentation3d run(mesh, {{"punch", cylinder_needle(a, 1e-3), 0.0, 0.0}}, d);
+  run.advance_to(d);
+  const auto path = std::filesystem::temp_directory_path() / "mneedle_test_indentation3d.vtu";
+  run.write_vtu(path.string());
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const char* field : {"displacement_m", "von_mises_Pa", "energy_density_J_per_m3", "layer"})
+    EXPECT_NE(text.find(field), std::string::npos) << field;
+  EXPECT_NE(text.find("NumberOfPoints=\"" + std::to_string(mesh.nodes.size()) + "\""),
+            std::string::npos);
+  std::filesystem::remove(path);
+}
+
+TEST(Indentation3d, RejectsShrinkingDepthAndMissingNeedles) {
+  const TetMesh mesh =
+      punch_mesh(homogeneous_block(MaterialModel::Linear, 1e5, 0.4, 400e-6, 300e-6), 100e-6, 2e-6,
+                 1, Fidelity::Fast);
+  EXPECT_THROW(Indentation3d(mesh, {}, 1e-6), mneedle::InputError);
+  Indentation3d run(mesh, {{"punch", cylinder_needle(100e-6, 1e-3), 0.0, 0.0}}, 2e-6);
+  run.advance_to(2e-6);
+  EXPECT_THROW(run.advance_to(1e-6), mneedle::InputError);
+}
+
+TEST(Indentation3d, SimulateThreeDimensionalReportsMeshAndCurve) {
+  TissueBlockSpec block;
+  block.size_x = block.size_y = 1000e-6;
+  block.layers = {{"stratum corneum", 15e-6, {MaterialModel::Linear, 1e9, 0.4, 0.0, 0.0}},
+                  {"dermis", 500e-6, {MaterialModel::Linear, 0.08e6, 0.4, 0.0, 0.0}}};
+  Simulation3dOptions options;
+  options.fidelity = Fidelity::Fast;
+  options.order = 1;
+  options.depth = 20e-6;
+  options.steps = 4;
+  const Simulation3dResult result = simulate_3d(
+      block, {{"cone", cone_needle(std::numbers::pi / 6, 115e-6, 1e-3), 0.0, 0.0}}, options);
+  ASSERT_EQ(result.steps.size(), 4U);
+  EXPECT_EQ(result.order, 1);
+  EXPECT_GT(result.nodes, 0);
+  for (std::size_t k = 1; k < result.steps.size(); ++k)
+    EXPECT_GE(result.steps[k].needles[0].force_N, result.steps[k - 1].needles[0].force_N);
+  EXPECT_GT(result.steps.back().needles[0].force_N, 0.0);
+  EXPECT_GE(result.quality.min_dihedral_deg, kMinDihedralFloorDeg);
+}
+
+}  // namespace

@@ -1,0 +1,167 @@
+#include "mneedle/fe/tissue_mesh.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "mneedle/error.h"
+
+namespace {
+
+using namespace mneedle::fe;
+
+MaterialParameters linear(double E, double nu) {
+  return {MaterialModel::Linear, E, nu, 0.0, 0.0};
+}
+
+// Paper A's block: 3000 x 3000 x 1150 um, stratum corneum / epidermis / dermis.
+TissueBlockSpec paper_a_skin(Fidelity fidelity, int order) {
+  TissueBlockSpec spec;
+  spec.size_x = spec.size_y = 3000e-6;
+  spec.layers = {{"stratum corneum", 15e-6, linear(1e9, 0.4)},
+                 {"epidermis", 100e-6, linear(0.134e6, 0.4)},
+                 {"dermis", 1035e-6, linear(0.08e6, 0.4)}};
+  spec.sites = {{0.0, 0.0, 115e-6}};
+  spec.fidelity = fidelity;
+  spec.order = order;
+  spec.insertion_depth = 200e-6;
+  return spec;
+}
+
+double tet_volume(const TetMesh& mesh, const std::array<int, 10>& t) {
+  const auto& p = mesh.nodes;
+  return (p[t[1]] - p[t[0]]).dot((p[t[2]] - p[t[0]]).cross(p[t[3]] - p[t[0]])) / 6.0;
+}
+
+TEST(TissueMesh, VolumesArePositiveAndFillTheBlock) {
+  const TetMesh mesh = generate_tissue_mesh(paper_a_skin(Fidelity::Fast, 1));
+  double total = 0.0;
+  for (const auto& t : mesh.elements) {
+    EXPECT_GT(tet_volume(mesh, t), 0.0);
+    total += tet_volume(mesh, t);
+  }
+  EXPECT_NEAR(total, 3000e-6 * 3000e-6 * 1150e-6, 1e-9 * total);
+}
+
+TEST(TissueMesh, EveryElementLiesInsideOneLayer) {
+  const TetMesh mesh = generate_tissue_mesh(paper_a_skin(Fidelity::Standard, 2));
+  const std::vector<double> interfaces = {0.0, -15e-6, -115e-6, -1150e-6};
+  for (std::size_t e = 0; e < mesh.elements.size(); ++e) {
+    const int layer = mesh.element_layer[e];
+    for (int a = 0; a < 10; ++a) {
+      const double z =
+          mesh.nodes[static_cast<std::size_t>(mesh.elements[e][static_cast<std::size_t>(a)])].z();
+      EXPECT_LE(z, interfaces[static_cast<std::size_t>(layer)] + 1e-12);
+      EXPECT_GE(z, interfaces[static_cast<std::size_t>(layer) + 1] - 1e-12);
+    }
+  }
+  EXPECT_EQ(mesh.material_of(0).E,
+            mesh.layers[static_cast<std::size_t>(mesh.element_layer[0])].material.E);
+}
+
+TEST(TissueMesh, FaceNeighboursAreMutualAndOnlyTheBoxSurfaceIsOpen) {
+  const TetMesh mesh = generate_tissue_mesh(paper_a_skin(Fidelity::Fast, 1));
+  const auto [nx, ny, nz] = mesh.grid_cells;
+  int open = 0;
+  for (std::size_t t = 0; t < mesh.elements.size(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      const int other = mesh.neighbours[t][static_cast<std::size_t>(f)];
+      if (other < 0) {
+        ++open;
+        continue;
+      }
+      const auto& back = mesh.neighbours[static_cast<std::size_t>(other)];
+      EXPECT_NE(std::find(back.begin(), back.end(), static_cast<int>(t)), back.end());
+    }
+  // Each boundary rectangle of the hexahedral grid is split into two triangles.
+  EXPECT_EQ(open, 4 * (nx * ny + ny * nz + nx * nz));
+  EXPECT_EQ(static_cast<int>(mesh.top_faces.size()), 2 * nx * ny);
+}
+
+TEST(TissueMesh, QuadraticMeshSharesEveryMidsideNode) {
+  const TetMesh mesh = generate_tissue_mesh(paper_a_skin(Fidelity::Fast, 2));
+  const long nx = mesh.grid_cells[0], ny = mesh.grid_cells[1], nz = mesh.grid_cells[2];
+  const long corners = (nx + 1) * (ny + 1) * (nz + 1);
+  const long grid_edges =
+      nx * (ny + 1) * (nz + 1) + (nx + 1) * ny * (nz + 1) + (nx + 1) * (ny + 1) * nz;
+  const long face_diagonals = nx * ny * (nz + 1) + nx * (ny + 1) * nz + (nx + 1) * ny * nz;
+  const long body_diagonals = nx * ny * nz;
+  EXPECT_EQ(static_cast<long>(mesh.nodes.size()),
+            corners + grid_edges + face_diagonals + body_diagonals);
+  for (const auto& t : mesh.elements)
+    for (int e = 0; e < 6; ++e) {
+      constexpr int kEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+      const auto& p = mesh.nodes;
+      const Eigen::Vector3d mid = 0.5 * (p[t[kEdge[e][0]]] + p[t[kEdge[e][1]]]);
+      EXPECT_LT((p[t[static_cast<std::size_t>(4 + e)]] - mid).norm(), 1e-15);
+    }
+}
+
+TEST(TissueMesh, ElementsAreFinestAtTheNeedleSite) {
+  const TetMesh mesh = generate_tissue_mesh(paper_a_skin(Fidelity::Standard, 1));
+  std::set<double> xs;
+  for (const auto& p : mesh.nodes) xs.insert(p.x());
+  const std::vector<double> x(xs.begin(), xs.end());
+  double near_site = 1.0, far = 0.0;
+  for (std::size_t i = 0; i + 1 < x.size(); ++i) {
+    const double width = x[i + 1] - x[i];
+    if (std::abs(0.5 * (x[i] + x[i + 1])) < 115e-6) near_site = std::min(near_site, width);
+    if (x[i] < -1000e-6) far = std::max(far, width);
+  }
+  const MeshSizing sizing = mesh_sizing(Fidelity::Standard, 1, 115e-6, 3000e-6);
+  EXPECT_LE(near_site, sizing.fine_size * 1.0001);
+  EXPECT_GT(far, 2.0 * near_site);
+}
+
+TEST(TissueMesh, ThinTopLayerGetsTheRequiredElementsThroughItsThickness) {
+  for (Fidelity fidelity : {Fidelity::Fast, Fidelity::Standard, Fidelity::Fine}) {
+    const TetMesh mesh = generate_tissue_mesh(paper_a_skin(fidelity, 2));
+    std::set<double> zs;
+    for (const auto& p : mesh.nodes)
+      if (p.z() > -15e-6 - 1e-12) zs.insert(p.z());
+    const int cells = (static_cast<int>(zs.size()) - 1) / 2;  // midside planes in between
+    EXPECT_GE(cells, mesh_sizing(fidelity, 2, 115e-6, 3000e-6).elements_through_top);
+  }
+}
+
+TEST(TissueMesh, QualityStaysAboveTheDocumentedFloorAtEveryFidelity) {
+  for (Fidelity fidelity : {Fidelity::Fast, Fidelity::Standard, Fidelity::Fine}) {
+    const MeshQuality q = mesh_quality(generate_tissue_mesh(paper_a_skin(fidelity, 1)));
+    EXPECT_GE(q.min_dihedral_deg, kMinDihedralFloorDeg) << to_string(fidelity);
+    EXPECT_GT(q.min_volume, 0.0);
+    EXPECT_GE(q.max_aspect_ratio, 1.0);
+    EXPECT_LE(q.max_aspect_ratio, kMaxAspectRatioCeiling) << to_string(fidelity);
+  }
+}
+
+TEST(TissueMesh, RegularKuhnCubeHasKnownQuality) {
+  TissueBlockSpec spec;
+  spec.size_x = spec.size_y = 1e-3;
+  spec.layers = {{"block", 1e-3, linear(1e5, 0.3)}};
+  spec.sites = {{0.0, 0.0, 1e-3}};  // a fine zone covering the whole block: uniform cells
+  spec.insertion_depth = 1e-3;
+  spec.fidelity = Fidelity::Fast;
+  spec.order = 1;
+  const MeshQuality q = mesh_quality(generate_tissue_mesh(spec));
+  // Cubic cells: the Kuhn tetrahedron's dihedral angles are 45, 60 and 90 degrees.
+  EXPECT_NEAR(q.min_dihedral_deg, 45.0, 1e-9);
+}
+
+TEST(TissueMesh, RejectsBadSpecsWithInputError) {
+  TissueBlockSpec spec = paper_a_skin(Fidelity::Fast, 2);
+  spec.layers[1].thickness = -1.0;
+  EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
+  spec = paper_a_skin(Fidelity::Fast, 3);
+  EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
+  spec = paper_a_skin(Fidelity::Fast, 2);
+  spec.sites[0].x = 2e-3;
+  EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
+  EXPECT_THROW(parse_fidelity("ultra"), mneedle::InputError);
+  EXPECT_EQ(parse_fidelity("fine"), Fidelity::Fine);
+}
+
+}  // namespace
