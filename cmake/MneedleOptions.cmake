@@ -1,6 +1,11 @@
 # Compiler flags shared by every mneedle target.
 function(mneedle_set_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic)
+  # GCC 12 reports -Wrestrict inside libstdc++ for `"literal" + std::string` (GCC bug 105329):
+  # a false positive that would otherwise fail -Werror builds.
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+    target_compile_options(${target} PRIVATE -Wno-restrict)
+  endif()
   if(MNEEDLE_WERROR)
     target_compile_options(${target} PRIVATE -Werror)
   endif()

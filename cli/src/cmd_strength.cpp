@@ -6,11 +6,11 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "mneedle/design_source.h"
 #include "mneedle/error.h"
 #include "mneedle/needle_strength.h"
 #include "mneedle/section_table.h"
 #include "mneedle/units.h"
-#include "needle_source.h"
 
 namespace mneedle::cli {
 namespace {

@@ -13,6 +13,12 @@ void add_scene_command(CLI::App& app);
 void add_plugins_command(CLI::App& app);
 void add_generate_command(CLI::App& app);
 void add_inspect_command(CLI::App& app);
+void add_force_command(CLI::App& app);
 void add_strength_command(CLI::App& app);
+void add_screen_command(CLI::App& app);
+void add_fit_command(CLI::App& app);
+void add_predict_command(CLI::App& app);
+void add_stats_command(CLI::App& app);
+void add_simulate_command(CLI::App& app);
 
 }  // namespace mneedle::cli

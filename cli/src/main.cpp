@@ -13,7 +13,13 @@ int main(int argc, char** argv) {
   mneedle::cli::add_plugins_command(app);
   mneedle::cli::add_generate_command(app);
   mneedle::cli::add_inspect_command(app);
+  mneedle::cli::add_force_command(app);
   mneedle::cli::add_strength_command(app);
+  mneedle::cli::add_screen_command(app);
+  mneedle::cli::add_fit_command(app);
+  mneedle::cli::add_predict_command(app);
+  mneedle::cli::add_stats_command(app);
+  mneedle::cli::add_simulate_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -56,8 +56,11 @@ StrengthReport needle_strength(const SectionProfile& profile, const NeedleMateri
   r.strength_n = material.strength_pa / worst_stress;
 
   const double e = material.youngs_modulus_pa;
+  // The column is the loaded part: from the tissue surface, which holds the needle laterally,
+  // to the base. Below the surface the tissue carries the tip; a sharp tip pinned at its point
+  // would have I → 0 there and no buckling strength at all.
   r.elastic_buckling_n = critical_buckling_load(
-      [&](double h) { return e * profile(h).i_min_m4; }, options.length_m, options.end);
+      [&](double s) { return e * profile(z + s).i_min_m4; }, options.length_m - z, options.end);
   r.buckling_n = johnson_critical_load(r.elastic_buckling_n, r.a_min_m2, material.strength_pa);
   r.johnson = r.buckling_n < r.elastic_buckling_n;
 

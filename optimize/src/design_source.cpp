@@ -1,4 +1,4 @@
-#include "needle_source.h"
+#include "mneedle/design_source.h"
 
 #include "mneedle/error.h"
 #include "mneedle/mesh_io.h"
@@ -6,7 +6,7 @@
 #include "mneedle/needle_frame.h"
 #include "mneedle/units.h"
 
-namespace mneedle::cli {
+namespace mneedle {
 namespace {
 
 const PluginParameter& find_parameter(const PluginShapeInfo& shape, const std::string& name) {
@@ -90,4 +90,4 @@ NeedleSource needle_from_scene(const PluginRegistry& registry, const NeedleSpec&
   return n;
 }
 
-}  // namespace mneedle::cli
+}  // namespace mneedle

@@ -89,3 +89,23 @@ TEST(NeedleStrength, MarginIsCapacityOverPeakForce) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(NeedleStrength, BucklingColumnStartsAtTheTissueSurface) {
+  // A sharp cone tip below a cylindrical shaft: pinned at the surface, the column is the shaft
+  // alone, so Euler's load for the shaft length above the surface applies.
+  const double r = 115e-6, length = 1e-3, tip = 300e-6, e = 169e9;
+  mneedle::SectionProfile profile = [&](double h) {
+    const double rr = h < tip ? r * h / tip : r;
+    return mneedle::SectionProperties{kPi * rr * rr, kPi * std::pow(rr, 4) / 4.0, rr};
+  };
+  mneedle::StrengthOptions o;
+  o.length_m = length;
+  o.load_height_m = tip;
+  const auto report = mneedle::needle_strength(profile, material(e, 1e12), o);
+  const double euler = kPi * kPi * e * kPi * std::pow(r, 4) / 4.0 / std::pow(0.7 * (length - tip), 2);
+  EXPECT_NEAR(report.elastic_buckling_n / euler, 1.0, 3e-3);
+}
+
+}  // namespace

@@ -39,7 +39,8 @@ struct StrengthReport {
   double critical_height_m = 0.0;   // where material failure is decided
 };
 
-/// Capacity of a needle of the given section profile and material. InputError for non-physical
+/// Capacity of a needle of the given section profile and material. The buckling column is the
+/// part between the tissue surface (load height, pinned or free) and the base (clamped). InputError for non-physical
 /// options (zero length, load height outside [0, L), an empty loaded section).
 StrengthReport needle_strength(const SectionProfile& profile, const NeedleMaterial& material,
                                const StrengthOptions& options);

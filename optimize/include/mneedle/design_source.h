@@ -1,6 +1,6 @@
 #pragma once
-// Where a command's needle comes from: a mesh file, a plugin with --set values, or a scene's
-// [[needles]] entry. Every path ends in a validated mesh in the needle frame.
+// Where a needle comes from: a mesh file, a plugin with --set values, or a scene's [[needles]]
+// entry. Every path ends in a validated mesh in the needle frame.
 
 #include <filesystem>
 #include <map>
@@ -12,7 +12,7 @@
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene.h"
 
-namespace mneedle::cli {
+namespace mneedle {
 
 struct NeedleSource {
   std::string name;
@@ -26,7 +26,8 @@ struct NeedleSource {
 std::map<std::string, double> parse_parameter_settings(const PluginShapeInfo& shape,
                                                        const std::vector<std::string>& settings);
 
-/// A scene's plugin parameters (parsed quantities) → SI values for the shape.
+/// Parsed quantities (a scene's or a design list's) → SI values for the shape; `where` prefixes
+/// the key in messages.
 std::map<std::string, double> scene_parameters(const PluginShapeInfo& shape,
                                                const std::map<std::string, Quantity>& given,
                                                const std::string& where);
@@ -39,4 +40,4 @@ NeedleSource needle_from_plugin(const PluginRegistry& registry, const std::strin
 
 NeedleSource needle_from_scene(const PluginRegistry& registry, const NeedleSpec& spec);
 
-}  // namespace mneedle::cli
+}  // namespace mneedle

@@ -1,0 +1,69 @@
+#pragma once
+// Batch screening of needle designs: collect designs from files, folders and design lists,
+// evaluate them in parallel, write each result the moment it is done, resume a killed run.
+
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mneedle/design_evaluation.h"
+#include "mneedle/plugin_host.h"
+#include "mneedle/scene.h"
+
+namespace mneedle {
+
+/// One design to screen: a mesh file, or a plugin shape with parameters (a design-list entry).
+struct DesignInput {
+  std::string name;
+  std::filesystem::path file;                    // mesh file, or the design list it came from
+  double metres_per_unit = 1e-3;                 // mesh files only
+  std::optional<std::string> plugin;             // design-list entries only
+  std::map<std::string, Quantity> parameters;    // design-list entries only, as written
+};
+
+/// Mesh files (STL, OBJ, PLY, OFF) as given, every mesh file of a folder (sorted, not recursive)
+/// and every [[designs]] entry of a TOML design list. InputError for a path that does not exist or
+/// a design list with an error (naming file:line).
+std::vector<DesignInput> collect_designs(const std::vector<std::filesystem::path>& inputs,
+                                         double metres_per_unit);
+
+struct ScreeningOptions {
+  int jobs = 1;
+  std::optional<std::string> material;       // overrides the scene's needle material
+  std::optional<std::filesystem::path> out;  // folder for results.csv and results.jsonl
+  bool resume = false;                       // skip designs already in out/results.jsonl
+  std::string fidelity = "standard";
+};
+
+/// One row of a screening: an evaluation or the reason there is none. `json` is the row as
+/// written to results.jsonl (with units in its keys), which is what --resume reads back.
+struct ScreeningRow {
+  std::string design;
+  std::string hash;  // of the design's bytes, the scene's bytes, fidelity and material
+  bool ok = false;
+  bool resumed = false;
+  std::string error;
+  std::string json;
+  double peak_force_n = 0.0;
+  double margin = 0.0;
+  bool passes = false;
+};
+
+/// Screens `designs` on `scene` (its file is `scene_file`, for the hash). Every design gets a row,
+/// in input order; a design that fails gets an error row and the others go on. When `out` is
+/// set, each row is appended to out/results.jsonl and out/results.csv as soon as it is finished.
+/// `on_row` (optional) is called for each finished row, serialised.
+std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs, const Scene& scene,
+                                         const std::filesystem::path& scene_file,
+                                         const PluginRegistry& registry,
+                                         const ScreeningOptions& options,
+                                         const std::function<void(const ScreeningRow&)>& on_row = {});
+
+/// Sorted for the table: successful rows first, passing before failing, then by peak force;
+/// error rows last in input order.
+std::vector<ScreeningRow> rank_rows(std::vector<ScreeningRow> rows);
+
+}  // namespace mneedle

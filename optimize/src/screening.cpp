@@ -1,0 +1,351 @@
+#include "mneedle/screening.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <thread>
+#include <toml++/toml.h>
+
+#include "mneedle/design_source.h"
+#include "mneedle/error.h"
+
+namespace mneedle {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::string lower_extension(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+bool is_mesh_file(const fs::path& p) {
+  static const std::set<std::string> kMesh = {".stl", ".obj", ".ply", ".off"};
+  return kMesh.count(lower_extension(p)) > 0;
+}
+
+std::string read_bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// FNV-1a: a stable fingerprint, not a cryptographic one.
+std::uint64_t fnv1a(std::string_view bytes, std::uint64_t h = 14695981039346656037ull) {
+  for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+std::string hex(std::uint64_t v) {
+  std::ostringstream s;
+  s << std::hex << v;
+  return s.str();
+}
+
+std::string where(const fs::path& file, const toml::source_region& region) {
+  return file.string() + ":" + std::to_string(region.begin.line);
+}
+
+Quantity list_value(const toml::node& node, const std::string& at) {
+  if (const auto* s = node.as_string()) {
+    try {
+      return parse_quantity(s->get());
+    } catch (const InputError& e) {
+      throw InputError(at + ": " + e.what());
+    }
+  }
+  if (const auto v = node.value<double>()) return {*v, Dimension::Dimensionless};
+  throw InputError(at + ": expected a quantity such as \"230 um\" or a number");
+}
+
+std::vector<DesignInput> read_design_list(const fs::path& file) {
+  toml::table doc;
+  try {
+    doc = toml::parse_file(file.string());
+  } catch (const toml::parse_error& e) {
+    throw InputError(file.string() + ":" + std::to_string(e.source().begin.line) + ": " +
+                     std::string(e.description()));
+  }
+  for (const auto& [key, node] : doc)
+    if (key.str() != "designs")
+      throw InputError(where(file, node.source()) + ": unknown key '" + std::string(key.str()) +
+                       "' (a design list holds [[designs]] tables)");
+  const auto* designs = doc["designs"].as_array();
+  if (!designs || designs->empty())
+    throw InputError(file.string() + ": a design list needs at least one [[designs]] table");
+  std::vector<DesignInput> out;
+  for (const auto& node : *designs) {
+    const auto* t = node.as_table();
+    const std::string at = where(file, node.source());
+    if (!t) throw InputError(at + ": each entry of designs must be a table");
+    DesignInput d;
+    d.file = file;
+    for (const auto& [key, value] : *t) {
+      const std::string k(key.str());
+      const std::string at_key = where(file, value.source()) + ": designs." + k;
+      if (k == "name" || k == "plugin") {
+        if (!value.is_string()) throw InputError(at_key + ": expected a string");
+        (k == "name" ? d.name : d.plugin.emplace()) = value.as_string()->get();
+      } else {
+        d.parameters[k] = list_value(value, at_key);
+      }
+    }
+    if (!d.plugin) throw InputError(at + ": designs entry without 'plugin'");
+    if (d.name.empty()) d.name = *d.plugin + "_" + std::to_string(out.size() + 1);
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
+std::string design_fingerprint(const DesignInput& d) {
+  if (!d.plugin) return read_bytes(d.file) + "|unit=" + std::to_string(d.metres_per_unit);
+  std::string text = "plugin=" + *d.plugin;
+  for (const auto& [k, q] : d.parameters) text += "|" + k + "=" + std::to_string(q.value_si);
+  return text;
+}
+
+TriangleMesh design_mesh(const DesignInput& d, const PluginRegistry& registry) {
+  if (!d.plugin) return needle_from_file(d.file, d.metres_per_unit).mesh;
+  const auto& info = registry.shape(*d.plugin);
+  return needle_from_plugin(registry, *d.plugin,
+                            scene_parameters(info, d.parameters, d.file.string() + ": " + d.name))
+      .mesh;
+}
+
+std::string scene_material(const Scene& scene, const ScreeningOptions& o) {
+  if (o.material) return *o.material;
+  for (const auto& n : scene.needles)
+    if (n.material) return *n.material;
+  return "silicon";
+}
+
+json evaluation_json(const DesignEvaluation& e) {
+  const auto& g = e.geometry;
+  const auto& s = e.strength;
+  return {{"triangles", g.triangles},
+          {"volume_m3", g.volume_m3},
+          {"area_m2", g.area_m2},
+          {"length_m", g.length_m},
+          {"tip_length_m", g.tip_length_m},
+          {"alpha_area_m2", g.alpha_area_m2},
+          {"beta_area_m2", g.beta_area_m2},
+          {"depth_m", e.depth_m},
+          {"force_at_depth_N", e.force_at_depth_n},
+          {"peak_force_N", e.peak_force_n},
+          {"puncture", nullptr},
+          {"material", e.material},
+          {"buckling_N", s.buckling_n},
+          {"strength_N", s.strength_n},
+          {"capacity_N", s.capacity_n},
+          {"governing", s.governing},
+          {"margin", std::isfinite(e.margin) ? json(e.margin) : json(nullptr)},
+          {"safety_factor", e.safety_factor},
+          {"passes", e.passes},
+          {"notes", e.notes}};
+}
+
+// The hash names a design's inputs, so --resume can tell which finished rows still apply.
+std::string row_hash(const DesignInput& d, const std::string& scene_hash, const std::string& fidelity,
+                     const std::string& material) {
+  std::string fingerprint;
+  try {
+    fingerprint = design_fingerprint(d);
+  } catch (const std::exception&) {
+    fingerprint = d.name + d.file.string();  // unreadable: evaluation reports why
+  }
+  return hex(fnv1a(fingerprint + "|" + scene_hash + "|" + fidelity + "|" + material));
+}
+
+ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::string& hash,
+                          const std::string& material, const PluginRegistry& registry,
+                          const ScreeningOptions& o) {
+  ScreeningRow row;
+  row.design = d.name;
+  row.hash = hash;
+  const auto start = std::chrono::steady_clock::now();
+  json j = {{"design", d.name}, {"source", d.file.string()}};
+  try {
+    const DesignEvaluation e = evaluate_design(design_mesh(d, registry), scene, material);
+    row.ok = true;
+    row.peak_force_n = e.peak_force_n;
+    row.margin = e.margin;
+    row.passes = e.passes;
+    j.update(evaluation_json(e));
+  } catch (const std::exception& e) {
+    row.ok = false;
+    row.error = e.what();
+    j["error"] = row.error;
+  }
+  j["hash"] = row.hash;
+  j["ok"] = row.ok;
+  j["fidelity"] = o.fidelity;
+  j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  row.json = j.dump();
+  return row;
+}
+
+ScreeningRow row_from_json(const std::string& line) {
+  const json j = json::parse(line);
+  ScreeningRow row;
+  row.design = j.at("design").get<std::string>();
+  row.hash = j.at("hash").get<std::string>();
+  row.ok = j.at("ok").get<bool>();
+  row.resumed = true;
+  row.json = line;
+  if (row.ok) {
+    row.peak_force_n = j.at("peak_force_N").get<double>();
+    row.margin = j.at("margin").is_null() ? INFINITY : j.at("margin").get<double>();
+    row.passes = j.at("passes").get<bool>();
+  } else {
+    row.error = j.value("error", "");
+  }
+  return row;
+}
+
+// Rows finished by an earlier run, by hash; a half-written last line (a killed run) is ignored.
+std::map<std::string, ScreeningRow> finished_rows(const fs::path& jsonl) {
+  std::map<std::string, ScreeningRow> done;
+  std::ifstream in(jsonl);
+  std::string line;
+  while (std::getline(in, line)) {
+    try {
+      ScreeningRow row = row_from_json(line);
+      done[row.hash] = std::move(row);
+    } catch (const std::exception&) {
+    }
+  }
+  return done;
+}
+
+std::string csv_field(const json& j, const char* key) {
+  if (!j.contains(key) || j[key].is_null()) return "";
+  if (j[key].is_string()) {
+    std::string s = j[key].get<std::string>();
+    std::replace(s.begin(), s.end(), '"', '\'');
+    return "\"" + s + "\"";
+  }
+  return j[key].dump();
+}
+
+constexpr const char* kCsvColumns[] = {"design", "ok", "peak_force_N", "force_at_depth_N", "depth_m",
+                                        "capacity_N", "governing", "margin", "passes", "material",
+                                        "triangles", "volume_m3", "tip_length_m", "error", "hash"};
+
+class ResultWriter {
+ public:
+  explicit ResultWriter(const std::optional<fs::path>& out) {
+    if (!out) return;
+    fs::create_directories(*out);
+    const bool fresh_csv = !fs::exists(*out / "results.csv");
+    jsonl_.open(*out / "results.jsonl", std::ios::app);
+    csv_.open(*out / "results.csv", std::ios::app);
+    if (!jsonl_ || !csv_) throw InputError(out->string() + ": cannot write results");
+    if (fresh_csv) {
+      std::string header;
+      for (const char* c : kCsvColumns) {
+        if (!header.empty()) header += ',';
+        header += c;
+      }
+      csv_ << header << "\n" << std::flush;
+    }
+  }
+
+  void write(const ScreeningRow& row) {
+    if (!jsonl_.is_open()) return;
+    const json j = json::parse(row.json);
+    std::string line;
+    for (const char* c : kCsvColumns) {
+      if (!line.empty()) line += ',';
+      line += csv_field(j, c);
+    }
+    // Flushed per row: a run killed half-way keeps every finished design.
+    jsonl_ << row.json << "\n" << std::flush;
+    csv_ << line << "\n" << std::flush;
+  }
+
+ private:
+  std::ofstream jsonl_, csv_;
+};
+
+}  // namespace
+
+std::vector<DesignInput> collect_designs(const std::vector<fs::path>& inputs, double metres_per_unit) {
+  std::vector<DesignInput> out;
+  auto add_file = [&](const fs::path& p) {
+    out.push_back({p.stem().string(), p, metres_per_unit, std::nullopt, {}});
+  };
+  for (const auto& input : inputs) {
+    if (!fs::exists(input)) throw InputError(input.string() + ": no such file or folder");
+    if (fs::is_directory(input)) {
+      std::vector<fs::path> files;
+      for (const auto& entry : fs::directory_iterator(input))
+        if (entry.is_regular_file() && is_mesh_file(entry.path())) files.push_back(entry.path());
+      std::sort(files.begin(), files.end());
+      for (const auto& f : files) add_file(f);
+    } else if (lower_extension(input) == ".toml") {
+      for (auto& d : read_design_list(input)) out.push_back(std::move(d));
+    } else if (is_mesh_file(input)) {
+      add_file(input);
+    } else {
+      throw InputError(input.string() + ": not a mesh file (.stl .obj .ply .off) or design list (.toml)");
+    }
+  }
+  return out;
+}
+
+std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs, const Scene& scene,
+                                         const fs::path& scene_file, const PluginRegistry& registry,
+                                         const ScreeningOptions& options,
+                                         const std::function<void(const ScreeningRow&)>& on_row) {
+  const std::string scene_hash = hex(fnv1a(read_bytes(scene_file)));
+  std::map<std::string, ScreeningRow> done;
+  if (options.resume && options.out) done = finished_rows(*options.out / "results.jsonl");
+  ResultWriter writer(options.out);
+
+  std::vector<ScreeningRow> rows(designs.size());
+  std::atomic<std::size_t> next{0};
+  std::mutex report;
+  const std::string material = scene_material(scene, options);
+  auto worker = [&] {
+    for (std::size_t i = next++; i < designs.size(); i = next++) {
+      const std::string hash = row_hash(designs[i], scene_hash, options.fidelity, material);
+      const auto previous = done.find(hash);
+      const bool skip = previous != done.end();
+      ScreeningRow row = skip ? previous->second
+                              : evaluate_row(designs[i], scene, hash, material, registry, options);
+      std::lock_guard<std::mutex> lock(report);
+      if (!skip) writer.write(row);
+      if (on_row) on_row(row);
+      rows[i] = std::move(row);
+    }
+  };
+  const int jobs = std::max(1, std::min<int>(options.jobs, static_cast<int>(designs.size())));
+  std::vector<std::thread> pool;
+  for (int j = 1; j < jobs; ++j) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  return rows;
+}
+
+std::vector<ScreeningRow> rank_rows(std::vector<ScreeningRow> rows) {
+  std::stable_sort(rows.begin(), rows.end(), [](const ScreeningRow& a, const ScreeningRow& b) {
+    if (a.ok != b.ok) return a.ok;
+    if (!a.ok) return false;
+    if (a.passes != b.passes) return a.passes;
+    return a.peak_force_n < b.peak_force_n;
+  });
+  return rows;
+}
+
+}  // namespace mneedle
