@@ -26,16 +26,21 @@ struct ScreenArgs {
   std::vector<std::string> plugin_dirs;
 };
 
-std::string cell(double value, Dimension d) { return format_quantity(value, d); }
+std::string cell(double value, Dimension d) {
+  return format_quantity(value, d);
+}
 
-void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene, const std::string& material) {
+void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
+                 const std::string& material) {
   std::printf("Scene %s: depth %s, material %s, safety factor %.2f\n", scene.source_name.c_str(),
               format_quantity(scene.requirements.target_depth.value_or(scene.insertion.depth),
                               Dimension::Length)
                   .c_str(),
               material.c_str(), scene.requirements.safety_factor);
-  std::printf("Ranked by peak post-puncture force up to that depth (paper A's distributed loads);\n"
-              "the puncture depth is not modelled yet, so every design is taken as punctured at the surface.\n\n");
+  std::printf(
+      "Ranked by peak post-puncture force up to that depth (paper A's distributed loads);\n"
+      "the puncture depth is not modelled yet, so every design is taken as punctured at the "
+      "surface.\n\n");
   std::printf("%-4s %-24s %-6s %-12s %-12s %-12s %-8s %-9s\n", "rank", "design", "status",
               "peak force", "capacity", "governing", "margin", "tip");
   int rank = 0;
@@ -45,7 +50,8 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene, co
       continue;
     }
     const auto j = nlohmann::json::parse(row.json);
-    const std::string margin = j["margin"].is_null() ? "inf" : std::to_string(row.margin).substr(0, 6);
+    const std::string margin =
+        j["margin"].is_null() ? "inf" : std::to_string(row.margin).substr(0, 6);
     std::printf("%-4d %-24s %-6s %-12s %-12s %-12s %-8s %-9s\n", ++rank, row.design.c_str(),
                 row.passes ? "pass" : "FAIL", cell(row.peak_force_n, Dimension::Force).c_str(),
                 cell(j["capacity_N"].get<double>(), Dimension::Force).c_str(),
@@ -56,9 +62,10 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene, co
 
 void run_screen(const ScreenArgs& args) {
   const Scene scene = load_scene(args.scene);
-  const auto registry = PluginRegistry::discover({args.plugin_dirs.begin(), args.plugin_dirs.end()});
-  const auto designs = collect_designs({args.designs.begin(), args.designs.end()},
-                                       length_unit_scale(args.unit));
+  const auto registry =
+      PluginRegistry::discover({args.plugin_dirs.begin(), args.plugin_dirs.end()});
+  const auto designs =
+      collect_designs({args.designs.begin(), args.designs.end()}, length_unit_scale(args.unit));
   if (designs.empty()) throw InputError("screen: no mesh files or designs found in the inputs");
 
   ScreeningOptions options;
@@ -66,19 +73,19 @@ void run_screen(const ScreenArgs& args) {
   if (!args.material.empty()) options.material = args.material;
   if (!args.out.empty()) options.out = args.out;
   options.resume = args.resume;
-  options.fidelity = args.fidelity.empty() ? std::string(to_string(scene.model.fidelity)) : args.fidelity;
+  options.fidelity =
+      args.fidelity.empty() ? std::string(to_string(scene.model.fidelity)) : args.fidelity;
   if (options.resume && !options.out) throw InputError("screen: --resume needs --out DIR");
 
-  const auto rows = rank_rows(screen_designs(designs, scene, args.scene, registry, options,
-                                             [&](const ScreeningRow& row) {
-                                               if (!args.json)
-                                                 std::cerr << (row.resumed ? "resumed " : "done    ")
-                                                           << row.design << "\n";
-                                             }));
+  const auto rows = rank_rows(
+      screen_designs(designs, scene, args.scene, registry, options, [&](const ScreeningRow& row) {
+        if (!args.json) std::cerr << (row.resumed ? "resumed " : "done    ") << row.design << "\n";
+      }));
   std::size_t failed = 0;
   for (const auto& r : rows) failed += r.ok ? 0 : 1;
   if (args.json) {
-    nlohmann::json out = {{"scene", args.scene}, {"ranking", "peak_force_N"}, {"designs", nlohmann::json::array()}};
+    nlohmann::json out = {
+        {"scene", args.scene}, {"ranking", "peak_force_N"}, {"designs", nlohmann::json::array()}};
     for (const auto& r : rows) {
       auto j = nlohmann::json::parse(r.json);
       j["resumed"] = r.resumed;
@@ -100,19 +107,25 @@ void run_screen(const ScreenArgs& args) {
 
 void add_screen_command(CLI::App& app) {
   auto args = std::make_shared<ScreenArgs>();
-  auto* cmd = app.add_subcommand("screen", "Rank needle designs (mesh files, folders, design lists) on a scene");
+  auto* cmd = app.add_subcommand(
+      "screen", "Rank needle designs (mesh files, folders, design lists) on a scene");
   cmd->footer(
       "Examples:\n"
       "  mneedle screen designs --scene designs/scenes/human_skin.toml\n"
-      "  mneedle screen designs/*.stl my_designs.toml --scene skin.toml --jobs 2 --out results --resume");
-  cmd->add_option("designs", args->designs, "Mesh files, folders of them, or TOML design lists")->required();
+      "  mneedle screen designs/*.stl my_designs.toml --scene skin.toml --jobs 2 --out results "
+      "--resume");
+  cmd->add_option("designs", args->designs, "Mesh files, folders of them, or TOML design lists")
+      ->required();
   cmd->add_option("--scene", args->scene, "Scene file (TOML)")->required();
-  cmd->add_option("--unit", args->unit, "Length unit of the mesh files: um, mm, m")->capture_default_str();
-  cmd->add_option("--material", args->material, "Needle material (default: the scene's, else silicon)");
+  cmd->add_option("--unit", args->unit, "Length unit of the mesh files: um, mm, m")
+      ->capture_default_str();
+  cmd->add_option("--material", args->material,
+                  "Needle material (default: the scene's, else silicon)");
   cmd->add_option("--fidelity", args->fidelity, "fast, standard or fine (default: the scene's)")
       ->check(CLI::IsMember({"fast", "standard", "fine"}));
   cmd->add_option("--jobs", args->jobs, "Designs evaluated at once")->check(CLI::PositiveNumber);
-  cmd->add_option("--out", args->out, "Folder for results.csv and results.jsonl, written as designs finish");
+  cmd->add_option("--out", args->out,
+                  "Folder for results.csv and results.jsonl, written as designs finish");
   cmd->add_flag("--resume", args->resume, "Skip designs already in --out for the same inputs");
   cmd->add_option("--plugin-dir", args->plugin_dirs, "Extra plugin folder (repeatable)");
   cmd->add_flag("--json", args->json, "Print one JSON object");

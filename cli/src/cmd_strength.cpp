@@ -51,7 +51,8 @@ SectionTable section_table(const PluginRegistry& registry, const NeedleSource& n
 void run_strength(const StrengthArgs& args) {
   if (args.file.empty() == args.plugin.empty())
     throw InputError("strength: give either a mesh FILE or --plugin NAME");
-  const auto registry = PluginRegistry::discover({args.plugin_dirs.begin(), args.plugin_dirs.end()});
+  const auto registry =
+      PluginRegistry::discover({args.plugin_dirs.begin(), args.plugin_dirs.end()});
   NeedleSource needle =
       args.file.empty()
           ? needle_from_plugin(registry, args.plugin,
@@ -98,8 +99,8 @@ void run_strength(const StrengthArgs& args) {
             << "  strength:  " << format_quantity(r.strength_n, Dimension::Force) << "  ("
             << failure_mode_name(material.failure) << " at "
             << format_quantity(r.critical_height_m, Dimension::Length) << " above the tip)\n"
-            << "  capacity:  " << format_quantity(r.capacity_n, Dimension::Force) << "  governed by "
-            << r.governing << "\n";
+            << "  capacity:  " << format_quantity(r.capacity_n, Dimension::Force)
+            << "  governed by " << r.governing << "\n";
 }
 
 }  // namespace
@@ -114,8 +115,10 @@ void add_strength_command(CLI::App& app) {
   cmd->add_option("file", args->file, "Needle mesh (STL, OBJ, PLY, OFF)");
   cmd->add_option("--plugin", args->plugin, "Tip-shape plugin instead of a file");
   cmd->add_option("--set", args->settings, "Plugin parameter, key=value with unit (repeatable)");
-  cmd->add_option("--unit", args->unit, "Length unit of the mesh file: um, mm, m")->capture_default_str();
-  cmd->add_option("--material", args->material, "Needle material (see docs/materials.md)")->required();
+  cmd->add_option("--unit", args->unit, "Length unit of the mesh file: um, mm, m")
+      ->capture_default_str();
+  cmd->add_option("--material", args->material, "Needle material (see docs/materials.md)")
+      ->required();
   cmd->add_option("--end", args->end, "End condition: fixed-pinned, fixed-free, pinned-pinned")
       ->capture_default_str();
   cmd->add_option("--depth", args->depth,

@@ -49,9 +49,12 @@ void element_matrices(const std::function<double(double)>& ei, double h0, double
 
 double effective_length_factor(EndCondition end) {
   switch (end) {
-    case EndCondition::FixedPinned: return 0.7;
-    case EndCondition::FixedFree: return 2.0;
-    case EndCondition::PinnedPinned: return 1.0;
+    case EndCondition::FixedPinned:
+      return 0.7;
+    case EndCondition::FixedFree:
+      return 2.0;
+    case EndCondition::PinnedPinned:
+      return 1.0;
   }
   return 1.0;
 }
@@ -66,9 +69,12 @@ EndCondition parse_end_condition(std::string_view text) {
 
 std::string_view end_condition_name(EndCondition end) {
   switch (end) {
-    case EndCondition::FixedPinned: return "fixed-pinned";
-    case EndCondition::FixedFree: return "fixed-free";
-    case EndCondition::PinnedPinned: return "pinned-pinned";
+    case EndCondition::FixedPinned:
+      return "fixed-pinned";
+    case EndCondition::FixedFree:
+      return "fixed-free";
+    case EndCondition::PinnedPinned:
+      return "pinned-pinned";
   }
   return "unknown";
 }
@@ -100,8 +106,8 @@ double critical_buckling_load(const std::function<double(double)>& flexural_rigi
     kg.block<4, 4>(2 * e, 2 * e) += kge;
   }
 
-  // Node 0 is the tip, node `elements` the base. Keep the free DOFs: the base is clamped (w = θ = 0)
-  // unless pinned (w = 0); the tip is free or pinned (w = 0).
+  // Node 0 is the tip, node `elements` the base. Keep the free DOFs: the base is clamped (w = θ =
+  // 0) unless pinned (w = 0); the tip is free or pinned (w = 0).
   std::vector<int> free_dofs;
   const bool tip_pinned = end != EndCondition::FixedFree;
   const bool base_clamped = end != EndCondition::PinnedPinned;
@@ -114,7 +120,8 @@ double critical_buckling_load(const std::function<double(double)>& flexural_rigi
   const Eigen::MatrixXd kf = k(free_dofs, free_dofs);
   const Eigen::MatrixXd kgf = kg(free_dofs, free_dofs);
 
-  // K u = P K_G u  ⇔  K_G u = (1/P) K u with K positive definite: the largest 1/P gives the lowest P.
+  // K u = P K_G u  ⇔  K_G u = (1/P) K u with K positive definite: the largest 1/P gives the lowest
+  // P.
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(kgf, kf);
   if (solver.info() != Eigen::Success)
     throw SolverError("buckling: the beam eigenproblem did not converge");

@@ -10,7 +10,8 @@ namespace mneedle {
 const std::vector<NeedleMaterial>& builtin_needle_materials() {
   static const std::vector<NeedleMaterial> materials = {
       {"silicon", 169e9, 0.064, 1.0e9, FailureMode::Fracture,
-       "Hopcroft, Nix & Kenny, J. MEMS 19 (2010): E<110> = 169 GPa, nu = 0.064; fracture strength of "
+       "Hopcroft, Nix & Kenny, J. MEMS 19 (2010): E<110> = 169 GPa, nu = 0.064; fracture strength "
+       "of "
        "etched MEMS silicon 1-3 GPa (Sharpe et al. 1997), lower end taken"},
       {"stainless_steel_304", 193e9, 0.29, 215e6, FailureMode::Yield,
        "ASM handbook, annealed AISI 304: E 193-200 GPa, nu 0.29, yield 215 MPa (ultimate 505 MPa)"},
@@ -19,19 +20,25 @@ const std::vector<NeedleMaterial>& builtin_needle_materials() {
       {"ti6al4v", 113.8e9, 0.342, 790e6, FailureMode::Yield,
        "ASTM F136 Ti-6Al-4V ELI: E 113.8 GPa, nu 0.342, yield 790 MPa"},
       {"pla", 3.5e9, 0.36, 50e6, FailureMode::Fracture,
-       "Poly(L-lactic acid), Farah, Anderson & Langer, Adv. Drug Deliv. Rev. 107 (2016): E 3.5 GPa, "
+       "Poly(L-lactic acid), Farah, Anderson & Langer, Adv. Drug Deliv. Rev. 107 (2016): E 3.5 "
+       "GPa, "
        "tensile strength ~50 MPa"},
       {"pga", 7.0e9, 0.30, 70e6, FailureMode::Fracture,
-       "Poly(glycolic acid), Middleton & Tipton, Biomaterials 21 (2000): E ~7 GPa, tensile strength "
+       "Poly(glycolic acid), Middleton & Tipton, Biomaterials 21 (2000): E ~7 GPa, tensile "
+       "strength "
        "~70 MPa"},
       {"plga", 2.0e9, 0.35, 45e6, FailureMode::Fracture,
-       "PLGA 50:50, Middleton & Tipton, Biomaterials 21 (2000): E ~2 GPa, tensile strength 41-55 MPa"},
+       "PLGA 50:50, Middleton & Tipton, Biomaterials 21 (2000): E ~2 GPa, tensile strength 41-55 "
+       "MPa"},
       {"cmc", 0.7e9, 0.30, 25e6, FailureMode::Fracture,
-       "Carboxymethyl cellulose (dry, cast): Lee, Park & Prausnitz, Biomaterials 29 (2008) simulate CMC "
-       "needles at 1/5 of PLA's buckling load, i.e. E = 0.7 GPa for PLA at 3.5 GPa; strength an estimate "
+       "Carboxymethyl cellulose (dry, cast): Lee, Park & Prausnitz, Biomaterials 29 (2008) "
+       "simulate CMC "
+       "needles at 1/5 of PLA's buckling load, i.e. E = 0.7 GPa for PLA at 3.5 GPa; strength an "
+       "estimate "
        "for dry cellulose-ether films"},
       {"polycarbonate", 2.4e9, 0.37, 62e6, FailureMode::Yield,
-       "Bisphenol-A polycarbonate, manufacturers' data sheets (e.g. Lexan): E 2.3-2.4 GPa, nu 0.37, "
+       "Bisphenol-A polycarbonate, manufacturers' data sheets (e.g. Lexan): E 2.3-2.4 GPa, nu "
+       "0.37, "
        "tensile yield 62 MPa"},
   };
   return materials;
@@ -53,7 +60,8 @@ void validate_needle_material(const NeedleMaterial& m, std::string_view where) {
     fail("nu must lie in (-1, 0.5)");
 }
 
-NeedleMaterial find_needle_material(std::string_view name, const std::vector<NeedleMaterial>& user) {
+NeedleMaterial find_needle_material(std::string_view name,
+                                    const std::vector<NeedleMaterial>& user) {
   for (const auto& m : user)
     if (m.name == name) {
       validate_needle_material(m, "user materials");

@@ -56,7 +56,8 @@ DesignEvaluation evaluate_design(const TriangleMesh& mesh, const Scene& scene,
     e.force_at_depth_n = s.force_N;
   }
 
-  const NeedleMaterial material = find_needle_material(needle_material, scene_needle_materials(scene));
+  const NeedleMaterial material =
+      find_needle_material(needle_material, scene_needle_materials(scene));
   e.material = material.name;
   StrengthOptions so;
   so.length_m = e.geometry.length_m;

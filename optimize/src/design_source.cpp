@@ -71,7 +71,8 @@ NeedleSource needle_from_plugin(const PluginRegistry& registry, const std::strin
   n.plugin = shape;
   const auto& info = registry.shape(shape);
   const std::vector<double> values = registry.resolve_parameters(shape, params_si);
-  for (std::size_t i = 0; i < info.parameters.size(); ++i) n.params[info.parameters[i].name] = values[i];
+  for (std::size_t i = 0; i < info.parameters.size(); ++i)
+    n.params[info.parameters[i].name] = values[i];
   n.mesh = registry.generate(shape, n.params);
   return n;
 }

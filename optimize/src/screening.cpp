@@ -1,5 +1,6 @@
 #include "mneedle/screening.h"
 
+#include <toml++/toml.h>
 #include <algorithm>
 #include <atomic>
 #include <cctype>
@@ -12,7 +13,6 @@
 #include <set>
 #include <sstream>
 #include <thread>
-#include <toml++/toml.h>
 
 #include "mneedle/design_source.h"
 #include "mneedle/error.h"
@@ -25,7 +25,8 @@ namespace {
 
 std::string lower_extension(const fs::path& p) {
   std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
 
@@ -156,8 +157,8 @@ json evaluation_json(const DesignEvaluation& e) {
 }
 
 // The hash names a design's inputs, so --resume can tell which finished rows still apply.
-std::string row_hash(const DesignInput& d, const std::string& scene_hash, const std::string& fidelity,
-                     const std::string& material) {
+std::string row_hash(const DesignInput& d, const std::string& scene_hash,
+                     const std::string& fidelity, const std::string& material) {
   std::string fingerprint;
   try {
     fingerprint = design_fingerprint(d);
@@ -238,9 +239,10 @@ std::string csv_field(const json& j, const char* key) {
   return j[key].dump();
 }
 
-constexpr const char* kCsvColumns[] = {"design", "ok", "peak_force_N", "force_at_depth_N", "depth_m",
-                                        "capacity_N", "governing", "margin", "passes", "material",
-                                        "triangles", "volume_m3", "tip_length_m", "error", "hash"};
+constexpr const char* kCsvColumns[] = {
+    "design",       "ok",     "peak_force_N", "force_at_depth_N", "depth_m",   "capacity_N",
+    "governing",    "margin", "passes",       "material",         "triangles", "volume_m3",
+    "tip_length_m", "error",  "hash"};
 
 class ResultWriter {
  public:
@@ -280,7 +282,8 @@ class ResultWriter {
 
 }  // namespace
 
-std::vector<DesignInput> collect_designs(const std::vector<fs::path>& inputs, double metres_per_unit) {
+std::vector<DesignInput> collect_designs(const std::vector<fs::path>& inputs,
+                                         double metres_per_unit) {
   std::vector<DesignInput> out;
   auto add_file = [&](const fs::path& p) {
     out.push_back({p.stem().string(), p, metres_per_unit, std::nullopt, {}});
@@ -298,14 +301,16 @@ std::vector<DesignInput> collect_designs(const std::vector<fs::path>& inputs, do
     } else if (is_mesh_file(input)) {
       add_file(input);
     } else {
-      throw InputError(input.string() + ": not a mesh file (.stl .obj .ply .off) or design list (.toml)");
+      throw InputError(input.string() +
+                       ": not a mesh file (.stl .obj .ply .off) or design list (.toml)");
     }
   }
   return out;
 }
 
-std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs, const Scene& scene,
-                                         const fs::path& scene_file, const PluginRegistry& registry,
+std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs,
+                                         const Scene& scene, const fs::path& scene_file,
+                                         const PluginRegistry& registry,
                                          const ScreeningOptions& options,
                                          const std::function<void(const ScreeningRow&)>& on_row) {
   const std::string scene_hash = hex(fnv1a(read_bytes(scene_file)));

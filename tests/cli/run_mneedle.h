@@ -18,7 +18,9 @@ struct CommandRun {
   std::string err;
 };
 
-inline std::string mneedle_binary() { return std::string(MNEEDLE_BINARY_ROOT) + "/cli/mneedle"; }
+inline std::string mneedle_binary() {
+  return std::string(MNEEDLE_BINARY_ROOT) + "/cli/mneedle";
+}
 
 inline CommandRun run_mneedle(const std::string& arguments) {
   static int counter = 0;
@@ -31,7 +33,8 @@ inline CommandRun run_mneedle(const std::string& arguments) {
   FILE* pipe = ::popen(command.c_str(), "r");
   if (pipe == nullptr) return run;
   char buffer[4096];
-  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;) run.out.append(buffer, n);
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;)
+    run.out.append(buffer, n);
   const int status = ::pclose(pipe);
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   std::ifstream in(err_file);

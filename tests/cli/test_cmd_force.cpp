@@ -1,8 +1,10 @@
 // Runs the built `mneedle force` on scenes and checks exit status and output.
 
 #include <gtest/gtest.h>
+
 #include <sys/wait.h>
 #include <unistd.h>
+#include "run_mneedle.h"
 
 #include <cmath>
 #include <cstdio>
@@ -14,11 +16,8 @@
 
 namespace {
 
-struct CommandRun {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
+using mneedle::test::CommandRun;
+using mneedle::test::run_mneedle;
 
 std::string scene_asset(const std::string& name) {
   return std::string(MNEEDLE_TEST_ASSETS) + "/scenes/" + name;
@@ -26,32 +25,6 @@ std::string scene_asset(const std::string& name) {
 
 std::string design(const std::string& name) {
   return std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/" + name;
-}
-
-std::string read_all(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
-CommandRun run_mneedle(const std::string& arguments) {
-  const std::string binary = std::string(MNEEDLE_BINARY_ROOT) + "/cli/mneedle";
-  const std::filesystem::path err_file =
-      std::filesystem::temp_directory_path() /
-      ("mneedle_test_cmd_force_" + std::to_string(::getpid()) + ".err");
-  const std::string command = "'" + binary + "' " + arguments + " 2>'" + err_file.string() + "'";
-  CommandRun run;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  char buffer[4096];
-  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;)
-    run.out.append(buffer, n);
-  const int status = ::pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.err = read_all(err_file);
-  std::filesystem::remove(err_file);
-  return run;
 }
 
 class ForceCommand : public ::testing::Test {

@@ -39,7 +39,8 @@ TEST(ScreenCommand, BrokenDesignGetsAnErrorRowAndTheOthersAreKept) {
   fs::remove_all(dir);
   fs::create_directories(dir / "in");
   fs::copy_file(kRoot + "/designs/cone.stl", dir / "in" / "cone.stl");
-  fs::copy_file(std::string(MNEEDLE_TEST_ASSETS) + "/meshes/open_box.stl", dir / "in" / "broken.stl");
+  fs::copy_file(std::string(MNEEDLE_TEST_ASSETS) + "/meshes/open_box.stl",
+                dir / "in" / "broken.stl");
   const auto run = run_mneedle("screen '" + (dir / "in").string() + "' --scene '" + kSkin +
                                "' --out '" + (dir / "out").string() + "'");
   EXPECT_NE(run.exit_code, 0);
@@ -70,8 +71,8 @@ TEST(StrengthCommand, CylinderPluginBucklesAtEulersLoadOverTheWholeLength) {
   EXPECT_NEAR(j["elastic_buckling_N"].get<double>() / euler, 1.0, 1e-3);
   EXPECT_EQ(j["governing"], "buckling");
   EXPECT_DOUBLE_EQ(j["effective_length_factor"].get<double>(), 2.0);
-  for (const char* key : {"material", "E_Pa", "I_min_m4", "length_m", "buckling_N", "strength_N",
-                          "capacity_N"})
+  for (const char* key :
+       {"material", "E_Pa", "I_min_m4", "length_m", "buckling_N", "strength_N", "capacity_N"})
     EXPECT_TRUE(j.contains(key)) << key;
 }
 

@@ -1,8 +1,10 @@
 // Runs the built `mneedle fit`, `predict` and `stats` end to end and checks status and output.
 
 #include <gtest/gtest.h>
+
 #include <sys/wait.h>
 #include <unistd.h>
+#include "run_mneedle.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -17,11 +19,8 @@
 
 namespace {
 
-struct CommandRun {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
+using mneedle::test::CommandRun;
+using mneedle::test::run_mneedle;
 
 const std::filesystem::path kWork = std::filesystem::temp_directory_path() /
                                     ("mneedle_test_triforce_" + std::to_string(::getpid()));
@@ -33,26 +32,6 @@ struct ScratchCleanup {
     std::filesystem::remove_all(kWork, ignored);
   }
 } const kScratchCleanup;
-
-CommandRun run_mneedle(const std::string& arguments) {
-  std::filesystem::create_directories(kWork);
-  const std::string binary = std::string(MNEEDLE_BINARY_ROOT) + "/cli/mneedle";
-  const auto err_file = kWork / "stderr.txt";
-  const std::string command = "'" + binary + "' " + arguments + " 2>'" + err_file.string() + "'";
-  CommandRun run;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  char buffer[4096];
-  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;)
-    run.out.append(buffer, n);
-  const int status = ::pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(err_file);
-  std::stringstream s;
-  s << in.rdbuf();
-  run.err = s.str();
-  return run;
-}
 
 // A recording like the rig's: approach, loading at 1 mm/s from contact at 2 mm, hold, retraction.
 std::string write_recording() {

@@ -51,9 +51,12 @@ TEST(ColumnBuckling, HollowTubeUsesTheAnnulusSecondMoment) {
 
 TEST(ColumnBuckling, ConvergesUnderRefinementForATaperedCone) {
   auto ei = [](double h) { return std::pow(1.0 + h, 4); };
-  const double coarse = mneedle::critical_buckling_load(ei, 1.0, mneedle::EndCondition::FixedPinned, 8);
-  const double fine = mneedle::critical_buckling_load(ei, 1.0, mneedle::EndCondition::FixedPinned, 60);
-  const double finer = mneedle::critical_buckling_load(ei, 1.0, mneedle::EndCondition::FixedPinned, 120);
+  const double coarse =
+      mneedle::critical_buckling_load(ei, 1.0, mneedle::EndCondition::FixedPinned, 8);
+  const double fine =
+      mneedle::critical_buckling_load(ei, 1.0, mneedle::EndCondition::FixedPinned, 60);
+  const double finer =
+      mneedle::critical_buckling_load(ei, 1.0, mneedle::EndCondition::FixedPinned, 120);
   EXPECT_LT(std::abs(fine - finer), std::abs(coarse - finer));
   EXPECT_NEAR(fine / finer, 1.0, 1e-6);
 }

@@ -20,7 +20,8 @@ TEST(NeedleStrength, SlenderSolidRodBucklesAtEulersLoad) {
   mneedle::StrengthOptions o;
   o.length_m = length;
   o.end = mneedle::EndCondition::FixedFree;
-  const auto r = mneedle::needle_strength(mneedle::circular_rod_profile(d, 0.0), material(e, 1e9), o);
+  const auto r =
+      mneedle::needle_strength(mneedle::circular_rod_profile(d, 0.0), material(e, 1e9), o);
   const double i = kPi * std::pow(d, 4) / 64.0;
   EXPECT_NEAR(r.elastic_buckling_n / (kPi * kPi * e * i / std::pow(2.0 * length, 2)), 1.0, 1e-6);
   EXPECT_FALSE(r.johnson);
@@ -32,8 +33,8 @@ TEST(NeedleStrength, StubbyHollowNeedleIsLimitedByItsCrushingLoad) {
   const double d = 230e-6, bore = 90e-6, length = 300e-6, sigma = 50e6;
   mneedle::StrengthOptions o;
   o.length_m = length;
-  const auto r = mneedle::needle_strength(mneedle::circular_rod_profile(d, bore),
-                                          material(169e9, sigma), o);
+  const auto r =
+      mneedle::needle_strength(mneedle::circular_rod_profile(d, bore), material(169e9, sigma), o);
   const double area = kPi / 4.0 * (d * d - bore * bore);
   EXPECT_NEAR(r.strength_n, sigma * area, 1e-9 * sigma * area);
   // Johnson's parabola tends to the crushing load σA as the column gets short.
@@ -104,7 +105,8 @@ TEST(NeedleStrength, BucklingColumnStartsAtTheTissueSurface) {
   o.length_m = length;
   o.load_height_m = tip;
   const auto report = mneedle::needle_strength(profile, material(e, 1e12), o);
-  const double euler = kPi * kPi * e * kPi * std::pow(r, 4) / 4.0 / std::pow(0.7 * (length - tip), 2);
+  const double euler =
+      kPi * kPi * e * kPi * std::pow(r, 4) / 4.0 / std::pow(0.7 * (length - tip), 2);
   EXPECT_NEAR(report.elastic_buckling_n / euler, 1.0, 3e-3);
 }
 

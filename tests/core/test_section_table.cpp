@@ -30,7 +30,8 @@ mneedle::TriangleMesh cylinder(double r, double h, int n) {
   mneedle::TriangleMesh m;
   for (int ring = 0; ring < 2; ++ring)
     for (int i = 0; i < n; ++i)
-      m.vertices.push_back({r * std::cos(2 * kPi * i / n), r * std::sin(2 * kPi * i / n), ring * h});
+      m.vertices.push_back(
+          {r * std::cos(2 * kPi * i / n), r * std::sin(2 * kPi * i / n), ring * h});
   const auto un = static_cast<std::uint32_t>(n);
   m.vertices.push_back({0, 0, 0});
   m.vertices.push_back({0, 0, h});
@@ -65,7 +66,8 @@ TEST(SectionTable, BoreIsSubtractedWhateverTheLoopOrientation) {
   const double r_out = 115e-6, r_in = 45e-6;
   const int n = 4096;
   for (bool clockwise : {false, true}) {
-    const auto s = mneedle::polygon_section_properties({circle(r_out, n), circle(r_in, n, clockwise)});
+    const auto s =
+        mneedle::polygon_section_properties({circle(r_out, n), circle(r_in, n, clockwise)});
     EXPECT_NEAR(s.area_m2 / (kPi * (r_out * r_out - r_in * r_in)), 1.0, 1e-5);
     EXPECT_NEAR(s.i_min_m4 / (kPi / 4 * (std::pow(r_out, 4) - std::pow(r_in, 4))), 1.0, 1e-5);
   }

@@ -21,11 +21,14 @@ class Screening : public ::testing::Test {
     fs::remove_all(dir_);
     fs::create_directories(dir_ / "in");
     for (const char* name : {"cone", "cylinder", "sharp_bevel"})
-      fs::copy_file(kRoot + "/designs/" + name + ".stl", dir_ / "in" / (std::string(name) + ".stl"));
-    fs::copy_file(std::string(MNEEDLE_TEST_ASSETS) + "/meshes/open_box.stl", dir_ / "in" / "broken.stl");
+      fs::copy_file(kRoot + "/designs/" + name + ".stl",
+                    dir_ / "in" / (std::string(name) + ".stl"));
+    fs::copy_file(std::string(MNEEDLE_TEST_ASSETS) + "/meshes/open_box.stl",
+                  dir_ / "in" / "broken.stl");
     std::ofstream(dir_ / "in" / "notes.txt") << "not a design\n";
-    std::ofstream(dir_ / "list.toml") << "[[designs]]\nname = \"bevel_20\"\nplugin = \"sharp_bevel\"\n"
-                                         "bevel_angle = \"20 deg\"\n";
+    std::ofstream(dir_ / "list.toml")
+        << "[[designs]]\nname = \"bevel_20\"\nplugin = \"sharp_bevel\"\n"
+           "bevel_angle = \"20 deg\"\n";
     scene_ = mneedle::load_scene(scene_file_);
     registry_ = mneedle::PluginRegistry::discover({MNEEDLE_PLUGIN_BUILD_DIR});
   }

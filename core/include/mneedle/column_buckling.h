@@ -14,11 +14,12 @@ enum class EndCondition { FixedPinned, FixedFree, PinnedPinned };
 /// The effective length factor K of Euler's formula for a constant section, P = π²EI/(KL)².
 double effective_length_factor(EndCondition end);
 
-EndCondition parse_end_condition(std::string_view text);  // "fixed-pinned" | "fixed-free" | "pinned-pinned"
+EndCondition parse_end_condition(
+    std::string_view text);  // "fixed-pinned" | "fixed-free" | "pinned-pinned"
 std::string_view end_condition_name(EndCondition end);
 
-/// Lowest elastic critical load [N] of a column of length L [m] whose flexural rigidity EI(h) [N m²]
-/// varies with the height h above the tip (h = 0 tip, h = L clamped base). Solved as the beam
+/// Lowest elastic critical load [N] of a column of length L [m] whose flexural rigidity EI(h) [N
+/// m²] varies with the height h above the tip (h = 0 tip, h = L clamped base). Solved as the beam
 /// eigenproblem K u = P K_G u on cubic Hermite elements; `elements` sets the discretisation.
 double critical_buckling_load(const std::function<double(double)>& flexural_rigidity, double length,
                               EndCondition end, int elements = 120);

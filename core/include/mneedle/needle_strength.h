@@ -13,18 +13,18 @@ namespace mneedle {
 /// Section properties at height h above the tip, perpendicular to the axis (bores subtracted).
 struct SectionProperties {
   double area_m2 = 0.0;
-  double i_min_m4 = 0.0;          // smallest principal second moment of area
-  double extreme_fibre_m = 0.0;   // largest distance of the section from its centroid
+  double i_min_m4 = 0.0;         // smallest principal second moment of area
+  double extreme_fibre_m = 0.0;  // largest distance of the section from its centroid
 };
 
 using SectionProfile = std::function<SectionProperties(double height_m)>;
 
 struct StrengthOptions {
-  double length_m = 0.0;        // needle length, tip to clamped base
-  double load_height_m = 0.0;   // height of the tissue surface above the tip (insertion depth)
+  double length_m = 0.0;       // needle length, tip to clamped base
+  double load_height_m = 0.0;  // height of the tissue surface above the tip (insertion depth)
   EndCondition end = EndCondition::FixedPinned;
-  double lateral_ratio = 0.0;   // |lateral force| / axial force on the tip (bevels), adds bending
-  int samples = 200;            // sections checked between load height and base
+  double lateral_ratio = 0.0;  // |lateral force| / axial force on the tip (bevels), adds bending
+  int samples = 200;           // sections checked between load height and base
 };
 
 struct StrengthReport {
@@ -40,8 +40,8 @@ struct StrengthReport {
 };
 
 /// Capacity of a needle of the given section profile and material. The buckling column is the
-/// part between the tissue surface (load height, pinned or free) and the base (clamped). InputError for non-physical
-/// options (zero length, load height outside [0, L), an empty loaded section).
+/// part between the tissue surface (load height, pinned or free) and the base (clamped). InputError
+/// for non-physical options (zero length, load height outside [0, L), an empty loaded section).
 StrengthReport needle_strength(const SectionProfile& profile, const NeedleMaterial& material,
                                const StrengthOptions& options);
 

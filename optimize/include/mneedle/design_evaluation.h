@@ -32,10 +32,10 @@ struct DesignEvaluation {
   double peak_force_n = 0.0;      // largest force up to depth_m
   StrengthReport strength;
   std::string material;
-  double margin = 0.0;            // capacity / peak force
+  double margin = 0.0;  // capacity / peak force
   double safety_factor = 1.5;
-  bool passes = false;            // margin >= safety factor and the needle reaches depth_m
-  std::vector<std::string> notes; // why a design fails, what was not modelled
+  bool passes = false;             // margin >= safety factor and the needle reaches depth_m
+  std::vector<std::string> notes;  // why a design fails, what was not modelled
 };
 
 struct EvaluationOptions {

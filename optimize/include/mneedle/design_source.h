@@ -16,9 +16,9 @@ namespace mneedle {
 
 struct NeedleSource {
   std::string name;
-  TriangleMesh mesh;                      // metres, needle frame
-  std::optional<std::string> plugin;      // the shape, when made by a plugin
-  std::map<std::string, double> params;   // SI, the shape's parameters (defaults filled in)
+  TriangleMesh mesh;                     // metres, needle frame
+  std::optional<std::string> plugin;     // the shape, when made by a plugin
+  std::map<std::string, double> params;  // SI, the shape's parameters (defaults filled in)
 };
 
 /// "key=value" settings (values with units, e.g. diameter=230um) → SI values checked against the

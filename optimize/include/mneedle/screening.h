@@ -18,10 +18,10 @@ namespace mneedle {
 /// One design to screen: a mesh file, or a plugin shape with parameters (a design-list entry).
 struct DesignInput {
   std::string name;
-  std::filesystem::path file;                    // mesh file, or the design list it came from
-  double metres_per_unit = 1e-3;                 // mesh files only
-  std::optional<std::string> plugin;             // design-list entries only
-  std::map<std::string, Quantity> parameters;    // design-list entries only, as written
+  std::filesystem::path file;                  // mesh file, or the design list it came from
+  double metres_per_unit = 1e-3;               // mesh files only
+  std::optional<std::string> plugin;           // design-list entries only
+  std::map<std::string, Quantity> parameters;  // design-list entries only, as written
 };
 
 /// Mesh files (STL, OBJ, PLY, OFF) as given, every mesh file of a folder (sorted, not recursive)
@@ -56,11 +56,10 @@ struct ScreeningRow {
 /// in input order; a design that fails gets an error row and the others go on. When `out` is
 /// set, each row is appended to out/results.jsonl and out/results.csv as soon as it is finished.
 /// `on_row` (optional) is called for each finished row, serialised.
-std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs, const Scene& scene,
-                                         const std::filesystem::path& scene_file,
-                                         const PluginRegistry& registry,
-                                         const ScreeningOptions& options,
-                                         const std::function<void(const ScreeningRow&)>& on_row = {});
+std::vector<ScreeningRow> screen_designs(
+    const std::vector<DesignInput>& designs, const Scene& scene,
+    const std::filesystem::path& scene_file, const PluginRegistry& registry,
+    const ScreeningOptions& options, const std::function<void(const ScreeningRow&)>& on_row = {});
 
 /// Sorted for the table: successful rows first, passing before failing, then by peak force;
 /// error rows last in input order.
