@@ -1,6 +1,6 @@
 // `mneedle simulate SCENE [--fidelity ...] [--contact ...] [--json|--csv]`: the pre-puncture
-// finite element stage. For now an axisymmetric needle (cylinder or cone plugin) alone on the
-// axis of a tissue cylinder; other needles need the 3-D model.
+// finite element stage. An axisymmetric needle (cylinder or cone plugin) alone runs on the
+// axisymmetric model; bevels, STL needles and arrays run on the 3-D tetrahedral model.
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -14,8 +14,10 @@
 #include <vector>
 
 #include "commands.h"
+#include "mneedle/design_source.h"
 #include "mneedle/error.h"
 #include "mneedle/fe/axisymmetric.h"
+#include "mneedle/fe/indentation3d.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene.h"
 #include "mneedle/units.h"
@@ -27,6 +29,8 @@ struct SimulateOptions {
   std::filesystem::path scene;
   std::string fidelity;
   std::string contact;
+  std::string model = "auto";
+  std::string vtu;
   bool json = false;
   bool csv = false;
 };
@@ -152,8 +156,104 @@ void print_table(const std::string& name, const fe::InsertionResult& r) {
               << s.strain_energy_J * 1e6 << std::setw(7) << s.newton_iterations << "\n";
 }
 
+bool axisymmetric_scene(const Scene& scene) {
+  if (scene.needles.size() != 1) return false;
+  const auto* plugin = std::get_if<PluginGeometry>(&scene.needles.front().geometry);
+  return plugin != nullptr && (plugin->plugin == "cylinder" || plugin->plugin == "cone");
+}
+
+fe::TissueBlockSpec block_of(const Scene& scene) {
+  fe::TissueBlockSpec block;
+  block.size_x = scene.tissue.size[0];
+  block.size_y = scene.tissue.size[1];
+  const auto layers = layers_of(scene);
+  for (std::size_t i = 0; i < layers.size(); ++i)
+    block.layers.push_back(
+        {scene.tissue.layers[i].name, layers[i].thickness_m, layers[i].material});
+  return block;
+}
+
+nlohmann::json to_json_3d(const fe::Simulation3dResult& r) {
+  nlohmann::json needles = nlohmann::json::array();
+  for (std::size_t n = 0; n < (r.steps.empty() ? 0 : r.steps.front().needles.size()); ++n) {
+    nlohmann::json curve = nlohmann::json::array();
+    for (const fe::Step3d& s : r.steps) {
+      const fe::NeedleStep3d& ns = s.needles[n];
+      curve.push_back({{"depth_m", s.depth_m},
+                       {"force_N", ns.force_N},
+                       {"lateral_force_N", {ns.lateral_force_N[0], ns.lateral_force_N[1]}},
+                       {"contact_area_m2", ns.contact_area_m2},
+                       {"contact_pressure_Pa", ns.contact_pressure_Pa},
+                       {"strain_energy_J", s.strain_energy_J}});
+    }
+    needles.push_back({{"name", r.steps.front().needles[n].name}, {"curve", curve}});
+  }
+  return {{"needles", needles},
+          {"mesh",
+           {{"nodes", r.nodes},
+            {"elements", r.elements},
+            {"order", r.order},
+            {"axisymmetric", false},
+            {"min_dihedral_deg", r.quality.min_dihedral_deg},
+            {"max_aspect_ratio", r.quality.max_aspect_ratio}}}};
+}
+
+void print_3d(const fe::Simulation3dResult& r, bool csv) {
+  if (csv)
+    std::cout << "needle,depth_m,force_N,lateral_force_x_N,lateral_force_y_N,contact_area_m2,"
+                 "contact_pressure_Pa,strain_energy_J,newton_iterations\n";
+  else
+    std::cout << "3-D model: " << r.nodes << " nodes, " << r.elements << " TET"
+              << (r.order == 2 ? 10 : 4) << ", " << std::setprecision(3) << r.timing.total_s
+              << " s (" << r.solver_backend
+              << ")\n  needle          depth [um]   force [mN]   lateral x, y [mN]\n";
+  for (const fe::Step3d& s : r.steps)
+    for (const fe::NeedleStep3d& n : s.needles) {
+      if (csv) {
+        std::cout << std::setprecision(9) << n.name << "," << s.depth_m << "," << n.force_N << ","
+                  << n.lateral_force_N[0] << "," << n.lateral_force_N[1] << "," << n.contact_area_m2
+                  << "," << n.contact_pressure_Pa << "," << s.strain_energy_J << ","
+                  << s.newton_iterations << "\n";
+      } else {
+        std::cout << "  " << std::left << std::setw(14) << n.name << std::right << std::fixed
+                  << std::setprecision(2) << std::setw(12) << s.depth_m * 1e6
+                  << std::setprecision(4) << std::setw(13) << n.force_N * 1e3 << "   "
+                  << n.lateral_force_N[0] * 1e3 << ", " << n.lateral_force_N[1] * 1e3 << "\n";
+        std::cout.unsetf(std::ios::fixed);
+      }
+    }
+}
+
+void run_3d(const Scene& scene, const SimulateOptions& o) {
+  if (contact_of(scene, o.contact) == fe::ContactMode::Frictionless)
+    throw InputError(scene.source_name +
+                     ": model.contact: frictionless contact is not available in the 3-D model yet "
+                     "(use sticking, or an axisymmetric needle)");
+  const PluginRegistry registry = PluginRegistry::discover();
+  std::vector<fe::Needle3d> needles;
+  for (const NeedleSpec& spec : scene.needles)
+    needles.push_back({spec.name, needle_from_scene(registry, spec).mesh, spec.at[0], spec.at[1]});
+  fe::Simulation3dOptions options;
+  options.fidelity = fidelity_of(scene, o.fidelity);
+  options.depth = scene.insertion.depth;
+  options.vtu_directory = o.vtu;
+  const fe::Simulation3dResult result = fe::simulate_3d(block_of(scene), needles, options);
+  if (o.json)
+    std::cout << to_json_3d(result).dump(2) << "\n";
+  else
+    print_3d(result, o.csv);
+}
+
 void run(const SimulateOptions& o) {
   const Scene scene = load_scene(o.scene);
+  const bool axisymmetric =
+      o.model == "axisymmetric" || (o.model == "auto" && axisymmetric_scene(scene));
+  if (!axisymmetric || !o.vtu.empty()) {
+    if (o.model == "axisymmetric")
+      throw InputError("simulate: --vtu is written by the 3-D model only (use --model 3d)");
+    run_3d(scene, o);
+    return;
+  }
   if (scene.needles.size() != 1)
     throw InputError(scene.source_name + ": needles: " + std::to_string(scene.needles.size()) +
                      " needles need the 3-D model; the axisymmetric solver takes exactly one");
@@ -180,13 +280,21 @@ void run(const SimulateOptions& o) {
 
 void add_simulate_command(CLI::App& app) {
   auto options = std::make_shared<SimulateOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "simulate", "Pre-puncture finite element insertion (axisymmetric needles for now)");
+  CLI::App* cmd =
+      app.add_subcommand("simulate", "Pre-puncture finite element insertion (axisymmetric or 3-D)");
   cmd->add_option("scene", options->scene, "scene file (TOML)")->required();
   cmd->add_option("--fidelity", options->fidelity, "mesh fidelity (default: the scene's)")
       ->check(CLI::IsMember({"fast", "standard", "fine"}));
   cmd->add_option("--contact", options->contact, "needle contact (default: the scene's)")
       ->check(CLI::IsMember({"sticking", "frictionless"}));
+  cmd->add_option("--model", options->model,
+                  "auto (axisymmetric when the scene allows it), axisymmetric or 3d")
+      ->check(CLI::IsMember({"auto", "axisymmetric", "3d"}))
+      ->capture_default_str();
+  cmd->add_option("--vtu", options->vtu, "write step_<k>.vtu per depth step here (3-D model)");
+  cmd->footer(
+      "Examples:\n  mneedle simulate designs/scenes/human_skin.toml --fidelity fast --json\n"
+      "  mneedle simulate tests/assets/scenes/axisymmetric_punch.toml --csv");
   auto* json = cmd->add_flag("--json", options->json, "print the curve as JSON");
   cmd->add_flag("--csv", options->csv, "print the curve as CSV")->excludes(json);
   cmd->callback([options]() { run(*options); });

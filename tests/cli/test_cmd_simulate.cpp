@@ -57,11 +57,25 @@ TEST(CmdSimulate, CsvHasOneRowPerDepth) {
   EXPECT_EQ(rows, 10);  // fast fidelity: 10 output depths
 }
 
-TEST(CmdSimulate, NonAxisymmetricNeedleIsAClearError) {
-  const CommandRun run = run_mneedle("simulate '" + scene("bevel_needs_3d.toml") + "'");
+TEST(CmdSimulate, AxisymmetricModelRefusesABevelClearly) {
+  const CommandRun run =
+      run_mneedle("simulate '" + scene("bevel_needs_3d.toml") + "' --model axisymmetric");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("bevel_needs_3d.toml:"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("3-D model"), std::string::npos) << run.err;
+}
+
+TEST(CmdSimulate, BevelRunsIn3dWithALateralForce) {
+  const CommandRun run = run_mneedle("simulate '" + scene("bevel_3d_linear.toml") + "' --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_FALSE(j["mesh"]["axisymmetric"].get<bool>());
+  const auto& last = j["needles"][0]["curve"].back();
+  EXPECT_NEAR(last["depth_m"].get<double>(), 50e-6, 1e-12);
+  EXPECT_GT(last["force_N"].get<double>(), 0.0);
+  // The bevel faces one side: the tissue pushes it sideways, along x in the plugin's frame.
+  EXPECT_GT(std::abs(last["lateral_force_N"][0].get<double>()), 0.0);
+  EXPECT_NEAR(last["lateral_force_N"][1].get<double>(), 0.0, 1e-9);
 }
 
 TEST(CmdSimulate, FrictionlessIsRefusedUntilImplemented) {

@@ -3,6 +3,7 @@
 // by a rigid axisymmetric needle: 6-node triangles, total Lagrangian, Newton-Raphson.
 // SI units throughout: metres, newtons, pascals, joules.
 
+#include "mneedle/fe/fidelity.h"
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <array>
@@ -40,7 +41,6 @@ struct AxisymmetricNeedle {
   double lowest_height_at(double r) const;
 };
 
-enum class Fidelity { Fast, Standard, Fine };
 enum class ContactMode { Sticking, Frictionless };
 
 /// Structured graded mesh controls. Element size h_m is used within fine_radius_m of the axis

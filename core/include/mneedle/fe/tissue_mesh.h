@@ -2,6 +2,7 @@
 // Graded, layer-conforming tetrahedral mesh of a layered tissue block (paper A §2.1: each
 // tetrahedron knows its layer, its material and its four face neighbours).
 
+#include "mneedle/fe/fidelity.h"
 #include <Eigen/Core>
 #include <array>
 #include <string>
@@ -11,7 +12,6 @@
 
 namespace mneedle::fe {
 
-enum class Fidelity { Fast, Standard, Fine };
 
 /// Parses "fast", "standard" or "fine"; throws InputError naming `field` otherwise.
 Fidelity parse_fidelity(const std::string& text, const std::string& field = "fidelity");
