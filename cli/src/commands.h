@@ -16,6 +16,7 @@ void add_inspect_command(CLI::App& app);
 void add_force_command(CLI::App& app);
 void add_strength_command(CLI::App& app);
 void add_screen_command(CLI::App& app);
+void add_optimize_command(CLI::App& app);
 void add_fit_command(CLI::App& app);
 void add_predict_command(CLI::App& app);
 void add_stats_command(CLI::App& app);

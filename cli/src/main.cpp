@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   mneedle::cli::add_force_command(app);
   mneedle::cli::add_strength_command(app);
   mneedle::cli::add_screen_command(app);
+  mneedle::cli::add_optimize_command(app);
   mneedle::cli::add_fit_command(app);
   mneedle::cli::add_predict_command(app);
   mneedle::cli::add_stats_command(app);

@@ -95,4 +95,32 @@ TEST(StrengthCommand, UnknownMaterialAndMissingNeedleAreClearErrors) {
   EXPECT_NE(run.err.find("either a mesh FILE or --plugin"), std::string::npos) << run.err;
 }
 
+TEST(OptimizeCommand, SearchesABevelAngleAndWritesItsOutputs) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("mneedle_optimize_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSkin +
+                               "' --vary bevel_angle --bound bevel_angle=20deg:60deg"
+                               " --material silicon --max-evals 25 --json --out '" +
+                               dir.string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_TRUE(j["feasible"].get<bool>());
+  EXPECT_EQ(j["algorithm"], "cobyla");
+  EXPECT_TRUE(j["best"]["puncture_depth_m"].is_null());
+  // A sharper bevel carries less post-puncture load here: the search goes to the lower bound.
+  const double angle = j["best"]["params"]["bevel_angle"].get<double>();
+  EXPECT_NEAR(angle, 20.0 * 3.14159265358979323846 / 180.0, 0.01);
+  EXPECT_TRUE(fs::exists(dir / "best.stl"));
+  EXPECT_TRUE(fs::exists(dir / "history.csv"));
+  EXPECT_TRUE(fs::exists(dir / "summary.json"));
+  fs::remove_all(dir);
+}
+
+TEST(OptimizeCommand, UnknownParameterIsAClearError) {
+  const auto run = run_mneedle("optimize --plugin cone --scene '" + kSkin + "' --vary bevel_angle");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("has no parameter 'bevel_angle'"), std::string::npos) << run.err;
+}
+
 }  // namespace
