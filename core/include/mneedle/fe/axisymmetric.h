@@ -3,7 +3,6 @@
 // by a rigid axisymmetric needle: 6-node triangles, total Lagrangian, Newton-Raphson.
 // SI units throughout: metres, newtons, pascals, joules.
 
-#include "mneedle/fe/fidelity.h"
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <array>
@@ -11,6 +10,7 @@
 #include <limits>
 #include <memory>
 #include <vector>
+#include "mneedle/fe/fidelity.h"
 
 #include "mneedle/fe/material.h"
 

@@ -2,16 +2,15 @@
 // Graded, layer-conforming tetrahedral mesh of a layered tissue block (paper A §2.1: each
 // tetrahedron knows its layer, its material and its four face neighbours).
 
-#include "mneedle/fe/fidelity.h"
 #include <Eigen/Core>
 #include <array>
 #include <string>
 #include <vector>
+#include "mneedle/fe/fidelity.h"
 
 #include "mneedle/fe/material.h"
 
 namespace mneedle::fe {
-
 
 /// Parses "fast", "standard" or "fine"; throws InputError naming `field` otherwise.
 Fidelity parse_fidelity(const std::string& text, const std::string& field = "fidelity");
