@@ -10,8 +10,8 @@
 #include <limits>
 #include <memory>
 #include <vector>
-#include "mneedle/fe/fidelity.h"
 
+#include "mneedle/fe/fidelity.h"
 #include "mneedle/fe/material.h"
 
 namespace mneedle::fe {

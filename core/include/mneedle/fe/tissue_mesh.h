@@ -6,8 +6,8 @@
 #include <array>
 #include <string>
 #include <vector>
-#include "mneedle/fe/fidelity.h"
 
+#include "mneedle/fe/fidelity.h"
 #include "mneedle/fe/material.h"
 
 namespace mneedle::fe {
