@@ -61,17 +61,19 @@ double lowest_z(const TriangleMesh& mesh) {
 
 }  // namespace
 
+int nested_loop_sign(const std::vector<std::vector<Point2>>& polygons, std::size_t i) {
+  if (polygons[i].size() < 3) return 0;
+  int depth = 0;
+  for (std::size_t j = 0; j < polygons.size(); ++j) {
+    if (j != i && polygons[j].size() >= 3 && contains(polygons[j], polygons[i].front())) ++depth;
+  }
+  return depth % 2 == 0 ? 1 : -1;
+}
+
 double nested_polygon_area(const std::vector<std::vector<Point2>>& polygons) {
   double area = 0.0;
-  for (std::size_t i = 0; i < polygons.size(); ++i) {
-    if (polygons[i].size() < 3) continue;
-    int depth = 0;
-    for (std::size_t j = 0; j < polygons.size(); ++j) {
-      if (j != i && polygons[j].size() >= 3 && contains(polygons[j], polygons[i].front())) ++depth;
-    }
-    const double magnitude = std::abs(shoelace_area(polygons[i]));
-    area += depth % 2 == 0 ? magnitude : -magnitude;
-  }
+  for (std::size_t i = 0; i < polygons.size(); ++i)
+    area += nested_loop_sign(polygons, i) * std::abs(shoelace_area(polygons[i]));
   return area;
 }
 

@@ -12,26 +12,6 @@ namespace {
 
 using Loop = std::vector<std::array<double, 2>>;
 
-bool loop_contains(const Loop& loop, const std::array<double, 2>& p) {
-  bool inside = false;
-  for (std::size_t i = 0, j = loop.size() - 1; i < loop.size(); j = i++) {
-    const auto& a = loop[i];
-    const auto& b = loop[j];
-    if ((a[1] > p[1]) != (b[1] > p[1]) &&
-        p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0])
-      inside = !inside;
-  }
-  return inside;
-}
-
-// +1 for material, −1 for a hole: holes sit inside an odd number of other loops.
-double nesting_sign(const std::vector<Loop>& loops, std::size_t i) {
-  int depth = 0;
-  for (std::size_t j = 0; j < loops.size(); ++j)
-    if (j != i && loops[j].size() >= 3 && loop_contains(loops[j], loops[i].front())) ++depth;
-  return depth % 2 == 0 ? 1.0 : -1.0;
-}
-
 // Area moments of one loop about the origin, oriented counter-clockwise.
 struct Moments {
   double a = 0, sx = 0, sy = 0, ixx = 0, iyy = 0, ixy = 0;
@@ -66,8 +46,8 @@ SectionProperties lerp(const SectionProperties& a, const SectionProperties& b, d
 SectionProperties polygon_section_properties(const std::vector<Loop>& loops) {
   Moments total;
   for (std::size_t i = 0; i < loops.size(); ++i) {
-    if (loops[i].size() < 3) continue;
-    const double s = nesting_sign(loops, i);
+    const double s = nested_loop_sign(loops, i);
+    if (s == 0.0) continue;
     const Moments m = loop_moments(loops[i]);
     total.a += s * m.a, total.sx += s * m.sx, total.sy += s * m.sy;
     total.ixx += s * m.ixx, total.iyy += s * m.iyy, total.ixy += s * m.ixy;

@@ -22,6 +22,10 @@ struct CrossSection {
 /// other loops contain it and - when odd, so a bore inside a shaft is subtracted.
 double nested_polygon_area(const std::vector<std::vector<Point2>>& polygons);
 
+/// +1 when loop `i` is material, -1 when it is a hole (inside an odd number of the other loops),
+/// the rule nested_polygon_area applies; 0 for a loop of fewer than three points.
+int nested_loop_sign(const std::vector<std::vector<Point2>>& polygons, std::size_t i);
+
 /// Slices one mesh at many heights, building CGAL's AABB tree once. The mesh must be in the
 /// needle frame (axis along z, body toward +z) and halfedge-representable (closed, manifold);
 /// otherwise the constructor throws InputError.
