@@ -98,6 +98,8 @@ void run_optimize(const OptimizeArgs& a) {
   const auto fixed = parse_parameter_settings(shape, a.settings);
   const auto vars = variables(shape, a);
   const double min_feature = parse_quantity(a.min_feature, Dimension::Length);
+  if (!(min_feature > 0.0))
+    throw InputError("--min-feature: must be a positive length, got '" + a.min_feature + "'");
   std::string material = a.material;
   if (material.empty())
     for (const auto& n : scene.needles)

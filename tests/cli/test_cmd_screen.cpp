@@ -121,6 +121,10 @@ TEST(OptimizeCommand, UnknownParameterIsAClearError) {
   const auto run = run_mneedle("optimize --plugin cone --scene '" + kSkin + "' --vary bevel_angle");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("has no parameter 'bevel_angle'"), std::string::npos) << run.err;
+  const auto negative = run_mneedle("optimize --plugin cone --scene '" + kSkin +
+                                    "' --vary half_angle --min-feature -5um");
+  EXPECT_EQ(negative.exit_code, 1);
+  EXPECT_NE(negative.err.find("--min-feature"), std::string::npos) << negative.err;
 }
 
 }  // namespace
