@@ -41,7 +41,6 @@ struct AxisymmetricNeedle {
   double lowest_height_at(double r) const;
 };
 
-enum class ContactMode { Sticking, Frictionless };
 
 /// Structured graded mesh controls. Element size h_m is used within fine_radius_m of the axis
 /// and down to fine_depth_m; beyond, sizes grow geometrically by `growth` up to max_size_m.

@@ -1,8 +1,25 @@
 #pragma once
 // The speed–accuracy levels every FE model offers; each model maps them to its own mesh sizes.
+// Explicit overrides let a user (or a convergence study) pin any one of those choices.
+
+#include <optional>
 
 namespace mneedle::fe {
 
 enum class Fidelity { Fast, Standard, Fine };
+
+/// Each set field replaces what the fidelity level would choose; unset fields keep the level's.
+struct FidelityOverrides {
+  std::optional<int> order;                 ///< 1: linear elements (TET4), 2: quadratic (TET10, T6)
+  std::optional<double> tip_size_m;         ///< element size at the needle tip
+  std::optional<double> growth;             ///< size ratio between neighbouring elements
+  std::optional<double> domain_scale;       ///< tissue block lateral size relative to the scene's
+  std::optional<double> tolerance;          ///< Newton residual tolerance (relative)
+  std::optional<int> steps;                 ///< depth steps of the insertion
+  std::optional<int> elements_through_top;  ///< elements through the top layer's thickness
+};
+
+/// Contact between the rigid needle and the tissue surface.
+enum class ContactMode { Sticking, Frictionless };
 
 }  // namespace mneedle::fe

@@ -1,0 +1,26 @@
+#pragma once
+// Cracked copies of a tissue mesh, for the energy puncture criterion: the energy release rate is
+// G = (U_intact - U_cracked) / crack area at the same needle position (paper A eq. 12 read as
+// Griffith's criterion at fixed displacement; docs/model.md).
+
+#include <Eigen/Core>
+
+#include "mneedle/fe/tissue_mesh.h"
+
+namespace mneedle::fe {
+
+/// A planar crack through a needle's axis: the half-disc of radius `depth_m` below `origin_m`
+/// (a point on the undeformed surface z = 0, reference coordinates) in the plane through
+/// `origin_m` with normal `normal` (horizontal).
+struct PlanarCrack {
+  Eigen::Vector3d origin_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();
+  double depth_m = 0.0;
+};
+
+/// The mesh with the faces inside the crack opened: nodes on the crack's interior are doubled,
+/// one copy per side (nodes on the crack front stay shared). `area_m2` receives the area of the
+/// faces opened (one side). Throws InputError when no mesh face lies on the crack's plane there.
+TetMesh crack_mesh(const TetMesh& mesh, const PlanarCrack& crack, double* area_m2);
+
+}  // namespace mneedle::fe
