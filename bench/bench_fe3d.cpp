@@ -1,5 +1,5 @@
 // One sharp-bevel needle (230 um) pressed 200 um into paper A's 3000 x 3000 x 1150 um three-layer
-// skin, 3-D, at each fidelity; counters split the time (docs/_parts/fe_3d_performance.md).
+// skin, 3-D, at each fidelity; counters split the time (docs/_parts/fe3d-performance.md).
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
@@ -33,7 +33,8 @@ TissueBlockSpec paper_a_skin(MaterialModel model) {
   return block;
 }
 
-void run(benchmark::State& state, MaterialModel model) {
+void run(benchmark::State& state, MaterialModel model, bool half = false,
+         ContactMode contact = ContactMode::Sticking) {
   const auto fidelity = static_cast<Fidelity>(state.range(0));
   const int order = static_cast<int>(state.range(1));
   const std::vector<Needle3d> needles{{"sharp bevel", sharp_bevel(), 0.0, 0.0}};
@@ -42,9 +43,12 @@ void run(benchmark::State& state, MaterialModel model) {
   options.order = order;
   options.depth = 200e-6;
   options.steps = 10;
+  options.half_model = half;
+  options.contact = contact;
   Simulation3dResult result;
   for (auto _ : state) result = simulate_3d(paper_a_skin(model), needles, options);
-  state.SetLabel(to_string(fidelity) + (order == 1 ? " TET4" : " TET10"));
+  state.SetLabel(to_string(fidelity) + (order == 1 ? " TET4" : " TET10") + (half ? " half" : "") +
+                 (contact == ContactMode::Frictionless ? " frictionless" : ""));
   state.counters["nodes"] = result.nodes;
   state.counters["elements"] = result.elements;
   state.counters["force_N"] = result.steps.back().needles[0].force_N;
@@ -65,6 +69,19 @@ void st_venant_skin(benchmark::State& state) {
   run(state, MaterialModel::StVenantKirchhoff);
 }
 
+// The half model (mirror plane y = 0 through the bevel's axis) and frictionless contact.
+void linear_skin_half(benchmark::State& state) {
+  run(state, MaterialModel::Linear, true);
+}
+void linear_skin_frictionless(benchmark::State& state) {
+  run(state, MaterialModel::Linear, false, ContactMode::Frictionless);
+}
+
+BENCHMARK(linear_skin_half)->ArgsProduct({{0, 1}, {2}})->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK(linear_skin_frictionless)
+    ->ArgsProduct({{0}, {2}})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 BENCHMARK(linear_skin)->ArgsProduct({{0, 1, 2}, {2, 1}})->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(st_venant_skin)->ArgsProduct({{0, 1}, {2, 1}})->Iterations(1)->Unit(benchmark::kSecond);
 

@@ -64,26 +64,39 @@ std::vector<double> radial_grid(const AxisymmetricMeshOptions& o) {
   return r;
 }
 
-// Depth below the surface (s = -z) of every node row, surface first.
+// Depth below the surface (s = -z) of every node row, surface first. Depth breaks split a
+// layer into segments meshed like layers; a segment needs its share of the layer's minimum.
 std::vector<double> depth_grid(const std::vector<AxisymmetricLayer>& layers,
                                const AxisymmetricMeshOptions& o) {
   std::vector<double> s{0.0};
   double top = 0.0;
   double h = o.h_m;
-  for (const AxisymmetricLayer& layer : layers) {
-    const double bottom = top + layer.thickness_m;
-    const double fine_end = std::clamp(o.fine_depth_m, top, bottom);
-    const int minimum = o.min_elements_per_layer;
-    if (fine_end > top) {
-      const bool whole = fine_end >= bottom;
-      append_uniform(s, top, fine_end, uniform_count(fine_end - top, o.h_m, whole ? minimum : 1));
-      h = o.h_m;
+  for (std::size_t k = 0; k < layers.size(); ++k) {
+    const double layer_top = top, layer_bottom = top + layers[k].thickness_m;
+    const int layer_minimum = k == 0 && o.elements_through_top > 0
+                                  ? std::max(o.elements_through_top, 1)
+                                  : o.min_elements_per_layer;
+    std::vector<double> ends;
+    for (double b : o.depth_breaks_m)
+      if (b > layer_top + 1e-9 * layers[k].thickness_m &&
+          b < layer_bottom - 1e-9 * layers[k].thickness_m)
+        ends.push_back(b);
+    std::sort(ends.begin(), ends.end());
+    ends.push_back(layer_bottom);
+    for (double bottom : ends) {
+      const double fraction = (bottom - top) / layers[k].thickness_m;
+      const int minimum = std::max(1, static_cast<int>(std::ceil(layer_minimum * fraction - 1e-9)));
+      const double fine_end = std::clamp(o.fine_depth_m, top, bottom);
+      if (fine_end > top) {
+        const bool whole = fine_end >= bottom;
+        append_uniform(s, top, fine_end, uniform_count(fine_end - top, o.h_m, whole ? minimum : 1));
+        h = o.h_m;
+      }
+      if (fine_end < bottom)
+        h = append_graded(s, fine_end, bottom, h, o.growth, o.max_size_m,
+                          fine_end > top ? 1 : minimum);
+      top = bottom;
     }
-    if (fine_end < bottom) {
-      h = append_graded(s, fine_end, bottom, h, o.growth, o.max_size_m,
-                        fine_end > top ? 1 : minimum);
-    }
-    top = bottom;
   }
   return s;
 }

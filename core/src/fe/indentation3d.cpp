@@ -1,17 +1,22 @@
 #include "mneedle/fe/indentation3d.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
+#include "fe/contact3d.h"
 #include "fe/needle_shape.h"
 #include "mneedle/error.h"
+#include "mneedle/fe/crack.h"
 #include "mneedle/fe/solid3d.h"
 #include "mneedle/fe/sparse_solver.h"
+#include "mneedle/fe/stress_probe.h"
 
 namespace mneedle::fe {
 
@@ -40,15 +45,22 @@ constexpr int kMaxCaptureRounds = 60;
 constexpr int kMaxNewtonIterations = 40;
 constexpr int kMaxLineSearchHalvings = 6;
 constexpr int kMaxStepCuts = 12;
+// Frictionless contact: Uzawa updates of the multipliers until the largest change of a point's
+// force is below kUzawaTolerance of the summed contact force (ε = 100 E*/h: about 10 updates).
+constexpr int kMaxUzawa = 50;
+constexpr double kUzawaTolerance = 1e-4;
+constexpr int kMaxContactNewton = 60;
 
 }  // namespace
 
 struct Indentation3d::Impl {
-  Impl(const TetMesh& m, std::vector<Needle3d> n) : mesh(m), model(m), needles(std::move(n)) {}
+  Impl(const TetMesh& m, std::vector<Needle3d> n, const Indentation3dOptions& o)
+      : mesh(m), model(m), needles(std::move(n)), options(o) {}
 
   const TetMesh& mesh;
   SolidModel model;
   std::vector<Needle3d> needles;
+  Indentation3dOptions options;
   std::vector<NeedleShape> shapes;
   std::vector<double> reach;         // horizontal reach radius per needle
   std::vector<int> candidates;       // top-surface nodes a needle may capture
@@ -70,6 +82,14 @@ struct Indentation3d::Impl {
   double step = 0.0;
   Eigen::SparseMatrix<double> tangent;   // last factorised tangent before the Dirichlet rows
   std::vector<char> factor_constraints;  // prescribed dofs of the current factorisation
+  // Frictionless path: quadrature-point contact; on linear layers the tissue is condensed onto
+  // the contact-face nodes (rows) through K⁻¹ columns at the loaded ("involved") nodes.
+  std::optional<FrictionlessContact> contact;
+  std::vector<int> row_index;       // node -> row block in contact->nodes() or -1
+  std::vector<int> involved;        // nodes with a compliance column block
+  std::vector<int> involved_index;  // node -> column block or -1
+  Eigen::VectorXd contact_load;     // force on the tissue at the involved nodes (linear path)
+  std::vector<ContactPointState> contact_states;
 
   Eigen::Vector3d tip(int needle, double at_depth) const {
     const auto& n = needles[static_cast<std::size_t>(needle)];
@@ -296,7 +316,7 @@ struct Indentation3d::Impl {
       const Eigen::VectorXd force = assemble_force(refactor);
       const Eigen::VectorXd residual = free_part(force, constrained);
       const double residual_norm = residual.norm();
-      if (residual_norm <= 1e-8 * reaction_norm(force)) return iteration - 1;
+      if (residual_norm <= options.tolerance * reaction_norm(force)) return iteration - 1;
       if (refactor) factorize_tangent(constrained);
       const Eigen::VectorXd delta = solver.solve(Eigen::VectorXd(-residual));
       const double accepted = line_search(delta, residual_norm, constrained);
@@ -309,13 +329,13 @@ struct Indentation3d::Impl {
 
   // Backtracking on the residual norm; an inverted element at a trial point counts as a failure.
   // Returns the residual norm at the accepted point.
-  double line_search(const Eigen::VectorXd& delta, double residual_norm,
-                     const std::vector<char>& constrained) {
+  template <class ResidualNorm>
+  double backtrack(const Eigen::VectorXd& delta, double residual_norm, ResidualNorm&& norm_at) {
     double alpha = 1.0;
     for (int halving = 0; halving <= kMaxLineSearchHalvings; ++halving, alpha *= 0.5) {
       const Eigen::VectorXd trial = u + alpha * delta;
       try {
-        const double trial_norm = free_part(internal_force(trial), constrained).norm();
+        const double trial_norm = norm_at(trial);
         if (trial_norm < (1.0 - 1e-4 * alpha) * residual_norm ||
             halving == kMaxLineSearchHalvings) {
           u = trial;
@@ -326,6 +346,13 @@ struct Indentation3d::Impl {
       }
     }
     return residual_norm;
+  }
+
+  double line_search(const Eigen::VectorXd& delta, double residual_norm,
+                     const std::vector<char>& constrained) {
+    return backtrack(delta, residual_norm, [&](const Eigen::VectorXd& trial) {
+      return free_part(internal_force(trial), constrained).norm();
+    });
   }
 
   int solve_nonlinear_at(double at_depth) {
@@ -355,14 +382,18 @@ struct Indentation3d::Impl {
       const double h = std::min(step, target - depth);
       const Eigen::VectorXd saved_u = u;
       const std::size_t saved_captured = captured.size();
+      const std::vector<double> saved_multipliers =
+          frictionless() ? multipliers_of() : std::vector<double>{};
       try {
-        const int used = solve_nonlinear_at(depth + h);
+        const int used = frictionless() ? solve_frictionless_nonlinear_at(depth + h)
+                                        : solve_nonlinear_at(depth + h);
         total += used;
         depth += h;
         if (used <= 4) step = 1.5 * h;
         cuts = 0;
       } catch (const SolverError& error) {
         u = saved_u;
+        if (frictionless()) contact->set_multipliers(saved_multipliers);
         for (std::size_t i = saved_captured; i < captured.size(); ++i)
           captured_by[static_cast<std::size_t>(captured[i].node)] = -1;
         captured.resize(saved_captured);
@@ -374,6 +405,228 @@ struct Indentation3d::Impl {
       }
     }
     return total;
+  }
+
+  // ---- frictionless path ----------------------------------------------------------------------
+  bool frictionless() const { return options.contact == ContactMode::Frictionless; }
+
+  void setup_frictionless() {
+    contact.emplace(mesh, needles, &shapes, reach);
+    row_index.assign(mesh.nodes.size(), -1);
+    involved_index.assign(mesh.nodes.size(), -1);
+    const auto& rows = contact->nodes();
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      row_index[static_cast<std::size_t>(rows[r])] = static_cast<int>(r);
+    compliance.resize(3 * static_cast<Eigen::Index>(rows.size()), 0);
+    contact_load.resize(0);
+  }
+
+  // Nodal force of the contact on the tissue, free dofs only, at the involved nodes.
+  Eigen::VectorXd involved_contact_force(const std::vector<ContactPointState>& states) const {
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(involved.size()));
+    contact->for_each_force(states, [&](int node, const Eigen::Vector3d& force) {
+      const int i = involved_index[static_cast<std::size_t>(node)];
+      for (int j = 0; j < 3; ++j)
+        if (!fixed_dof[static_cast<std::size_t>(3 * node + j)]) f(3 * i + j) += force(j);
+    });
+    return f;
+  }
+
+  // Nodes of loaded faces that have no compliance column yet.
+  std::vector<int> missing_involved(const std::vector<ContactPointState>& states) const {
+    std::vector<int> missing;
+    contact->for_each_force(states, [&](int node, const Eigen::Vector3d&) {
+      if (involved_index[static_cast<std::size_t>(node)] < 0) missing.push_back(node);
+    });
+    std::sort(missing.begin(), missing.end());
+    missing.erase(std::unique(missing.begin(), missing.end()), missing.end());
+    return missing;
+  }
+
+  void add_involved(const std::vector<int>& nodes) {
+    const Eigen::Index old_columns = compliance.cols();
+    Eigen::MatrixXd unit =
+        Eigen::MatrixXd::Zero(model.dof_count(), 3 * static_cast<Eigen::Index>(nodes.size()));
+    for (std::size_t i = 0; i < nodes.size(); ++i)
+      for (int j = 0; j < 3; ++j)
+        unit(3 * nodes[i] + j, 3 * static_cast<Eigen::Index>(i) + j) = 1.0;
+    const Eigen::MatrixXd columns = solver.solve_many(unit);
+    const auto& rows = contact->nodes();
+    compliance.conservativeResize(Eigen::NoChange, old_columns + columns.cols());
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      for (int j = 0; j < 3; ++j)
+        compliance.block(3 * static_cast<Eigen::Index>(r) + j, old_columns, 1, columns.cols()) =
+            columns.row(3 * rows[r] + j);
+    for (int node : nodes) {
+      involved_index[static_cast<std::size_t>(node)] = static_cast<int>(involved.size());
+      involved.push_back(node);
+    }
+    contact_load.conservativeResize(3 * static_cast<Eigen::Index>(involved.size()));
+    contact_load.tail(3 * static_cast<Eigen::Index>(nodes.size())).setZero();
+  }
+
+  // Displacement of the contact-face nodes under the current contact load.
+  Eigen::VectorXd condensed_displacement() const {
+    if (involved.empty()) return Eigen::VectorXd::Zero(compliance.rows());
+    return compliance * contact_load;
+  }
+
+  std::vector<ContactPointState> condensed_states(double at_depth) const {
+    const Eigen::VectorXd ur = condensed_displacement();
+    return contact->evaluate(at_depth, [&](int node) -> Eigen::Vector3d {
+      const int r = row_index[static_cast<std::size_t>(node)];
+      return ur.segment<3>(3 * r);
+    });
+  }
+
+  // Newton on the contact load f at fixed multipliers: R(f) = f - f_c(u(f)) with u = C f, so
+  // dR/df = I + K_c C (K_c the penalty tangent at the loaded points).
+  int solve_condensed(double at_depth) {
+    int iterations = 0;
+    for (int iteration = 0; iteration < kMaxContactNewton; ++iteration) {
+      std::vector<ContactPointState> states = condensed_states(at_depth);
+      const std::vector<int> missing = missing_involved(states);
+      if (!missing.empty()) {
+        add_involved(missing);
+        continue;
+      }
+      const Eigen::VectorXd target = involved_contact_force(states);
+      const Eigen::VectorXd residual = contact_load - target;
+      contact_states = std::move(states);
+      if (residual.norm() <= 1e-10 * std::max(target.norm(), contact_load.norm()) ||
+          (target.norm() == 0.0 && contact_load.norm() == 0.0))
+        return iterations;
+      const Eigen::Index m = contact_load.size();
+      Eigen::MatrixXd penalty = Eigen::MatrixXd::Zero(m, m);
+      contact->for_each_tangent(contact_states, [&](int a, int b, const Eigen::Matrix3d& block) {
+        const int ia = involved_index[static_cast<std::size_t>(a)];
+        const int ib = involved_index[static_cast<std::size_t>(b)];
+        penalty.block<3, 3>(3 * ia, 3 * ib) += block;
+      });
+      for (std::size_t i = 0; i < involved.size(); ++i)
+        for (int j = 0; j < 3; ++j)
+          if (fixed_dof[static_cast<std::size_t>(3 * involved[i] + j)]) {
+            penalty.row(3 * static_cast<Eigen::Index>(i) + j).setZero();
+            penalty.col(3 * static_cast<Eigen::Index>(i) + j).setZero();
+          }
+      Eigen::MatrixXd jacobian = penalty * involved_rows();
+      jacobian.diagonal().array() += 1.0;
+      contact_load -= jacobian.partialPivLu().solve(residual);
+      ++iterations;
+    }
+    throw SolverError("3-D solve: frictionless contact did not converge at depth " +
+                      micrometres(at_depth));
+  }
+
+  // C restricted to the involved nodes' rows.
+  Eigen::MatrixXd involved_rows() const {
+    Eigen::MatrixXd c(contact_load.size(), compliance.cols());
+    for (std::size_t i = 0; i < involved.size(); ++i)
+      c.middleRows(3 * static_cast<Eigen::Index>(i), 3) =
+          compliance.middleRows(3 * row_index[static_cast<std::size_t>(involved[i])], 3);
+    return c;
+  }
+
+  double needle_force_scale() const {
+    double total = 0.0;
+    contact->for_each_force(contact_states,
+                            [&](int, const Eigen::Vector3d& f) { total += f.norm(); });
+    return total;
+  }
+
+  int advance_frictionless_linear(double at_depth) {
+    if (!linear_factorized) factorize_linear();
+    const auto start = Clock::now();
+    int solves = 0;
+    for (int update = 0; update < kMaxUzawa; ++update) {
+      solves += solve_condensed(at_depth);
+      const double change = contact->update_multipliers(contact_states);
+      if (change <= kUzawaTolerance * needle_force_scale()) {
+        timing.contact_s += seconds_since(start);
+        return solves;
+      }
+    }
+    throw SolverError("3-D solve: frictionless multipliers did not settle at depth " +
+                      micrometres(at_depth));
+  }
+
+  Eigen::VectorXd frictionless_linear_displacement() const {
+    Eigen::VectorXd load = Eigen::VectorXd::Zero(model.dof_count());
+    for (std::size_t i = 0; i < involved.size(); ++i)
+      load.segment<3>(3 * involved[i]) = contact_load.segment<3>(3 * static_cast<Eigen::Index>(i));
+    if (involved.empty()) return load;
+    return solver.solve(load);
+  }
+
+  // Nonlinear layers: Newton on f_int(u) - f_c(u) = 0 with the penalty tangent added to the
+  // assembled one; the factorisation is kept while the residual falls fourfold per iteration.
+  Eigen::VectorXd contact_residual(const Eigen::VectorXd& at, double at_depth,
+                                   std::vector<ContactPointState>* states) {
+    Eigen::VectorXd r = internal_force(at);
+    *states = contact->evaluate(
+        at_depth, [&](int node) -> Eigen::Vector3d { return at.segment<3>(3 * node); });
+    contact->for_each_force(
+        *states, [&](int node, const Eigen::Vector3d& f) { r.segment<3>(3 * node) -= f; });
+    return free_part(r, fixed_dof);
+  }
+
+  int newton_frictionless(double at_depth) {
+    const double length_scale = (mesh.nodes.front() - mesh.nodes.back()).norm();
+    bool refactor = true;
+    for (int iteration = 1; iteration <= kMaxNewtonIterations; ++iteration) {
+      std::vector<ContactPointState> states;
+      Eigen::VectorXd residual;
+      if (refactor) {
+        const Eigen::VectorXd force = assemble_force(true);
+        states = contact->evaluate(
+            at_depth, [&](int node) -> Eigen::Vector3d { return u.segment<3>(3 * node); });
+        residual = force;
+        contact->for_each_force(states, [&](int node, const Eigen::Vector3d& f) {
+          residual.segment<3>(3 * node) -= f;
+        });
+        residual = free_part(residual, fixed_dof);
+        contact->for_each_tangent(states, [&](int a, int b, const Eigen::Matrix3d& block) {
+          if (a >= b) model.add_block(a, b, block, &stiffness);
+        });
+      } else {
+        residual = contact_residual(u, at_depth, &states);
+      }
+      contact_states = states;
+      const double scale = std::max(needle_force_scale(), 1e-30);
+      if (residual.norm() <= options.tolerance * scale) return iteration - 1;
+      if (refactor) factorize_tangent(fixed_dof);
+      const Eigen::VectorXd delta = solver.solve(Eigen::VectorXd(-residual));
+      const double accepted = contact_line_search(delta, residual.norm(), at_depth);
+      if (delta.lpNorm<Eigen::Infinity>() < 1e-13 * length_scale) return iteration;
+      refactor = !(accepted < 0.25 * residual.norm());
+    }
+    throw SolverError("Newton-Raphson with frictionless contact did not converge in " +
+                      std::to_string(kMaxNewtonIterations) + " iterations");
+  }
+
+  double contact_line_search(const Eigen::VectorXd& delta, double residual_norm, double at_depth) {
+    return backtrack(delta, residual_norm, [&](const Eigen::VectorXd& trial) {
+      std::vector<ContactPointState> states;
+      return contact_residual(trial, at_depth, &states).norm();
+    });
+  }
+
+  int solve_frictionless_nonlinear_at(double at_depth) {
+    int total = 0;
+    for (int update = 0; update < kMaxUzawa; ++update) {
+      total += newton_frictionless(at_depth);
+      contact_states = contact->evaluate(
+          at_depth, [&](int node) -> Eigen::Vector3d { return u.segment<3>(3 * node); });
+      const double change = contact->update_multipliers(contact_states);
+      if (change <= kUzawaTolerance * needle_force_scale()) return total;
+    }
+    throw SolverError("frictionless multipliers did not settle");
+  }
+
+  std::vector<double> multipliers_of() const {
+    std::vector<double> m;
+    for (const auto& p : contact->points()) m.push_back(p.multiplier);
+    return m;
   }
 
   // ---- results ------------------------------------------------------------------------------
@@ -410,14 +663,68 @@ struct Indentation3d::Impl {
     return area;
   }
 
+  // A half model reports the whole problem: its mirror image carries the same share.
+  double whole() const { return mesh.mirror_y0 ? 2.0 : 1.0; }
+
+  Eigen::VectorXd field() const {
+    if (!model.is_linear()) return u;
+    return frictionless() ? frictionless_linear_displacement() : linear_displacement();
+  }
+
+  Step3d report_frictionless(double at_depth, int solves) {
+    Step3d result;
+    result.depth_m = at_depth;
+    result.newton_iterations = solves;
+    if (model.is_linear()) {
+      double work = 0.0;  // Clapeyron: U = ½ Σ f·u over the loaded dofs
+      const Eigen::VectorXd ur = condensed_displacement();
+      for (std::size_t i = 0; i < involved.size(); ++i)
+        work += contact_load.segment<3>(3 * static_cast<Eigen::Index>(i))
+                    .dot(ur.segment<3>(3 * row_index[static_cast<std::size_t>(involved[i])]));
+      result.strain_energy_J = whole() * 0.5 * work;
+    } else {
+      result.strain_energy_J = whole() * model.strain_energy(u);
+    }
+    const auto& points = contact->points();
+    std::vector<Eigen::Vector3d> force(needles.size(), Eigen::Vector3d::Zero());
+    std::vector<double> area(needles.size(), 0.0);
+    std::vector<std::vector<char>> touched(needles.size(), std::vector<char>(mesh.nodes.size(), 0));
+    for (std::size_t q = 0; q < points.size(); ++q) {
+      const ContactPointState& state = contact_states[q];
+      if (state.traction <= 0.0) continue;
+      const auto n = static_cast<std::size_t>(points[q].needle);
+      force[n] -= points[q].weight * state.traction * state.normal;  // tissue on needle
+      area[n] += points[q].weight;
+      for (int a = 0; a < contact->face_nodes(); ++a)
+        touched[n][static_cast<std::size_t>(points[q].nodes[static_cast<std::size_t>(a)])] = 1;
+    }
+    for (std::size_t n = 0; n < needles.size(); ++n) {
+      NeedleStep3d needle;
+      needle.name = needles[n].name;
+      Eigen::Vector3d total = whole() * force[n];
+      if (mesh.mirror_y0) total.y() = 0.0;
+      needle.force_N = total.z();
+      needle.lateral_force_N = {total.x(), total.y()};
+      needle.contact_area_m2 = whole() * area[n];
+      needle.contact_pressure_Pa =
+          needle.contact_area_m2 > 0.0 ? needle.force_N / needle.contact_area_m2 : 0.0;
+      needle.captured_nodes =
+          static_cast<int>(std::count(touched[n].begin(), touched[n].end(), char{1}));
+      result.needles.push_back(needle);
+    }
+    return result;
+  }
+
   Step3d report(double at_depth, int solves) {
+    if (frictionless()) return report_frictionless(at_depth, solves);
     Step3d result;
     result.depth_m = at_depth;
     result.newton_iterations = solves;
     const Eigen::VectorXd forces = captured_forces();
     const Eigen::VectorXd imposed = prescribed_vector(at_depth);
-    result.strain_energy_J = model.is_linear() ? 0.5 * forces.dot(imposed) : model.strain_energy(u);
-    const Eigen::VectorXd field = model.is_linear() ? linear_displacement() : u;
+    result.strain_energy_J =
+        whole() * (model.is_linear() ? 0.5 * forces.dot(imposed) : model.strain_energy(u));
+    const Eigen::VectorXd moved = model.is_linear() ? linear_displacement() : u;
     for (std::size_t n = 0; n < needles.size(); ++n) {
       NeedleStep3d needle;
       needle.name = needles[n].name;
@@ -427,9 +734,11 @@ struct Indentation3d::Impl {
         total -= forces.segment<3>(3 * static_cast<Eigen::Index>(i));  // tissue on needle
         ++needle.captured_nodes;
       }
+      total *= whole();
+      if (mesh.mirror_y0) total.y() = 0.0;  // the mirror halves' y forces cancel
       needle.force_N = total.z();
       needle.lateral_force_N = {total.x(), total.y()};
-      needle.contact_area_m2 = contact_area(static_cast<int>(n), field);
+      needle.contact_area_m2 = whole() * contact_area(static_cast<int>(n), moved);
       needle.contact_pressure_Pa =
           needle.contact_area_m2 > 0.0 ? needle.force_N / needle.contact_area_m2 : 0.0;
       result.needles.push_back(needle);
@@ -438,15 +747,53 @@ struct Indentation3d::Impl {
   }
 };
 
-Indentation3d::Indentation3d(const TetMesh& mesh, std::vector<Needle3d> needles, double max_depth)
-    : impl_(std::make_unique<Impl>(mesh, std::move(needles))) {
+namespace {
+
+double mesh_extent(const TetMesh& mesh) {
+  Eigen::Vector3d lo = mesh.nodes.front(), hi = mesh.nodes.front();
+  for (const auto& p : mesh.nodes) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  return (hi - lo).norm();
+}
+
+// A half model is exact only for needles that the mirror plane y = 0 maps onto themselves.
+void check_half_model(const std::vector<Needle3d>& needles, const std::vector<NeedleShape>& shapes,
+                      double extent) {
+  const double tolerance = 1e-9 * extent;
+  for (std::size_t n = 0; n < needles.size(); ++n) {
+    if (std::abs(needles[n].y) > tolerance)
+      throw InputError("3-D half model: needle '" + needles[n].name +
+                       "' at y = " + micrometres(needles[n].y) + " is off the mirror plane y = 0");
+    if (!shapes[n].mirror_symmetric_y(1e-6 * extent + 1e-12))
+      throw InputError("3-D half model: needle '" + needles[n].name +
+                       "' is not mirror-symmetric about y = 0 (use the full model)");
+  }
+}
+
+}  // namespace
+
+Indentation3d::Indentation3d(const TetMesh& mesh, std::vector<Needle3d> needles, double max_depth,
+                             const Indentation3dOptions& options)
+    : impl_(std::make_unique<Impl>(mesh, std::move(needles), options)) {
   if (impl_->needles.empty()) throw InputError("3-D indentation: no needle given");
   if (!(max_depth > 0.0)) throw InputError("3-D indentation: depth must be positive");
+  if (!(options.tolerance > 0.0) || !(options.tolerance < 1.0))
+    throw InputError("3-D indentation: tolerance must lie in (0, 1)");
+  if (mesh.fixed.size() != mesh.nodes.size() || mesh.nodes.empty())
+    throw InputError("3-D indentation: mesh has no nodes or no boundary flags");
   impl_->select_candidates(max_depth);
+  if (impl_->frictionless()) impl_->setup_frictionless();
+  const double extent = mesh_extent(mesh);
+  if (mesh.mirror_y0) check_half_model(impl_->needles, impl_->shapes, extent);
   impl_->fixed_dof.assign(static_cast<std::size_t>(impl_->model.dof_count()), 0);
-  for (std::size_t n = 0; n < mesh.nodes.size(); ++n)
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
     if (mesh.fixed[n])
       for (int j = 0; j < 3; ++j) impl_->fixed_dof[3 * n + static_cast<std::size_t>(j)] = 1;
+    if (mesh.mirror_y0 && std::abs(mesh.nodes[n].y()) <= 1e-12 * extent)
+      impl_->fixed_dof[3 * n + 1] = 1;  // symmetry: u_y = 0 on the mirror plane
+  }
 }
 
 Indentation3d::~Indentation3d() = default;
@@ -459,7 +806,8 @@ Step3d Indentation3d::advance_to(double depth) {
   int solves = 0;
   if (impl_->model.is_linear()) {
     try {
-      solves = impl_->advance_linear(depth);
+      solves = impl_->frictionless() ? impl_->advance_frictionless_linear(depth)
+                                     : impl_->advance_linear(depth);
     } catch (const SolverError& error) {
       const std::string what = error.what();
       if (what.rfind("3-D solve", 0) == 0) throw;
@@ -475,7 +823,7 @@ Step3d Indentation3d::advance_to(double depth) {
 }
 
 Eigen::VectorXd Indentation3d::displacement() const {
-  return impl_->model.is_linear() ? impl_->linear_displacement() : impl_->u;
+  return impl_->field();
 }
 
 const Timing3d& Indentation3d::timing() const {
@@ -529,20 +877,69 @@ void Indentation3d::write_vtu(const std::string& path) const {
   if (!out) throw InputError(path + ": write failed");
 }
 
-Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d>& needles,
-                               const Simulation3dOptions& options) {
+namespace {
+
+// Every needle's crack, one after the other on the same mesh; returns the total area (one
+// face, of the meshed part) and each needle's share.
+TetMesh cracked_copy(const TetMesh& mesh, const std::vector<Needle3d>& needles, double depth,
+                     std::vector<double>* areas) {
+  TetMesh cracked = mesh;
+  for (const Needle3d& needle : needles) {
+    PlanarCrack crack;
+    crack.origin_m = Eigen::Vector3d(needle.x, needle.y, 0.0);
+    crack.normal = Eigen::Vector3d::UnitX();
+    crack.depth_m = depth;
+    double area = 0.0;
+    cracked = crack_mesh(cracked, crack, &area);
+    areas->push_back(area);
+  }
+  cracked.mirror_y0 = mesh.mirror_y0;
+  return cracked;
+}
+
+void check_options(const Simulation3dOptions& options) {
   if (!(options.depth > 0.0) || !std::isfinite(options.depth))
     throw InputError("simulate_3d: depth must be positive");
   if (options.steps < 1) throw InputError("simulate_3d: steps must be >= 1");
+  if (options.overrides.steps && *options.overrides.steps < 1)
+    throw InputError("simulate_3d: overrides.steps must be >= 1");
+  if (options.overrides.domain_scale &&
+      (!(*options.overrides.domain_scale > 0.0) || !std::isfinite(*options.overrides.domain_scale)))
+    throw InputError("simulate_3d: overrides.domain_scale must be positive");
+  if (!(options.stress_average_length_m >= 0.0) || !std::isfinite(options.stress_average_length_m))
+    throw InputError("simulate_3d: stress_average_length_m must be >= 0");
+  if (!(options.crack_depth_m >= 0.0) || !std::isfinite(options.crack_depth_m))
+    throw InputError("simulate_3d: crack_depth_m must be >= 0");
+}
+
+}  // namespace
+
+Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d>& needles,
+                               const Simulation3dOptions& options) {
+  check_options(options);
   const auto start = Clock::now();
   block.sites.clear();
-  for (const Needle3d& needle : needles)
-    block.sites.push_back(
-        {needle.x, needle.y, NeedleShape(needle.mesh).max_radius_up_to(options.depth)});
+  std::vector<Eigen::Vector2d> first_contact;
+  for (const Needle3d& needle : needles) {
+    const NeedleShape shape(needle.mesh);
+    block.sites.push_back({needle.x, needle.y, shape.max_radius_up_to(options.depth)});
+    first_contact.push_back(Eigen::Vector2d(needle.x, needle.y) + shape.first_contact_xy(1e-9));
+  }
   block.fidelity = options.fidelity;
-  block.order = options.order;
+  block.order = options.overrides.order.value_or(options.order);
   block.insertion_depth = options.depth;
+  block.overrides = options.overrides;
+  block.half_y = options.half_model;
+  if (options.overrides.domain_scale) {
+    block.size_x *= *options.overrides.domain_scale;
+    block.size_y *= *options.overrides.domain_scale;
+  }
+  const int steps = options.overrides.steps.value_or(options.steps);
   const TetMesh mesh = generate_tissue_mesh(block);
+  std::vector<double> crack_areas;
+  TetMesh cracked;
+  if (options.crack_depth_m > 0.0)
+    cracked = cracked_copy(mesh, needles, options.crack_depth_m, &crack_areas);
   const double meshing = seconds_since(start);
 
   Simulation3dResult result;
@@ -550,14 +947,43 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   result.elements = static_cast<int>(mesh.elements.size());
   result.order = mesh.order;
   result.quality = mesh_quality(mesh);
-  Indentation3d run(mesh, needles, options.depth);
+  Indentation3dOptions solver_options;
+  solver_options.contact = options.contact;
+  if (options.overrides.tolerance) solver_options.tolerance = *options.overrides.tolerance;
+  Indentation3d run(mesh, needles, options.depth, solver_options);
+  std::unique_ptr<Indentation3d> cracked_run;
+  if (options.crack_depth_m > 0.0)
+    cracked_run = std::make_unique<Indentation3d>(cracked, needles, options.depth, solver_options);
+  const double whole = mesh.mirror_y0 ? 2.0 : 1.0;
+  double total_crack_area = 0.0;
+  for (double a : crack_areas) total_crack_area += whole * a;
+  if (cracked_run && !(total_crack_area > 0.0))
+    throw SolverError("simulate_3d: the crack opened no mesh face (crack_depth_m too small?)");
   if (!options.vtu_directory.empty()) std::filesystem::create_directories(options.vtu_directory);
-  for (int k = 1; k <= options.steps; ++k) {
-    result.steps.push_back(run.advance_to(options.depth * k / options.steps));
+  for (int k = 1; k <= steps; ++k) {
+    const double depth = options.depth * k / steps;
+    Step3d step = run.advance_to(depth);
+    if (options.stress_average_length_m > 0.0) {
+      const Eigen::VectorXd u = run.displacement();
+      for (std::size_t n = 0; n < needles.size(); ++n)
+        step.needles[n].tip_stress_Pa = averaged_max_principal_stress(
+            mesh, u, Eigen::Vector3d(first_contact[n].x(), first_contact[n].y(), 0.0),
+            options.stress_average_length_m, 0);
+    }
+    if (cracked_run) {
+      const Step3d opened = cracked_run->advance_to(depth);
+      const double release = (step.strain_energy_J - opened.strain_energy_J) / total_crack_area;
+      for (std::size_t n = 0; n < needles.size(); ++n) {
+        step.needles[n].energy_release_rate_J_per_m2 = release;
+        step.needles[n].crack_area_m2 = whole * crack_areas[n];
+      }
+    }
     if (!options.vtu_directory.empty())
       run.write_vtu(
           (std::filesystem::path(options.vtu_directory) / ("step_" + std::to_string(k) + ".vtu"))
               .string());
+    result.steps.push_back(step);
+    if (options.on_step && !options.on_step(result.steps.back())) break;
   }
   result.timing = run.timing();
   result.timing.meshing_s = meshing;

@@ -44,9 +44,9 @@ Matrix6 symmetric_product(const Eigen::Matrix3d& A) {
   Matrix6 M;
   for (int a = 0; a < 6; ++a) {
     const int i = kVoigtPairs[a][0], j = kVoigtPairs[a][1];
-    for (int b = 0; b < 6; ++b) {
+    for (int b = a; b < 6; ++b) {
       const int k = kVoigtPairs[b][0], l = kVoigtPairs[b][1];
-      M(a, b) = 0.5 * (A(i, k) * A(j, l) + A(i, l) * A(j, k));
+      M(a, b) = M(b, a) = 0.5 * (A(i, k) * A(j, l) + A(i, l) * A(j, k));
     }
   }
   return M;
@@ -58,17 +58,6 @@ struct InvariantDerivatives {
   std::array<double, 3> d{};                  // dW/dI1, dW/dI2, dW/dI3
   std::array<std::array<double, 3>, 3> dd{};  // symmetric second derivatives
 };
-
-// W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2, written with ln J = ln(I3) / 2.
-InvariantDerivatives neo_hookean(double mu, double lambda, double I1, double I3) {
-  const double lnI3 = std::log(I3);
-  InvariantDerivatives w;
-  w.W = 0.5 * mu * (I1 - 3.0) - 0.5 * mu * lnI3 + 0.125 * lambda * lnI3 * lnI3;
-  w.d[0] = 0.5 * mu;
-  w.d[2] = -0.5 * mu / I3 + 0.25 * lambda * lnI3 / I3;
-  w.dd[2][2] = 0.5 * mu / (I3 * I3) + 0.25 * lambda * (1.0 - lnI3) / (I3 * I3);
-  return w;
-}
 
 // W = c10 (I1 I3^-1/3 - 3) + c01 (I2 I3^-2/3 - 3) + kappa/8 (ln I3)^2.
 InvariantDerivatives mooney_rivlin(double c10, double c01, double kappa, double I1, double I2,
@@ -172,7 +161,22 @@ MaterialResponse Material::evaluate(const Eigen::Matrix3d& F) const {
       r.energy_density = 0.5 * s.dot(to_voigt_strain(strain));
       return r;
     }
-    case MaterialModel::NeoHookean:
+    case MaterialModel::NeoHookean: {
+      // Closed form (Bonet & Wood): S = mu (I - C^-1) + lambda ln J C^-1,
+      // C = lambda C^-1 (x) C^-1 + 2 (mu - lambda ln J) (C^-1 (x) C^-1)_sym; the generic
+      // invariant path below gives the same, at twice the cost (the solvers' hot spot).
+      const double J = F.determinant();
+      if (!(J > 0.0)) throw SolverError("inverted element (det F = " + number(J) + ")");
+      const Eigen::Matrix3d Cg = F.transpose() * F;
+      const Eigen::Matrix3d Cinv = Cg.inverse();
+      const double lnJ = std::log(J);
+      r.energy_density = 0.5 * mu_ * (Cg.trace() - 3.0) - mu_ * lnJ + 0.5 * lambda_ * lnJ * lnJ;
+      r.S = mu_ * (I - Cinv) + lambda_ * lnJ * Cinv;
+      const Vector6 cinv = to_voigt_stress(Cinv);
+      r.C =
+          lambda_ * cinv * cinv.transpose() + 2.0 * (mu_ - lambda_ * lnJ) * symmetric_product(Cinv);
+      return r;
+    }
     case MaterialModel::MooneyRivlin: {
       const double J = F.determinant();
       if (!(J > 0.0)) throw SolverError("inverted element (det F = " + number(J) + ")");
@@ -181,9 +185,7 @@ MaterialResponse Material::evaluate(const Eigen::Matrix3d& F) const {
       const double I2 = 0.5 * (I1 * I1 - (Cg * Cg).trace());
       const double I3 = J * J;
       const InvariantDerivatives w =
-          parameters_.model == MaterialModel::NeoHookean
-              ? neo_hookean(mu_, lambda_, I1, I3)
-              : mooney_rivlin(parameters_.c10, parameters_.c01, kappa_, I1, I2, I3);
+          mooney_rivlin(parameters_.c10, parameters_.c01, kappa_, I1, I2, I3);
       return invariant_response(Cg, I1, I3, w);
     }
   }

@@ -3,6 +3,7 @@
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
+#include <CGAL/Polygon_mesh_processing/compute_normal.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/boost/graph/helpers.h>
@@ -40,6 +41,9 @@ NeedleShape::NeedleShape(const TriangleMesh& mesh) : impl_(std::make_unique<Impl
   impl_->surface = to_surface_mesh(mesh);
   if (!CGAL::is_closed(impl_->surface))
     throw InputError("needle mesh: surface is not closed (contact needs a solid needle)");
+  // Frictionless contact pushes along the face normals: they must point out of the needle.
+  if (!CGAL::Polygon_mesh_processing::is_outward_oriented(impl_->surface))
+    CGAL::Polygon_mesh_processing::reverse_face_orientations(impl_->surface);
   impl_->tree.emplace(faces(impl_->surface).first, faces(impl_->surface).second, impl_->surface);
   impl_->tree->accelerate_distance_queries();
   impl_->inside.emplace(impl_->surface);
@@ -69,6 +73,27 @@ Eigen::Vector3d NeedleShape::closest_point(const Eigen::Vector3d& point) const {
   return {q.x(), q.y(), q.z()};
 }
 
+Eigen::Vector3d NeedleShape::closest_point(const Eigen::Vector3d& point,
+                                           Eigen::Vector3d* face_normal) const {
+  const auto [q, face] = impl_->tree->closest_point_and_primitive(to_cgal(point));
+  const auto n = CGAL::Polygon_mesh_processing::compute_face_normal(face, impl_->surface);
+  *face_normal = Eigen::Vector3d(n.x(), n.y(), n.z()).normalized();
+  return {q.x(), q.y(), q.z()};
+}
+
+bool NeedleShape::vertical_hit(const Eigen::Vector3d& point, bool downward, Eigen::Vector3d* hit,
+                               Eigen::Vector3d* face_normal) const {
+  const CgalKernel::Ray_3 ray(to_cgal(point), CgalKernel::Direction_3(0, 0, downward ? -1 : 1));
+  const auto found = impl_->tree->first_intersection(ray);
+  if (!found) return false;
+  const CgalPoint* p = boost::get<CgalPoint>(&found->first);
+  if (!p) return false;  // the ray runs along a vertical face: no crossing point
+  *hit = {p->x(), p->y(), p->z()};
+  const auto n = CGAL::Polygon_mesh_processing::compute_face_normal(found->second, impl_->surface);
+  *face_normal = Eigen::Vector3d(n.x(), n.y(), n.z()).normalized();
+  return true;
+}
+
 double NeedleShape::max_radius_up_to(double height) const {
   // Every triangle that reaches below `height` counts whole, so the radius is never
   // underestimated between two vertex rings.
@@ -80,6 +105,27 @@ double NeedleShape::max_radius_up_to(double height) const {
     for (auto v : t) radius = std::max(radius, impl_->vertices[v].head<2>().norm());
   }
   return radius;
+}
+
+bool NeedleShape::mirror_symmetric_y(double tolerance) const {
+  for (const Eigen::Vector3d& v : impl_->vertices) {
+    const Eigen::Vector3d mirrored(v.x(), -v.y(), v.z());
+    if ((closest_point(mirrored) - mirrored).norm() > tolerance) return false;
+  }
+  return true;
+}
+
+Eigen::Vector2d NeedleShape::first_contact_xy(double tolerance) const {
+  double lowest = std::numeric_limits<double>::max();
+  for (const Eigen::Vector3d& v : impl_->vertices) lowest = std::min(lowest, v.z());
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  int count = 0;
+  for (const Eigen::Vector3d& v : impl_->vertices)
+    if (v.z() <= lowest + tolerance) {
+      sum += v.head<2>();
+      ++count;
+    }
+  return sum / count;
 }
 
 }  // namespace mneedle::fe

@@ -11,7 +11,7 @@ namespace mneedle::fe {
 /// A closed needle surface in the needle frame (tip at the origin, body along +z).
 class NeedleShape {
  public:
-  /// Throws InputError when the mesh is empty or not closed.
+  /// Throws InputError when the mesh is empty or not closed; an inward-oriented mesh is flipped.
   explicit NeedleShape(const TriangleMesh& mesh);
   ~NeedleShape();
   NeedleShape(NeedleShape&&) noexcept;
@@ -21,12 +21,24 @@ class NeedleShape {
   bool contains(const Eigen::Vector3d& point) const;
   /// Nearest point of the needle surface (needle frame), found through an AABB tree of the faces.
   Eigen::Vector3d closest_point(const Eigen::Vector3d& point) const;
+  /// The same, and the outward unit normal of the face that holds it.
+  Eigen::Vector3d closest_point(const Eigen::Vector3d& point, Eigen::Vector3d* face_normal) const;
   /// Where the vertical line through `point` (inside the needle) leaves the needle downward:
   /// the face that reached the point as the needle moved along -z. Falls back to the closest
   /// surface point when that face is vertical or the ray grazes an edge.
   Eigen::Vector3d lower_surface_below(const Eigen::Vector3d& point) const;
+  /// First crossing of the vertical ray from `point` (down or up) with the surface: the point
+  /// and the outward normal of its face. False when the ray misses the needle.
+  bool vertical_hit(const Eigen::Vector3d& point, bool downward, Eigen::Vector3d* hit,
+                    Eigen::Vector3d* face_normal) const;
   /// Largest distance from the needle axis of the faces that reach below `height` above the tip.
   double max_radius_up_to(double height) const;
+  /// True when the mirror image (x, -y, z) of every vertex lies on the surface within
+  /// `tolerance` (m): the needle is symmetric about its y = 0 plane.
+  bool mirror_symmetric_y(double tolerance) const;
+  /// Mean (x, y) of the lowest vertices (within `tolerance` of the lowest z): where the needle
+  /// first touches a flat surface, needle frame.
+  Eigen::Vector2d first_contact_xy(double tolerance) const;
 
  private:
   struct Impl;

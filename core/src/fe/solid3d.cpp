@@ -331,6 +331,22 @@ double SolidModel::assemble_fixed(const Eigen::VectorXd& u, Eigen::SparseMatrix<
   return energy;
 }
 
+void SolidModel::add_block(int row, int column, const Eigen::Matrix3d& block,
+                           Eigen::SparseMatrix<double>* stiffness) const {
+  const auto first = adjacency_.begin() + adjacency_start_[static_cast<std::size_t>(column)];
+  const auto last = adjacency_.begin() + adjacency_start_[static_cast<std::size_t>(column) + 1];
+  const auto found = std::lower_bound(first, last, row);
+  if (row < column || found == last || *found != row)
+    throw SolverError("3-D solid: contact block outside the stiffness pattern");
+  const int rank = static_cast<int>(found - first);
+  double* values = stiffness->valuePtr();
+  const auto* outer = stiffness->outerIndexPtr();
+  for (int j = 0; j < 3; ++j) {
+    double* entries = values + outer[3 * column + j] + 3 * rank;
+    for (int i = 0; i < 3; ++i) entries[i] += block(i, j);
+  }
+}
+
 double SolidModel::strain_energy(const Eigen::VectorXd& u) const {
   return assemble(u, nullptr, nullptr);
 }

@@ -30,6 +30,9 @@ void validate(const TissueBlockSpec& spec) {
     if (!(layer.thickness > 0.0) || !std::isfinite(layer.thickness))
       bad_spec("layers." + layer.name + ".thickness", "must be positive and finite");
   if (spec.order != 1 && spec.order != 2) bad_spec("order", "must be 1 or 2");
+  if (spec.half_y)
+    for (const NeedleSite& site : spec.sites)
+      if (site.y != 0.0) bad_spec("needle position", "a half model needs every site on y = 0");
   if (!(spec.insertion_depth >= 0.0)) bad_spec("insertion_depth", "must be >= 0");
   for (const NeedleSite& site : spec.sites) {
     if (!(site.radius > 0.0)) bad_spec("needle radius", "must be positive");
@@ -258,14 +261,17 @@ void link_neighbours_and_top(TetMesh& mesh) {
     }
 }
 
-void mark_fixed_nodes(TetMesh& mesh, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+// The mirror plane of a half model (y = lo.y = 0) is not a clamped side.
+void mark_fixed_nodes(TetMesh& mesh, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                      bool mirror_lo_y) {
   const double tolerance = 1e-9 * (hi - lo).norm();
   mesh.fixed.assign(mesh.nodes.size(), 0);
   for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
     const Eigen::Vector3d& p = mesh.nodes[n];
     const bool side = std::abs(p.x() - lo.x()) < tolerance ||
                       std::abs(p.x() - hi.x()) < tolerance ||
-                      std::abs(p.y() - lo.y()) < tolerance || std::abs(p.y() - hi.y()) < tolerance;
+                      (!mirror_lo_y && std::abs(p.y() - lo.y()) < tolerance) ||
+                      std::abs(p.y() - hi.y()) < tolerance;
     const bool bottom = std::abs(p.z() - lo.z()) < tolerance;
     mesh.fixed[n] = side || bottom ? 1 : 0;
   }
@@ -292,7 +298,8 @@ std::string to_string(Fidelity fidelity) {
   return "fine";
 }
 
-MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, double block_size) {
+MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, double block_size,
+                       const FidelityOverrides& overrides) {
   // Elements per needle radius at the site, growth ratio and elements through the top layer;
   // linear tetrahedra get twice the resolution of quadratic ones for a comparable answer.
   struct Level {
@@ -310,6 +317,22 @@ MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, doubl
   sizing.growth = level.growth;
   sizing.max_size = std::max(sizing.fine_size, block_size / 4.0);
   sizing.elements_through_top = level.through_top * static_cast<int>(refinement);
+  if (overrides.tip_size_m) {
+    if (!(*overrides.tip_size_m > 0.0) || !std::isfinite(*overrides.tip_size_m))
+      bad_spec("overrides.tip_size_m", "must be positive and finite");
+    sizing.fine_size = *overrides.tip_size_m;
+  }
+  if (overrides.growth) {
+    if (!(*overrides.growth >= 1.0) || !std::isfinite(*overrides.growth))
+      bad_spec("overrides.growth", "must be >= 1 and finite");
+    sizing.growth = *overrides.growth;
+  }
+  if (overrides.elements_through_top) {
+    if (*overrides.elements_through_top < 1)
+      bad_spec("overrides.elements_through_top", "must be >= 1");
+    sizing.elements_through_top = *overrides.elements_through_top;
+  }
+  sizing.max_size = std::max(sizing.fine_size, block_size / 4.0);
   return sizing;
 }
 
@@ -321,7 +344,8 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   for (const TissueLayer& layer : spec.layers) total += layer.thickness;
   if (radius == 0.0) radius = std::min(spec.size_x, spec.size_y) / 20.0;
   const MeshSizing sizing =
-      mesh_sizing(spec.fidelity, spec.order, radius, std::max({spec.size_x, spec.size_y, total}));
+      mesh_sizing(spec.fidelity, spec.order, radius, std::max({spec.size_x, spec.size_y, total}),
+                  spec.overrides);
   std::vector<double> cx, cy;
   for (const NeedleSite& site : spec.sites) {
     cx.push_back(site.x);
@@ -336,9 +360,19 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   MeshSizing lateral = sizing;
   lateral.max_size =
       std::max(sizing.fine_size, std::min(sizing.max_size, kMaxCellAspect * thinnest));
+  std::vector<double> y_axis = lateral_coordinates(spec.size_y / 2, cy, lateral);
+  // The full grid has a line through every site and is graded symmetrically about it, so its
+  // y >= 0 part is exactly the half model's grid.
+  std::vector<char> mirror_y = mirrored_cells(y_axis, cy);
+  if (spec.half_y) {
+    const auto first = std::find(y_axis.begin(), y_axis.end(), 0.0);
+    if (first == y_axis.end()) bad_spec("half model", "no grid line on y = 0");
+    const auto skip = first - y_axis.begin();
+    y_axis.erase(y_axis.begin(), first);
+    mirror_y.erase(mirror_y.begin(), mirror_y.begin() + skip);
+  }
   const std::array<std::vector<double>, 3> axes = {
-      lateral_coordinates(spec.size_x / 2, cx, lateral),
-      lateral_coordinates(spec.size_y / 2, cy, lateral), std::move(z)};
+      lateral_coordinates(spec.size_x / 2, cx, lateral), std::move(y_axis), std::move(z)};
 
   TetMesh mesh;
   mesh.order = spec.order;
@@ -362,11 +396,12 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
     }
     cell_layer.push_back(layer);
   }
-  split_cells(mesh, axes, cell_layer, mirrored_cells(axes[0], cx), mirrored_cells(axes[1], cy));
+  split_cells(mesh, axes, cell_layer, mirrored_cells(axes[0], cx), mirror_y);
   if (mesh.order == 2) add_midside_nodes(mesh);
   link_neighbours_and_top(mesh);
   mark_fixed_nodes(mesh, {axes[0].front(), axes[1].front(), axes[2].front()},
-                   {axes[0].back(), axes[1].back(), 0.0});
+                   {axes[0].back(), axes[1].back(), 0.0}, spec.half_y);
+  mesh.mirror_y0 = spec.half_y;
   return mesh;
 }
 

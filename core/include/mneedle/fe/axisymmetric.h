@@ -7,8 +7,10 @@
 #include <Eigen/SparseCore>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "mneedle/fe/fidelity.h"
@@ -41,7 +43,6 @@ struct AxisymmetricNeedle {
   double lowest_height_at(double r) const;
 };
 
-
 /// Structured graded mesh controls. Element size h_m is used within fine_radius_m of the axis
 /// and down to fine_depth_m; beyond, sizes grow geometrically by `growth` up to max_size_m.
 struct AxisymmetricMeshOptions {
@@ -53,6 +54,8 @@ struct AxisymmetricMeshOptions {
   double max_size_m = std::numeric_limits<double>::infinity();
   int min_elements_per_layer = 2;
   std::vector<double> radial_breaks_m;  ///< radii that must be node columns (punch edge, bore)
+  std::vector<double> depth_breaks_m;   ///< depths below the surface that must be node rows
+  int elements_through_top = 0;         ///< minimum elements through layer 0 (0: the general one)
 };
 
 /// Reference coordinates (r, z): z = 0 is the free surface, tissue at z < 0, axis at r = 0.
@@ -72,6 +75,15 @@ struct AxisymmetricMesh {
 AxisymmetricMesh make_axisymmetric_mesh(const std::vector<AxisymmetricLayer>& layers,
                                         const AxisymmetricMeshOptions& options);
 
+/// The mesh with a ring (cylindrical) crack opened: every node on the line r = radius_m,
+/// -depth_m < z <= 0 is doubled (the copy goes to the elements outside the ring); the node at
+/// (radius_m, -depth_m), the crack front, stays shared. The outer copy of the surface node is
+/// not a surface (contact) node: the needle presses the inside of the ring. `area_m2` receives
+/// 2 pi radius depth (one face). Throws InputError unless that line is a column of element edges
+/// ending at a node.
+AxisymmetricMesh crack_axisymmetric_mesh(const AxisymmetricMesh& mesh, double radius_m,
+                                         double depth_m, double* area_m2);
+
 /// Result of one equilibrium solve.
 struct Equilibrium {
   Eigen::VectorXd displacement;  ///< 2 per node: u_r, u_z
@@ -87,7 +99,8 @@ struct NewtonOptions {
   /// Also converged when |R_free| <= this * |reactions| and the last iteration did not halve it
   /// (the round-off floor of the assembled forces, ~1e-7 relative near a punch edge).
   double stagnation_tolerance = 1e-5;
-  /// Reuse the factorisation within a solve while the residual falls by 4x per iteration.
+  /// Reuse the last factorisation (of this solve, or of an earlier one with the same constrained
+  /// dofs) while the residual falls by 4x per iteration.
   bool modified_newton = true;
 };
 
@@ -105,6 +118,22 @@ class AxisymmetricModel {
   bool is_linear() const;
   /// Numeric factorisations performed by solve() so far.
   int factorization_count() const;
+  /// The per-layer constants the model was built with.
+  const std::vector<MaterialParameters>& layer_materials() const;
+
+  /// Per element: mean over its quadrature points of the von Mises Cauchy stress (Pa) and of
+  /// the strain energy density (J/m^3 of reference volume) at displacement u.
+  std::vector<double> von_mises(const Eigen::VectorXd& u) const;
+  std::vector<double> energy_density(const Eigen::VectorXd& u) const;
+  /// Volume-weighted (2 pi r dA, reference) mean of the maximum principal Cauchy stress (hoop
+  /// stress included) over the part of `layer` within length_m of point_m (reference (r, z)).
+  /// Returns 0 when no part of the layer is within reach.
+  double averaged_max_principal_stress(const Eigen::VectorXd& u, const Eigen::Vector2d& point_m,
+                                       double length_m, int layer) const;
+  /// ASCII VTU (ParaView): the (r, z) mesh as quadratic triangles in the plane y = 0 (x = r,
+  /// z = z), point data displacement_m (u_r, 0, u_z), cell data von_mises_Pa,
+  /// energy_density_J_per_m3 and layer. Throws InputError when the file cannot be written.
+  void write_vtu(const std::string& path, const Eigen::VectorXd& u) const;
 
   /// Internal force vector at displacement u; tangent stiffness when `tangent` is not null.
   /// Throws SolverError on an inverted element.
@@ -131,6 +160,15 @@ struct InsertionStep {
   double strain_energy_J = 0.0;
   int newton_iterations = 0;  ///< summed over the sub-steps since the previous output
   int contact_nodes = 0;
+  /// Maximum principal Cauchy stress (hoop stress included) of the top layer (layer 0),
+  /// volume-weighted (2 pi r dA) over the part within stress_average_length_m of the surface
+  /// point on the axis (Pa; 0 when the option is off).
+  double tip_stress_Pa = 0.0;
+  /// G = (U_intact - U_cracked) / crack_area_m2 at the same needle position, the cracked model
+  /// advanced in lock-step (J/m^2; 0 when crack_depth_m is 0). The crack is a ring (cylindrical)
+  /// crack at radius ring_crack_radius() from the surface down crack_depth_m.
+  double energy_release_rate_J_per_m2 = 0.0;
+  double crack_area_m2 = 0.0;  ///< 2 pi r_c c (one face)
 };
 
 struct InsertionOptions {
@@ -139,6 +177,16 @@ struct InsertionOptions {
   /// Frictionless: linear layers only (node-to-profile constraints on the condensed system).
   ContactMode contact = ContactMode::Sticking;
   NewtonOptions newton;
+  double stress_average_length_m = 0.0;  ///< tip_stress_Pa averaging length (0 = off)
+  /// Depth of the ring crack for G (0 = off). The mesh must have a node column at the crack
+  /// radius (ring_crack_radius of the needle) reaching at least this depth; a second, cracked
+  /// model runs in lock-step with the intact one.
+  double crack_depth_m = 0.0;
+  /// Called after each output step; returning false stops the insertion there.
+  std::function<bool(const InsertionStep&)> on_step;
+  /// When set, step_<k>.vtu (k = 1..output steps) is written there: the (r, z) mesh as
+  /// quadratic triangles with displacement, von Mises stress, strain energy density, layer id.
+  std::string vtu_directory;
 };
 
 struct InsertionResult {
@@ -165,6 +213,14 @@ struct AxisymmetricProblem {
   Fidelity fidelity = Fidelity::Standard;
   ContactMode contact = ContactMode::Sticking;
   int output_steps = 0;  ///< 0: from the fidelity
+  /// Honoured: tip_size_m, growth, domain_scale (cylinder radius), tolerance, steps; order must
+  /// be 2 (6-node triangles) when set, else InputError; elements_through_top sets the minimum
+  /// elements per layer.
+  FidelityOverrides overrides;
+  double stress_average_length_m = 0.0;  ///< as InsertionOptions
+  double crack_depth_m = 0.0;            ///< as InsertionOptions
+  std::function<bool(const InsertionStep&)> on_step;
+  std::string vtu_directory;
 };
 
 InsertionResult simulate_axisymmetric(const AxisymmetricProblem& problem);
@@ -174,5 +230,11 @@ AxisymmetricMeshOptions mesh_options_for(const AxisymmetricProblem& problem);
 
 /// Radius of the cylinder whose cross-section has the area of a square block of side `width_m`.
 double equal_area_radius(double width_m);
+
+/// Radius of the ring crack used for the energy release rate: a flat punch's (outer) edge; for a
+/// tapered needle (cone) the radius of its section at height `depth_m` above the tip (the
+/// needle's footprint on the undeformed surface at that depth), at least kRingCrackMinFraction
+/// of the needle's largest radius so that a sharp cone still gets a resolvable ring.
+double ring_crack_radius(const AxisymmetricNeedle& needle, double depth_m);
 
 }  // namespace mneedle::fe

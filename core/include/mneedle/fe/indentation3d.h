@@ -1,13 +1,16 @@
 #pragma once
 // 3-D pre-puncture stage (paper A §2.1): rigid needles pressed along -z into a layered tissue
-// block, sticking contact (a surface node captured by the needle moves with it for good).
+// block. Sticking contact (a surface node captured by the needle moves with it for good) or
+// frictionless contact (augmented Lagrangian at surface quadrature points; docs/model.md).
 
 #include <Eigen/Core>
 #include <array>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "mneedle/fe/fidelity.h"
 #include "mneedle/fe/tissue_mesh.h"
 #include "mneedle/mesh.h"
 
@@ -28,7 +31,13 @@ struct NeedleStep3d {
   std::array<double, 2> lateral_force_N{};  ///< (fx, fy) of the tissue on the needle
   double contact_area_m2 = 0.0;             ///< captured surface projected on the z = 0 plane
   double contact_pressure_Pa = 0.0;         ///< force_N / contact_area_m2 (0 without contact)
-  int captured_nodes = 0;
+  int captured_nodes = 0;  ///< sticking: captured nodes; frictionless: nodes of touching faces
+  /// Mean maximum principal stress of the top layer within stress_average_length_m of the
+  /// needle's first contact point (Pa; 0 when the option is off).
+  double tip_stress_Pa = 0.0;
+  /// G = (U_intact - U_cracked) / total crack area over all needles (J/m^2; 0 when off).
+  double energy_release_rate_J_per_m2 = 0.0;
+  double crack_area_m2 = 0.0;  ///< area of this needle's crack (one face, whole needle)
 };
 
 struct Step3d {
@@ -53,10 +62,20 @@ struct Timing3d {
 /// surface nodes through their condensed compliance (columns of K⁻¹ added as nodes are
 /// captured). Nonlinear materials: Newton–Raphson with line search and adaptive depth steps, one
 /// symbolic analysis for the whole insertion. Errors: SolverError naming the depth and the cause.
+/// Solver choices of one Indentation3d.
+struct Indentation3dOptions {
+  ContactMode contact = ContactMode::Sticking;
+  double tolerance = 1e-8;  ///< Newton: free residual / reaction force
+};
+
 class Indentation3d {
  public:
   /// max_depth bounds the needle travel (m): it fixes the candidate contact nodes.
-  Indentation3d(const TetMesh& mesh, std::vector<Needle3d> needles, double max_depth);
+  /// A mesh with mirror_y0 set is the y >= 0 half of a symmetric problem: nodes on y = 0 get
+  /// u_y = 0, every needle must sit on y = 0 with a mirror-symmetric surface (InputError
+  /// otherwise), and forces, energy and contact area are reported for the whole problem.
+  Indentation3d(const TetMesh& mesh, std::vector<Needle3d> needles, double max_depth,
+                const Indentation3dOptions& options = {});
   ~Indentation3d();
   Indentation3d(const Indentation3d&) = delete;
   Indentation3d& operator=(const Indentation3d&) = delete;
@@ -76,10 +95,23 @@ class Indentation3d {
 
 struct Simulation3dOptions {
   Fidelity fidelity = Fidelity::Standard;
-  int order = 2;              ///< 1: TET4, 2: TET10
+  int order = 2;              ///< 1: TET4, 2: TET10 (overrides.order wins when set)
   double depth = 0.0;         ///< final tip depth below the undeformed surface (m)
-  int steps = 10;             ///< equal output steps in depth
+  int steps = 10;             ///< equal output steps in depth (overrides.steps wins when set)
   std::string vtu_directory;  ///< when set, step_<k>.vtu is written there for every step
+  ContactMode contact = ContactMode::Sticking;
+  /// Honoured: order, tip_size_m, growth, domain_scale (block size x and y), tolerance, steps,
+  /// elements_through_top.
+  FidelityOverrides overrides;
+  /// Mesh only y >= 0 with the mirror plane y = 0 through every needle (InputError when a
+  /// needle is off the plane or not mirror-symmetric); results are for the whole problem.
+  bool half_model = false;
+  double stress_average_length_m = 0.0;  ///< tip_stress_Pa averaging length (0 = off)
+  /// Depth of the planar crack (normal x) through each needle's axis for G (0 = off); a second,
+  /// cracked model runs in lock-step with the intact one.
+  double crack_depth_m = 0.0;
+  /// Called after each output step; returning false stops the insertion there.
+  std::function<bool(const Step3d&)> on_step;
 };
 
 struct Simulation3dResult {

@@ -45,6 +45,10 @@ class SolidModel {
   double assemble(const Eigen::VectorXd& u, Eigen::SparseMatrix<double>* stiffness,
                   Eigen::VectorXd* internal_force) const;
   double strain_energy(const Eigen::VectorXd& u) const;
+  /// Adds `block` at rows of node `row`, columns of node `column` (row >= column, both in one
+  /// element) of a matrix from empty_stiffness(): for contact terms on top of the tangent.
+  void add_block(int row, int column, const Eigen::Matrix3d& block,
+                 Eigen::SparseMatrix<double>* stiffness) const;
   std::vector<double> von_mises(const Eigen::VectorXd& u) const;
   /// Strain energy density (J/m^3) per element (mean over its quadrature points).
   std::vector<double> energy_density(const Eigen::VectorXd& u) const;

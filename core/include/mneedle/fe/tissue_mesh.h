@@ -40,6 +40,12 @@ struct TissueBlockSpec {
   Fidelity fidelity = Fidelity::Standard;
   int order = 2;                 ///< 1: 4-node tetrahedra, 2: 10-node tetrahedra
   double insertion_depth = 0.0;  ///< m; the vertical grading keeps fine elements down to here
+  /// Each set field replaces the fidelity's choice (domain_scale, tolerance and steps are
+  /// applied by simulate_3d, not here).
+  FidelityOverrides overrides;
+  /// Mesh only the y >= 0 half (mirror plane y = 0, which must hold every site): the result
+  /// is exactly the y >= 0 half of the full mesh, with mirror_y0 set.
+  bool half_y = false;
 };
 
 /// Element sizes chosen for a fidelity and needle radius (m, growth ratios dimensionless).
@@ -50,7 +56,9 @@ struct MeshSizing {
   double max_size = 0.0;         ///< coarsest element size
   int elements_through_top = 1;  ///< elements through the (thin, stiff) top layer
 };
-MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, double block_size);
+/// Overrides honoured here: tip_size_m (fine_size), growth, elements_through_top.
+MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, double block_size,
+                       const FidelityOverrides& overrides = {});
 
 /// Tetrahedral mesh. 10-node node order: corners 0-3, then edges 01, 12, 20, 03, 13, 23
 /// (VTK_QUADRATIC_TETRA order); midside nodes are shared between neighbours.
@@ -64,6 +72,9 @@ struct TetMesh {
   std::vector<char> fixed;                     ///< node on the bottom or a side face
   std::vector<TissueLayer> layers;
   std::array<int, 3> grid_cells{};  ///< hexahedral cells in x, y, z
+  /// The y >= 0 half of a mirror-symmetric block: nodes on y = 0 lie on the symmetry plane
+  /// (not in `fixed`; the solver sets u_y = 0 there).
+  bool mirror_y0 = false;
 
   int nodes_per_element() const { return order == 1 ? 4 : 10; }
   const MaterialParameters& material_of(int element) const {

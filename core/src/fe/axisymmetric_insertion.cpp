@@ -1,0 +1,704 @@
+// Needle insertion into the axisymmetric model: sticking and frictionless contact, linear
+// (condensed) and nonlinear (Newton) drivers advanced depth by depth, the cracked twin model for
+// the energy release rate, per-step outputs, and the one-call problem setup.
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "axisymmetric_internal.h"
+#include "mneedle/error.h"
+#include "mneedle/fe/axisymmetric.h"
+
+namespace mneedle::fe {
+
+using namespace axi;
+
+namespace {
+
+// A captured surface node: where and at which depth the needle reached it (sticking contact).
+struct Capture {
+  Eigen::Vector2d point;
+  double depth;
+};
+
+struct ContactState {
+  std::map<std::uint32_t, Capture> captured;  // node -> capture
+};
+
+// Height of the needle's lower surface at radius r when its tip is at depth d, minus the node's
+// height: negative when the node is inside the needle.
+double gap(const AxisymmetricNeedle& needle, double depth, const Eigen::Vector2d& position) {
+  return -depth + needle.lowest_height_at(position.x()) - position.y();
+}
+
+// Captures every candidate node that entered the needle between (d0, u0) and (d1, u1), at the
+// linearly interpolated crossing. Returns how many were added.
+int capture_new_nodes(const AxisymmetricNeedle& needle,
+                      const std::vector<std::uint32_t>& candidates, const AxisymmetricMesh& mesh,
+                      double d0, const Eigen::VectorXd& u0, double d1, const Eigen::VectorXd& u1,
+                      ContactState& state) {
+  int added = 0;
+  for (std::uint32_t node : candidates) {
+    if (state.captured.count(node)) continue;
+    const Eigen::Vector2d X = mesh.nodes[node];
+    const Eigen::Vector2d p0 = X + Eigen::Vector2d(u0[2 * node], u0[2 * node + 1]);
+    const Eigen::Vector2d p1 = X + Eigen::Vector2d(u1[2 * node], u1[2 * node + 1]);
+    const double g1 = gap(needle, d1, p1);
+    if (!(g1 < 0.0)) continue;
+    const double g0 = gap(needle, d0, p0);
+    const double t = std::isfinite(g0) && g0 > 0.0 ? g0 / (g0 - g1) : 0.0;
+    state.captured[node] = Capture{p0 + t * (p1 - p0), d0 + t * (d1 - d0)};
+    ++added;
+  }
+  return added;
+}
+
+Eigen::Vector2d captured_displacement(const AxisymmetricMesh& mesh, std::uint32_t node,
+                                      const Capture& c, double depth) {
+  return c.point + Eigen::Vector2d(0.0, -(depth - c.depth)) - mesh.nodes[node];
+}
+
+// Projected contact area: the annulus between the innermost and outermost captured surface
+// nodes, each extended half-way to its free neighbour and clipped to the needle's section.
+double contact_area(const AxisymmetricMesh& mesh, const AxisymmetricNeedle& needle,
+                    const ContactState& state, const Eigen::VectorXd& u) {
+  const auto& surface = mesh.surface_nodes;
+  int first = -1, last = -1;
+  for (int i = 0; i < static_cast<int>(surface.size()); ++i)
+    if (state.captured.count(surface[i])) {
+      if (first < 0) first = i;
+      last = i;
+    }
+  if (first < 0) return 0.0;
+  auto radius = [&](int i) { return mesh.nodes[surface[i]].x() + u[2 * surface[i]]; };
+  double outer = radius(last);
+  if (last + 1 < static_cast<int>(surface.size()))
+    outer = std::min(0.5 * (outer + radius(last + 1)), needle.max_radius());
+  double inner = first == 0 ? 0.0 : radius(first);
+  if (first > 0) inner = std::max(0.5 * (inner + radius(first - 1)), needle.bore_radius_m);
+  return kPi * std::max(outer * outer - inner * inner, 0.0);
+}
+
+std::vector<std::uint32_t> reachable_surface_nodes(const AxisymmetricMesh& mesh,
+                                                   const AxisymmetricNeedle& needle, double depth) {
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t node : mesh.surface_nodes)
+    if (needle.lowest_height_at(mesh.nodes[node].x()) <= depth) out.push_back(node);
+  return out;
+}
+
+InsertionStep make_step(double depth, double force, double area, double energy, int iterations,
+                        int contacts) {
+  InsertionStep s;
+  s.depth_m = depth;
+  s.force_N = force;
+  s.contact_area_m2 = area;
+  s.contact_pressure_Pa = area > 0.0 ? force / area : 0.0;
+  s.strain_energy_J = energy;
+  s.newton_iterations = iterations;
+  s.contact_nodes = contacts;
+  return s;
+}
+
+void require_finite(const InsertionStep& s) {
+  if (!std::isfinite(s.force_N) || !std::isfinite(s.strain_energy_J) ||
+      !std::isfinite(s.contact_pressure_Pa))
+    throw SolverError("non-finite result at depth " + format_depth(s.depth_m));
+}
+
+// Dirichlet set of the clamped boundary, the symmetry axis and the captured nodes at depth d.
+void boundary_conditions(const AxisymmetricMesh& mesh, const ContactState& state, double depth,
+                         std::vector<std::uint32_t>& dofs, Eigen::VectorXd& values) {
+  std::map<std::uint32_t, double> fixed;
+  for (std::uint32_t node : mesh.fixed_nodes) {
+    fixed[2 * node] = 0.0;
+    fixed[2 * node + 1] = 0.0;
+  }
+  for (std::uint32_t node : mesh.axis_nodes) fixed[2 * node] = 0.0;
+  for (const auto& [node, capture] : state.captured) {
+    const Eigen::Vector2d u = captured_displacement(mesh, node, capture, depth);
+    if (mesh.nodes[node].x() > 0.0) fixed[2 * node] = u.x();
+    fixed[2 * node + 1] = u.y();
+  }
+  dofs.clear();
+  values.resize(static_cast<Eigen::Index>(fixed.size()));
+  Eigen::Index i = 0;
+  for (const auto& [dof, value] : fixed) {
+    dofs.push_back(dof);
+    values[i++] = value;
+  }
+}
+
+double needle_force(const ContactState& state, const Eigen::VectorXd& reaction) {
+  double force = 0.0;
+  for (const auto& entry : state.captured) force -= reaction[2 * entry.first + 1];
+  return force;
+}
+
+// Linear insertion: one factorisation, the stiffness condensed onto the reachable surface dofs
+// (Schur complement S); every depth is then a small dense solve.
+class CondensedSurface {
+ public:
+  /// keep_response: store the free dofs' response to the candidates (n x candidate dofs) so
+  /// that full() can recover the whole displacement field.
+  CondensedSurface(AxisymmetricModel& model, const std::vector<std::uint32_t>& candidates,
+                   bool keep_response)
+      : candidates_(candidates) {
+    const AxisymmetricMesh& mesh = model.mesh();
+    for (std::uint32_t node : candidates) {
+      index_[node] = static_cast<int>(dofs_.size());
+      dofs_.push_back(2 * node);
+      dofs_.push_back(2 * node + 1);
+    }
+    const auto n = static_cast<Eigen::Index>(model.dof_count());
+    std::vector<char> constrained(static_cast<std::size_t>(n), 0);
+    for (std::uint32_t node : mesh.fixed_nodes)
+      constrained[2 * node] = constrained[2 * node + 1] = 1;
+    for (std::uint32_t node : mesh.axis_nodes) constrained[2 * node] = 1;
+    axis_fixed_.assign(dofs_.size(), 0);
+    for (std::size_t j = 0; j < dofs_.size(); ++j) {
+      if (constrained[dofs_[j]]) axis_fixed_[j] = 1;  // u_r on the axis stays zero
+      constrained[dofs_[j]] = 1;
+    }
+    Eigen::SparseMatrix<double> K;
+    model.internal_force(Eigen::VectorXd::Zero(n), nullptr, &K);
+    const Eigen::SparseMatrix<double> K_full = K;
+    const double diagonal = K.diagonal().cwiseAbs().mean();
+    constrain(K, constrained, diagonal);
+    SparseSolver solver;
+    solver.analyze(K);
+    solver.factorize(K);
+    if (!solver.ok()) throw SolverError("singular stiffness matrix at depth 0");
+    const auto m = static_cast<Eigen::Index>(dofs_.size());
+    // Column j: free-dof response to a unit displacement of candidate dof j.
+    Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(n, m);
+    for (Eigen::Index j = 0; j < m; ++j) unit(dofs_[j], j) = 1.0;
+    Eigen::MatrixXd rhs = -(K_full * unit);
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (constrained[i]) rhs.row(i).setZero();
+    Eigen::MatrixXd response = solver.solve_many(rhs) + unit;
+    const Eigen::MatrixXd forces = K_full * response;
+    S_.resize(m, m);
+    for (Eigen::Index i = 0; i < m; ++i) S_.row(i) = forces.row(dofs_[i]);
+    S_ = 0.5 * (S_ + S_.transpose());
+    if (keep_response) response_ = std::move(response);
+  }
+
+  /// Whole displacement field for candidate displacements u (keep_response was set).
+  Eigen::VectorXd full(const Eigen::VectorXd& u) const { return response_ * u; }
+
+  const std::vector<std::uint32_t>& dofs() const { return dofs_; }
+
+  // Candidate displacements and forces with the captured nodes prescribed and the rest free.
+  void solve(const AxisymmetricMesh& mesh, const ContactState& state, double depth,
+             Eigen::VectorXd& u, Eigen::VectorXd& f) const {
+    const auto m = static_cast<Eigen::Index>(dofs_.size());
+    std::vector<char> prescribed(static_cast<std::size_t>(m), 0);
+    u = Eigen::VectorXd::Zero(m);
+    for (Eigen::Index j = 0; j < m; ++j) prescribed[j] = axis_fixed_[j];
+    for (const auto& [node, capture] : state.captured) {
+      const Eigen::Vector2d d = captured_displacement(mesh, node, capture, depth);
+      const int j = index_.at(node);
+      prescribed[j] = prescribed[j + 1] = 1;
+      u[j] = axis_fixed_[j] ? 0.0 : d.x();
+      u[j + 1] = d.y();
+    }
+    std::vector<Eigen::Index> free, fixed;
+    for (Eigen::Index j = 0; j < m; ++j) (prescribed[j] ? fixed : free).push_back(j);
+    if (!free.empty()) {
+      Eigen::MatrixXd S_ff(free.size(), free.size());
+      Eigen::VectorXd rhs = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(free.size()));
+      for (std::size_t a = 0; a < free.size(); ++a) {
+        for (std::size_t b = 0; b < free.size(); ++b) S_ff(a, b) = S_(free[a], free[b]);
+        for (Eigen::Index c : fixed) rhs[a] -= S_(free[a], c) * u[c];
+      }
+      const Eigen::VectorXd uf = S_ff.ldlt().solve(rhs);
+      for (std::size_t a = 0; a < free.size(); ++a) u[free[a]] = uf[a];
+    }
+    f = S_ * u;
+  }
+
+  // Frictionless: the active nodes lie on the needle's profile (one linear constraint each,
+  // free to slide along it); minimise the condensed energy with Lagrange multipliers.
+  void solve_frictionless(const AxisymmetricMesh& mesh, const AxisymmetricNeedle& needle,
+                          double depth, const std::map<std::uint32_t, double>& slopes,
+                          Eigen::VectorXd& u, Eigen::VectorXd& f) const {
+    const auto m = static_cast<Eigen::Index>(dofs_.size());
+    std::vector<std::pair<Eigen::Index, std::uint32_t>> rows;
+    Eigen::Index count = 0;
+    for (Eigen::Index j = 0; j < m; ++j) count += axis_fixed_[j];
+    count += static_cast<Eigen::Index>(slopes.size());
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(count, m);
+    Eigen::VectorXd c = Eigen::VectorXd::Zero(count);
+    Eigen::Index row = 0;
+    for (Eigen::Index j = 0; j < m; ++j)
+      if (axis_fixed_[j]) G(row++, j) = 1.0;
+    for (const auto& [node, slope] : slopes) {
+      // Profile segment z = -d + h0 + slope (r - r0) through the node's section.
+      const int j = index_.at(node);
+      const Eigen::Vector2d X = mesh.nodes[node];
+      const double h_at_X = needle.lowest_height_at(X.x());
+      const double level = std::isfinite(h_at_X) ? -depth + h_at_X : -depth;
+      G(row, j) = -slope;
+      G(row, j + 1) = 1.0;
+      c[row] = level - X.y();
+      ++row;
+    }
+    Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(m + count, m + count);
+    kkt.topLeftCorner(m, m) = S_;
+    kkt.topRightCorner(m, count) = G.transpose();
+    kkt.bottomLeftCorner(count, m) = G;
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(m + count);
+    rhs.tail(count) = c;
+    const Eigen::VectorXd x = kkt.fullPivLu().solve(rhs);
+    u = x.head(m);
+    f = S_ * u;
+  }
+
+  int index_of(std::uint32_t node) const { return index_.at(node); }
+
+  // Full-length displacement vector holding only the candidates' values (for capture tests).
+  Eigen::VectorXd scatter(const Eigen::VectorXd& u, std::size_t n) const {
+    Eigen::VectorXd full = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+    for (std::size_t j = 0; j < dofs_.size(); ++j) full[dofs_[j]] = u[static_cast<Eigen::Index>(j)];
+    return full;
+  }
+
+ private:
+  std::vector<std::uint32_t> candidates_;
+  std::vector<std::uint32_t> dofs_;
+  std::vector<char> axis_fixed_;
+  std::map<std::uint32_t, int> index_;
+  Eigen::MatrixXd S_;
+  Eigen::MatrixXd response_;
+};
+
+// One insertion on one model, advanced to a growing sequence of depths.
+class Stepper {
+ public:
+  virtual ~Stepper() = default;
+  virtual InsertionStep advance_to(double depth) = 0;
+  /// Whole displacement field (2 per node) at the last depth.
+  virtual Eigen::VectorXd displacement() const = 0;
+};
+
+// Nonlinear layers: Newton at every sub-step, adaptive step length.
+class NonlinearStepper : public Stepper {
+ public:
+  NonlinearStepper(AxisymmetricModel& model, const AxisymmetricNeedle& needle,
+                   const InsertionOptions& options)
+      : model_(model),
+        needle_(needle),
+        newton_(options.newton),
+        candidates_(reachable_surface_nodes(model.mesh(), needle, options.depth_m)),
+        interval_(options.depth_m / options.output_steps),
+        step_(interval_),
+        min_step_(1e-5 * options.depth_m) {
+    current_.displacement = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(model.dof_count()));
+    current_.reaction = current_.displacement;
+  }
+
+  InsertionStep advance_to(double target) override {
+    const AxisymmetricMesh& mesh = model_.mesh();
+    int iterations = 0;
+    while (depth_ < target * (1.0 - 1e-12)) {
+      step_ = std::min(step_, target - depth_);
+      const double next = depth_ + step_;
+      ContactState trial_state = state_;
+      int trial_iterations = 0;
+      std::string failure;
+      Equilibrium trial;
+      try {
+        boundary_conditions(mesh, trial_state, next, dofs_, values_);
+        trial = model_.solve(dofs_, values_, predictor(next), newton_);
+        trial_iterations += trial.newton_iterations;
+        for (int round = 0; round < 50; ++round) {
+          if (capture_new_nodes(needle_, candidates_, mesh, depth_, current_.displacement, next,
+                                trial.displacement, trial_state) == 0)
+            break;
+          boundary_conditions(mesh, trial_state, next, dofs_, values_);
+          trial = model_.solve(dofs_, values_, trial.displacement, newton_);
+          trial_iterations += trial.newton_iterations;
+        }
+      } catch (const SolverError& e) {
+        failure = e.what();
+      }
+      if (!failure.empty()) {
+        step_ *= 0.5;
+        if (step_ < min_step_)
+          throw SolverError("axisymmetric insertion stopped at depth " + format_depth(depth_) +
+                            ": " + failure);
+        continue;
+      }
+      last_increment_ = trial.displacement - current_.displacement;
+      last_step_ = next - depth_;
+      depth_ = next;
+      current_ = std::move(trial);
+      state_ = std::move(trial_state);
+      iterations += trial_iterations;
+      if (trial_iterations <= 6) step_ = std::min(step_ * 1.5, interval_);
+    }
+    const double force = needle_force(state_, current_.reaction);
+    const double area = contact_area(mesh, needle_, state_, current_.displacement);
+    return make_step(depth_, force, area, current_.strain_energy_J, iterations,
+                     static_cast<int>(state_.captured.size()));
+  }
+
+  Eigen::VectorXd displacement() const override { return current_.displacement; }
+
+ private:
+  // Start of Newton at depth `next`: the last converged increment extrapolated linearly (the
+  // path is smooth between captures), with the prescribed values put in place, so that the
+  // previous factorisation can often serve the whole step (modified Newton).
+  Eigen::VectorXd predictor(double next) const {
+    Eigen::VectorXd start = current_.displacement;
+    if (last_step_ > 0.0) start += (next - depth_) / last_step_ * last_increment_;
+    for (std::size_t i = 0; i < dofs_.size(); ++i)
+      start[dofs_[i]] = values_[static_cast<Eigen::Index>(i)];
+    return start;
+  }
+
+  AxisymmetricModel& model_;
+  AxisymmetricNeedle needle_;
+  NewtonOptions newton_;
+  std::vector<std::uint32_t> candidates_;
+  double interval_, step_, min_step_;
+  double depth_ = 0.0;
+  ContactState state_;
+  Equilibrium current_;
+  std::vector<std::uint32_t> dofs_;
+  Eigen::VectorXd values_;
+  Eigen::VectorXd last_increment_;
+  double last_step_ = 0.0;
+};
+
+// Linear layers, sticking: the condensed surface; sub-steps only refine where captures happen,
+// the solve itself is exact at any depth.
+class LinearStepper : public Stepper {
+ public:
+  LinearStepper(AxisymmetricModel& model, const AxisymmetricNeedle& needle,
+                const InsertionOptions& options, bool keep_field)
+      : mesh_(model.mesh()),
+        needle_(needle),
+        candidates_(reachable_surface_nodes(mesh_, needle, options.depth_m)),
+        n_(model.dof_count()),
+        sub_step_(options.depth_m / (options.output_steps * kSubsteps)) {
+    previous_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_));
+    if (!candidates_.empty())
+      surface_ = std::make_unique<CondensedSurface>(model, candidates_, keep_field);
+  }
+
+  InsertionStep advance_to(double target) override {
+    if (!surface_) return make_step(target, 0, 0, 0, 0, 0);
+    int solves = 0;
+    while (depth_ < target * (1.0 - 1e-12)) {
+      const double next = std::min(target, depth_ + sub_step_ * (1.0 + 1e-9));
+      for (int round = 0; round < 1000; ++round) {
+        surface_->solve(mesh_, state_, next, u_, f_);
+        ++solves;
+        if (capture_new_nodes(needle_, candidates_, mesh_, depth_, previous_, next,
+                              surface_->scatter(u_, n_), state_) == 0)
+          break;
+      }
+      depth_ = next;
+      previous_ = surface_->scatter(u_, n_);
+    }
+    double force = 0.0;
+    for (const auto& entry : state_.captured) {
+      const auto& dofs = surface_->dofs();
+      const auto it = std::find(dofs.begin(), dofs.end(), 2 * entry.first + 1);
+      force -= f_[it - dofs.begin()];
+    }
+    const double area = contact_area(mesh_, needle_, state_, previous_);
+    return make_step(depth_, force, area, 0.5 * u_.dot(f_), solves,
+                     static_cast<int>(state_.captured.size()));
+  }
+
+  Eigen::VectorXd displacement() const override {
+    if (!surface_ || u_.size() == 0) return Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_));
+    return surface_->full(u_);
+  }
+
+ private:
+  static constexpr int kSubsteps = 4;
+  const AxisymmetricMesh& mesh_;
+  AxisymmetricNeedle needle_;
+  std::vector<std::uint32_t> candidates_;
+  std::size_t n_;
+  double sub_step_;
+  std::unique_ptr<CondensedSurface> surface_;
+  ContactState state_;
+  Eigen::VectorXd previous_, u_, f_;
+  double depth_ = 0.0;
+};
+
+// Slope dh/dr of the needle profile where a node sits (0 on a flat face).
+double profile_slope(const AxisymmetricNeedle& needle, double r) {
+  const auto& R = needle.radii_m;
+  const auto& H = needle.heights_m;
+  if (R.empty() || r <= R.front()) return 0.0;
+  for (std::size_t i = 1; i < R.size(); ++i)
+    if (r <= R[i] && R[i] > R[i - 1]) return (H[i] - H[i - 1]) / (R[i] - R[i - 1]);
+  return 0.0;
+}
+
+// Linear layers, frictionless: active set on the condensed surface; each depth solved
+// independently (elastic, no history), starting from the previous active set.
+class FrictionlessStepper : public Stepper {
+ public:
+  FrictionlessStepper(AxisymmetricModel& model, const AxisymmetricNeedle& needle,
+                      const InsertionOptions& options, bool keep_field)
+      : mesh_(model.mesh()),
+        needle_(needle),
+        candidates_(reachable_surface_nodes(mesh_, needle, options.depth_m)),
+        n_(model.dof_count()),
+        depth_scale_(options.depth_m) {
+    if (candidates_.empty()) throw InputError("frictionless contact: the needle reaches no node");
+    surface_ = std::make_unique<CondensedSurface>(model, candidates_, keep_field);
+  }
+
+  InsertionStep advance_to(double depth) override {
+    int solves = 0;
+    for (bool changed = true; changed && solves < 200;) {
+      changed = false;
+      surface_->solve_frictionless(mesh_, needle_, depth, active_, u_, f_);
+      ++solves;
+      // Release the node pulled hardest (tensile normal force), else add penetrating nodes.
+      std::uint32_t worst = 0;
+      double worst_pull = 0.0;
+      for (const auto& [node, slope] : active_) {
+        const int j = surface_->index_of(node);
+        const double pull = -slope * f_[j] + f_[j + 1];  // along the profile's upward normal
+        if (pull > worst_pull) worst = node, worst_pull = pull;
+      }
+      if (worst_pull > 1e-12 * std::max(1.0, f_.norm())) {
+        active_.erase(worst);
+        changed = true;
+        continue;
+      }
+      for (std::uint32_t node : candidates_) {
+        if (active_.count(node)) continue;
+        const int j = surface_->index_of(node);
+        const Eigen::Vector2d p = mesh_.nodes[node] + Eigen::Vector2d(u_[j], u_[j + 1]);
+        if (gap(needle_, depth, p) < -1e-12 * depth_scale_) {
+          active_[node] = profile_slope(needle_, mesh_.nodes[node].x());
+          changed = true;
+        }
+      }
+    }
+    double force = 0.0;
+    ContactState state;
+    const Eigen::VectorXd full = surface_->scatter(u_, n_);
+    for (const auto& entry : active_) {
+      force -= f_[surface_->index_of(entry.first) + 1];
+      state.captured[entry.first] = Capture{Eigen::Vector2d::Zero(), 0.0};
+    }
+    const double area = contact_area(mesh_, needle_, state, full);
+    return make_step(depth, force, area, 0.5 * u_.dot(f_), solves,
+                     static_cast<int>(active_.size()));
+  }
+
+  Eigen::VectorXd displacement() const override {
+    if (u_.size() == 0) return Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_));
+    return surface_->full(u_);
+  }
+
+ private:
+  const AxisymmetricMesh& mesh_;
+  AxisymmetricNeedle needle_;
+  std::vector<std::uint32_t> candidates_;
+  std::size_t n_;
+  double depth_scale_;
+  std::unique_ptr<CondensedSurface> surface_;
+  std::map<std::uint32_t, double> active_;
+  Eigen::VectorXd u_, f_;
+};
+
+std::unique_ptr<Stepper> make_stepper(AxisymmetricModel& model, const AxisymmetricNeedle& needle,
+                                      const InsertionOptions& options, bool keep_field) {
+  if (options.contact == ContactMode::Frictionless)
+    return std::make_unique<FrictionlessStepper>(model, needle, options, keep_field);
+  if (model.is_linear()) return std::make_unique<LinearStepper>(model, needle, options, keep_field);
+  return std::make_unique<NonlinearStepper>(model, needle, options);
+}
+
+}  // namespace
+
+double ring_crack_radius(const AxisymmetricNeedle& needle, double depth_m) {
+  const auto& H = needle.heights_m;
+  const auto& R = needle.radii_m;
+  if (R.empty()) throw InputError("ring crack: the needle has no profile");
+  double r = R.back();
+  for (std::size_t i = 1; i < H.size(); ++i)
+    if (depth_m < H[i]) {
+      const double t = std::clamp((depth_m - H[i - 1]) / (H[i] - H[i - 1]), 0.0, 1.0);
+      r = R[i - 1] + t * (R[i] - R[i - 1]);
+      break;
+    }
+  if (!(r > 0.0)) throw InputError("ring crack: the needle's section at that depth has no radius");
+  return r;
+}
+
+InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle& needle,
+                              const InsertionOptions& options) {
+  if (!(options.depth_m > 0.0)) throw InputError("insertion depth must be > 0 m");
+  if (options.output_steps < 1) throw InputError("insertion needs at least one output step");
+  if (!(options.stress_average_length_m >= 0.0))
+    throw InputError("stress_average_length_m must be >= 0 m");
+  if (!(options.crack_depth_m >= 0.0)) throw InputError("crack_depth_m must be >= 0 m");
+  const bool frictionless = options.contact == ContactMode::Frictionless;
+  if (frictionless && !model.is_linear())
+    throw InputError(
+        "axisymmetric solver: frictionless contact needs linear layers for now; use sticking");
+  const auto start = std::chrono::steady_clock::now();
+  const int before = model.factorization_count();
+  const bool keep_field = options.stress_average_length_m > 0.0 || !options.vtu_directory.empty();
+  std::unique_ptr<Stepper> intact = make_stepper(model, needle, options, keep_field);
+  // Energy release rate: a ring-cracked twin advanced in lock-step with the intact model.
+  std::unique_ptr<AxisymmetricModel> cracked_model;
+  std::unique_ptr<Stepper> cracked;
+  double crack_area = 0.0;
+  if (options.crack_depth_m > 0.0) {
+    const double radius = ring_crack_radius(needle, options.depth_m);
+    cracked_model = std::make_unique<AxisymmetricModel>(
+        crack_axisymmetric_mesh(model.mesh(), radius, options.crack_depth_m, &crack_area),
+        model.layer_materials());
+    cracked = make_stepper(*cracked_model, needle, options, false);
+  }
+  if (!options.vtu_directory.empty()) std::filesystem::create_directories(options.vtu_directory);
+  InsertionResult result;
+  for (int k = 1; k <= options.output_steps; ++k) {
+    const double depth = options.depth_m * k / options.output_steps;
+    InsertionStep step = intact->advance_to(depth);
+    if (cracked) {
+      const InsertionStep twin = cracked->advance_to(depth);
+      step.crack_area_m2 = crack_area;
+      step.energy_release_rate_J_per_m2 =
+          (step.strain_energy_J - twin.strain_energy_J) / crack_area;
+    }
+    if (keep_field) {
+      const Eigen::VectorXd u = intact->displacement();
+      if (options.stress_average_length_m > 0.0)
+        step.tip_stress_Pa = model.averaged_max_principal_stress(
+            u, Eigen::Vector2d::Zero(), options.stress_average_length_m, 0);
+      if (!options.vtu_directory.empty())
+        model.write_vtu(
+            (std::filesystem::path(options.vtu_directory) / ("step_" + std::to_string(k) + ".vtu"))
+                .string(),
+            u);
+    }
+    require_finite(step);
+    result.steps.push_back(step);
+    if (options.on_step && !options.on_step(step)) break;
+  }
+  result.factorizations = model.is_linear() ? 1 : model.factorization_count() - before;
+  if (cracked_model)
+    result.factorizations += cracked_model->is_linear() ? 1 : cracked_model->factorization_count();
+  result.nodes = model.mesh().nodes.size();
+  result.elements = model.mesh().elements.size();
+  result.solve_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+namespace {
+
+void require_override(bool ok, const std::string& field, const std::string& problem) {
+  if (!ok) throw InputError("axisymmetric model: overrides." + field + " " + problem);
+}
+
+void check_overrides(const FidelityOverrides& o) {
+  require_override(!o.order || *o.order == 2, "order",
+                   "= " + std::to_string(o.order.value_or(2)) +
+                       " is not available: the axisymmetric model has 6-node (order 2) "
+                       "triangles only");
+  require_override(!o.tip_size_m || (std::isfinite(*o.tip_size_m) && *o.tip_size_m > 0.0),
+                   "tip_size_m", "must be > 0 m");
+  require_override(!o.growth || (std::isfinite(*o.growth) && *o.growth >= 1.0), "growth",
+                   "must be >= 1");
+  require_override(!o.domain_scale || (std::isfinite(*o.domain_scale) && *o.domain_scale > 0.0),
+                   "domain_scale", "must be > 0");
+  require_override(!o.tolerance || (std::isfinite(*o.tolerance) && *o.tolerance > 0.0), "tolerance",
+                   "must be > 0");
+  require_override(!o.steps || *o.steps >= 1, "steps", "must be >= 1");
+  require_override(!o.elements_through_top || *o.elements_through_top >= 1, "elements_through_top",
+                   "must be >= 1");
+}
+
+}  // namespace
+
+AxisymmetricMeshOptions mesh_options_for(const AxisymmetricProblem& problem) {
+  check_overrides(problem.overrides);
+  const AxisymmetricNeedle& needle = problem.needle;
+  // Contact radius scale: the needle's section where it crosses the undeformed surface.
+  double a = needle.max_radius();
+  for (std::size_t i = 1; i < needle.heights_m.size(); ++i)
+    if (problem.depth_m < needle.heights_m[i]) {
+      const double t = (problem.depth_m - needle.heights_m[i - 1]) /
+                       (needle.heights_m[i] - needle.heights_m[i - 1]);
+      a = needle.radii_m[i - 1] + t * (needle.radii_m[i] - needle.radii_m[i - 1]);
+      break;
+    }
+  a = std::max(a, 1e-3 * problem.depth_m);
+  int per_radius = 8;
+  double growth = 1.3;
+  if (problem.fidelity == Fidelity::Fast) per_radius = 4, growth = 1.45;
+  if (problem.fidelity == Fidelity::Fine) per_radius = 16, growth = 1.2;
+  const FidelityOverrides& ov = problem.overrides;
+  AxisymmetricMeshOptions o;
+  o.radius_m = problem.radius_m * ov.domain_scale.value_or(1.0);
+  o.h_m = std::min(ov.tip_size_m.value_or(a / per_radius), o.radius_m);
+  o.fine_radius_m = 2.0 * a;
+  // Total Lagrangian: the captured nodes sit on the reference surface, so the fine zone is the
+  // reference neighbourhood of the footprint (a deep, slender needle does not need a fine
+  // column down to its depth); below it the rows grow geometrically.
+  o.fine_depth_m = std::min(problem.depth_m, a) + a;
+  o.growth = ov.growth.value_or(growth);
+  o.max_size_m = o.radius_m / 8.0;
+  o.elements_through_top = ov.elements_through_top.value_or(0);
+  o.radial_breaks_m = {needle.bore_radius_m, needle.max_radius()};
+  // The flat face edge must be a node column; a sampled profile adds no further breaks.
+  if (!needle.radii_m.empty()) o.radial_breaks_m.push_back(needle.radii_m.front());
+  if (problem.crack_depth_m > 0.0) {
+    const double r_c = ring_crack_radius(needle, problem.depth_m);
+    o.radial_breaks_m.push_back(r_c);
+    o.fine_radius_m = std::max(o.fine_radius_m, 1.5 * r_c);
+    o.depth_breaks_m.push_back(problem.crack_depth_m);
+  }
+  return o;
+}
+
+InsertionResult simulate_axisymmetric(const AxisymmetricProblem& problem) {
+  const auto start = std::chrono::steady_clock::now();
+  AxisymmetricMesh mesh = make_axisymmetric_mesh(problem.layers, mesh_options_for(problem));
+  std::vector<MaterialParameters> materials;
+  for (const AxisymmetricLayer& l : problem.layers) materials.push_back(l.material);
+  AxisymmetricModel model(std::move(mesh), materials);
+  const double mesh_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  InsertionOptions options;
+  options.depth_m = problem.depth_m;
+  options.contact = problem.contact;
+  options.output_steps = problem.output_steps > 0             ? problem.output_steps
+                         : problem.fidelity == Fidelity::Fast ? 10
+                         : problem.fidelity == Fidelity::Fine ? 40
+                                                              : 20;
+  if (problem.overrides.steps) options.output_steps = *problem.overrides.steps;
+  if (problem.overrides.tolerance) options.newton.residual_tolerance = *problem.overrides.tolerance;
+  options.stress_average_length_m = problem.stress_average_length_m;
+  options.crack_depth_m = problem.crack_depth_m;
+  options.on_step = problem.on_step;
+  options.vtu_directory = problem.vtu_directory;
+  InsertionResult result = insert_needle(model, problem.needle, options);
+  result.mesh_seconds = mesh_seconds;
+  return result;
+}
+
+}  // namespace mneedle::fe

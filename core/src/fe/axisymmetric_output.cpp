@@ -1,0 +1,217 @@
+// Derived fields of the axisymmetric model: stresses, the averaged tip stress, VTU files and the
+// ring-cracked copy of a mesh.
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <string>
+
+#include "axisymmetric_internal.h"
+#include "mneedle/error.h"
+#include "mneedle/fe/axisymmetric.h"
+
+namespace mneedle::fe {
+
+using namespace axi;
+
+namespace {
+
+double von_mises_of(const Eigen::Matrix3d& s) {
+  const Eigen::Matrix3d dev = s - s.trace() / 3.0 * Eigen::Matrix3d::Identity();
+  return std::sqrt(1.5 * dev.squaredNorm());
+}
+
+// Largest eigenvalue of a Cauchy stress with the axisymmetric structure: the (r, z) block and
+// the hoop component are decoupled.
+double max_principal(const Eigen::Matrix3d& s) {
+  const double mean = 0.5 * (s(0, 0) + s(2, 2));
+  const double radius = std::hypot(0.5 * (s(0, 0) - s(2, 2)), s(0, 2));
+  return std::max(mean + radius, s(1, 1));
+}
+
+// Subdivision of the reference triangle into n^2 equal triangles: their centroids.
+std::vector<Eigen::Vector2d> sub_centroids(int n) {
+  std::vector<Eigen::Vector2d> out;
+  const double h = 1.0 / n;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n - i; ++j) {
+      out.emplace_back((i + 1.0 / 3.0) * h, (j + 1.0 / 3.0) * h);
+      if (i + j < n - 1) out.emplace_back((i + 2.0 / 3.0) * h, (j + 2.0 / 3.0) * h);
+    }
+  return out;
+}
+
+}  // namespace
+
+const std::vector<MaterialParameters>& AxisymmetricModel::layer_materials() const {
+  return impl_->parameters;
+}
+
+std::vector<double> AxisymmetricModel::von_mises(const Eigen::VectorXd& u) const {
+  const Impl& m = *impl_;
+  std::vector<double> out(m.mesh.elements.size(), 0.0);
+  for (std::size_t e = 0; e < out.size(); ++e) {
+    const Material& material = m.materials[m.mesh.element_layer[e]];
+    for (int q = 0; q < kQuadrature; ++q) {
+      const PointData& p = m.points[e * kQuadrature + q];
+      const Eigen::Matrix3d F = deformation_gradient(p, u, m.mesh.elements[e]);
+      out[e] += kRule[q].weight * von_mises_of(cauchy_stress(material, F, nullptr));
+    }
+  }
+  return out;
+}
+
+std::vector<double> AxisymmetricModel::energy_density(const Eigen::VectorXd& u) const {
+  const Impl& m = *impl_;
+  std::vector<double> out(m.mesh.elements.size(), 0.0);
+  for (std::size_t e = 0; e < out.size(); ++e) {
+    const Material& material = m.materials[m.mesh.element_layer[e]];
+    for (int q = 0; q < kQuadrature; ++q) {
+      const PointData& p = m.points[e * kQuadrature + q];
+      const Eigen::Matrix3d F = deformation_gradient(p, u, m.mesh.elements[e]);
+      out[e] += kRule[q].weight * material.evaluate(F).energy_density;
+    }
+  }
+  return out;
+}
+
+double AxisymmetricModel::averaged_max_principal_stress(const Eigen::VectorXd& u,
+                                                        const Eigen::Vector2d& point_m,
+                                                        double length_m, int layer) const {
+  if (!(length_m > 0.0)) throw InputError("stress average: length must be > 0 m");
+  const Impl& m = *impl_;
+  // Elements wholly inside the ball use their quadrature rule; cut ones a 64-triangle
+  // subdivision (midpoint rule per sub-triangle) that resolves the ball's edge to h/8.
+  static const std::vector<Eigen::Vector2d> kSub = sub_centroids(8);
+  double weighted = 0.0, volume = 0.0;
+  for (std::size_t e = 0; e < m.mesh.elements.size(); ++e) {
+    if (m.mesh.element_layer[e] != layer) continue;
+    const auto& nodes = m.mesh.elements[e];
+    double nearest = std::numeric_limits<double>::infinity(), farthest = 0.0;
+    Eigen::Vector2d lo = m.mesh.nodes[nodes[0]], hi = lo;
+    for (int a = 0; a < 3; ++a) {
+      const Eigen::Vector2d& X = m.mesh.nodes[nodes[a]];
+      lo = lo.cwiseMin(X);
+      hi = hi.cwiseMax(X);
+      farthest = std::max(farthest, (X - point_m).norm());
+    }
+    nearest = (point_m.cwiseMax(lo).cwiseMin(hi) - point_m).norm();
+    if (nearest > length_m) continue;
+    const Material& material = m.materials[layer];
+    auto add = [&](const PointData& p) {
+      const Eigen::Matrix3d F = deformation_gradient(p, u, nodes);
+      weighted += p.w * max_principal(cauchy_stress(material, F, nullptr));
+      volume += p.w;
+    };
+    if (farthest <= length_m) {
+      for (int q = 0; q < kQuadrature; ++q) add(m.points[e * kQuadrature + q]);
+      continue;
+    }
+    for (const Eigen::Vector2d& c : kSub) {
+      const PointData p = point_data(m.mesh, nodes, c.x(), c.y(), 1.0 / kSub.size());
+      Eigen::Vector2d X = Eigen::Vector2d::Zero();
+      for (int a = 0; a < kNodes; ++a) X += p.N[a] * m.mesh.nodes[nodes[a]];
+      if ((X - point_m).norm() <= length_m) add(p);
+    }
+  }
+  return volume > 0.0 ? weighted / volume : 0.0;
+}
+
+void AxisymmetricModel::write_vtu(const std::string& path, const Eigen::VectorXd& u) const {
+  const AxisymmetricMesh& mesh = impl_->mesh;
+  const std::vector<double> stress = von_mises(u);
+  const std::vector<double> energy = energy_density(u);
+  std::ofstream out(path);
+  if (!out) throw InputError(path + ": cannot open for writing");
+  out.precision(9);
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
+      << "<UnstructuredGrid><Piece NumberOfPoints=\"" << mesh.nodes.size() << "\" NumberOfCells=\""
+      << mesh.elements.size() << "\">\n<Points>\n"
+      << "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (const auto& p : mesh.nodes) out << p.x() << " 0 " << p.y() << '\n';
+  out << "</DataArray>\n</Points>\n<Cells>\n"
+      << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+  // VTK_QUADRATIC_TRIANGLE: corners, then mid-edges 0-1, 1-2, 2-0 (our order).
+  for (const auto& e : mesh.elements) {
+    for (std::uint32_t node : e) out << node << ' ';
+    out << '\n';
+  }
+  out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+  for (std::size_t e = 1; e <= mesh.elements.size(); ++e) out << 6 * e << '\n';
+  out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+  for (std::size_t e = 0; e < mesh.elements.size(); ++e) out << "22\n";
+  out << "</DataArray>\n</Cells>\n<PointData Vectors=\"displacement_m\">\n"
+      << "<DataArray type=\"Float64\" Name=\"displacement_m\" NumberOfComponents=\"3\" "
+         "format=\"ascii\">\n";
+  for (Eigen::Index i = 0; i + 1 < u.size(); i += 2) out << u(i) << " 0 " << u(i + 1) << '\n';
+  out << "</DataArray>\n</PointData>\n<CellData>\n"
+      << "<DataArray type=\"Float64\" Name=\"von_mises_Pa\" format=\"ascii\">\n";
+  for (double s : stress) out << s << '\n';
+  out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"energy_density_J_per_m3\" "
+         "format=\"ascii\">\n";
+  for (double w : energy) out << w << '\n';
+  out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"layer\" format=\"ascii\">\n";
+  for (int layer : mesh.element_layer) out << layer << '\n';
+  out << "</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+  if (!out) throw InputError(path + ": write failed");
+}
+
+AxisymmetricMesh crack_axisymmetric_mesh(const AxisymmetricMesh& mesh, double radius_m,
+                                         double depth_m, double* area_m2) {
+  if (!(radius_m > 0.0) || !(depth_m > 0.0))
+    throw InputError("ring crack: radius and depth must be > 0 m");
+  double extent = 0.0;
+  for (const Eigen::Vector2d& X : mesh.nodes) extent = std::max(extent, X.cwiseAbs().maxCoeff());
+  const double tol = 1e-9 * extent;
+  auto on_line = [&](const Eigen::Vector2d& X) {
+    return std::abs(X.x() - radius_m) <= tol && X.y() <= tol && X.y() >= -depth_m - tol;
+  };
+  auto describe = [&] {
+    return "ring crack at r = " + format_depth(radius_m) + ", depth " + format_depth(depth_m);
+  };
+  bool front = false;
+  std::map<std::uint32_t, std::uint32_t> copy;  // crack-face node -> its outer copy
+  AxisymmetricMesh out = mesh;
+  for (std::uint32_t n = 0; n < mesh.nodes.size(); ++n) {
+    if (!on_line(mesh.nodes[n])) continue;
+    if (mesh.nodes[n].y() <= -depth_m + tol) {
+      front = true;
+      continue;
+    }
+    copy[n] = static_cast<std::uint32_t>(out.nodes.size());
+    out.nodes.push_back(mesh.nodes[n]);
+  }
+  if (!front || copy.empty())
+    throw InputError(describe() + ": the mesh has no node column there reaching that depth");
+  // Each element on the line goes wholly to one side; the outer ones take the copies.
+  std::size_t faces = 0;
+  for (auto& e : out.elements) {
+    double inner = 0.0, outer = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      const double dr = mesh.nodes[e[a]].x() - radius_m;
+      inner = std::min(inner, dr);
+      outer = std::max(outer, dr);
+    }
+    const bool touches = std::any_of(e.begin(), e.end(), [&](auto n) { return copy.count(n); });
+    if (!touches) continue;
+    if (inner < -tol && outer > tol)
+      throw InputError(describe() + ": an element straddles the crack line");
+    if (outer <= tol) continue;
+    int on = 0;
+    for (auto& n : e) {
+      const auto it = copy.find(n);
+      if (it != copy.end()) n = it->second, ++on;
+    }
+    faces += on >= 2;
+  }
+  if (faces == 0) throw InputError(describe() + ": no element edge lies on the crack line");
+  // The outer copy of the surface node is not a contact node: the needle presses the inside of
+  // the ring. (Holding that corner of the outer wedge with the needle would pin one node of a
+  // free corner, whose energy vanishes under refinement, and G would not converge.)
+  if (area_m2) *area_m2 = 2.0 * kPi * radius_m * depth_m;
+  return out;
+}
+
+}  // namespace mneedle::fe

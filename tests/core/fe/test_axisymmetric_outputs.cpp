@@ -1,0 +1,322 @@
+// Per-step outputs of the axisymmetric model: fidelity overrides, on_step, averaged tip stress,
+// VTU files and the ring-crack energy release rate.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+
+#include "mneedle/error.h"
+#include "mneedle/fe/axisymmetric.h"
+
+namespace mneedle::fe {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+MaterialParameters material(MaterialModel model, double E, double nu) {
+  MaterialParameters p;
+  p.model = model;
+  p.E = E;
+  p.nu = nu;
+  return p;
+}
+
+// Flat punch radius 100 um on a 2 mm layer (a fast, well-understood case).
+AxisymmetricProblem punch_problem(MaterialModel model = MaterialModel::Linear) {
+  AxisymmetricProblem p;
+  p.layers = {{2e-3, material(model, 1e5, 0.3)}};
+  p.radius_m = 2e-3;
+  p.needle = AxisymmetricNeedle::flat_punch(1e-4);
+  p.depth_m = 2e-6;
+  p.fidelity = Fidelity::Fast;
+  p.output_steps = 2;
+  return p;
+}
+
+TEST(AxisymmetricOverrides, TipSizeGrowthDomainAndStepsAreHonoured) {
+  AxisymmetricProblem p = punch_problem();
+  const AxisymmetricMeshOptions base = mesh_options_for(p);
+  p.overrides.tip_size_m = 5e-6;
+  p.overrides.growth = 1.1;
+  p.overrides.domain_scale = 1.5;
+  p.overrides.elements_through_top = 7;
+  const AxisymmetricMeshOptions o = mesh_options_for(p);
+  EXPECT_DOUBLE_EQ(o.h_m, 5e-6);
+  EXPECT_DOUBLE_EQ(o.growth, 1.1);
+  EXPECT_DOUBLE_EQ(o.radius_m, 1.5 * base.radius_m);
+  EXPECT_EQ(o.elements_through_top, 7);
+  p.overrides = {};
+  p.overrides.steps = 3;
+  p.overrides.order = 2;
+  EXPECT_EQ(simulate_axisymmetric(p).steps.size(), 3u);
+}
+
+TEST(AxisymmetricOverrides, LinearOrderAndBadValuesAreRejected) {
+  AxisymmetricProblem p = punch_problem();
+  p.overrides.order = 1;
+  try {
+    simulate_axisymmetric(p);
+    FAIL() << "order 1 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("overrides.order"), std::string::npos);
+  }
+  p.overrides = {};
+  p.overrides.tip_size_m = -1.0;
+  EXPECT_THROW(simulate_axisymmetric(p), InputError);
+  p.overrides = {};
+  p.overrides.growth = 0.5;
+  EXPECT_THROW(simulate_axisymmetric(p), InputError);
+  p.overrides = {};
+  p.overrides.steps = 0;
+  EXPECT_THROW(simulate_axisymmetric(p), InputError);
+}
+
+TEST(AxisymmetricMesh, ElementsThroughTopAndDepthBreaksAreRows) {
+  const std::vector<AxisymmetricLayer> layers{{20e-6, material(MaterialModel::Linear, 1e9, 0.4)},
+                                              {980e-6, material(MaterialModel::Linear, 1e5, 0.4)}};
+  AxisymmetricMeshOptions o;
+  o.radius_m = 1e-3;
+  o.h_m = 2e-5;
+  o.fine_radius_m = 5e-5;
+  o.fine_depth_m = 1e-4;
+  o.elements_through_top = 5;
+  o.depth_breaks_m = {137e-6};
+  const AxisymmetricMesh mesh = make_axisymmetric_mesh(layers, o);
+  int rows_in_top = 0;
+  bool break_row = false;
+  for (std::uint32_t node : mesh.axis_nodes) {
+    const double depth = -mesh.nodes[node].y();
+    if (depth < 20e-6 - 1e-12) ++rows_in_top;  // corner and mid-edge rows above the interface
+    break_row = break_row || std::abs(depth - 137e-6) < 1e-12;
+  }
+  EXPECT_EQ(rows_in_top, 2 * 5);
+  EXPECT_TRUE(break_row);
+}
+
+TEST(AxisymmetricInsertion, OnStepReturningFalseStopsTheInsertion) {
+  AxisymmetricProblem p = punch_problem();
+  p.output_steps = 6;
+  int calls = 0;
+  p.on_step = [&calls](const InsertionStep& s) {
+    EXPECT_GT(s.depth_m, 0.0);
+    return ++calls < 3;
+  };
+  const InsertionResult r = simulate_axisymmetric(p);
+  EXPECT_EQ(calls, 3);
+  ASSERT_EQ(r.steps.size(), 3u);
+  EXPECT_NEAR(r.steps.back().depth_m, 1e-6, 1e-15);
+}
+
+// Homogeneous deformation u_r = a r, u_z = b z prescribed on the boundary: the stress is uniform,
+// so its average over any ball is the closed-form principal value.
+Eigen::VectorXd homogeneous_solution(AxisymmetricModel& fe, double a, double b) {
+  const AxisymmetricMesh& mesh = fe.mesh();
+  std::vector<std::uint32_t> dofs;
+  std::vector<double> values;
+  for (std::uint32_t node = 0; node < mesh.nodes.size(); ++node)
+    for (int c = 0; c < 2; ++c) {
+      dofs.push_back(2 * node + c);
+      values.push_back(c == 0 ? a * mesh.nodes[node].x() : b * mesh.nodes[node].y());
+    }
+  return fe
+      .solve(dofs, Eigen::Map<const Eigen::VectorXd>(values.data(), values.size()),
+             Eigen::VectorXd::Zero(fe.dof_count()))
+      .displacement;
+}
+
+AxisymmetricModel small_model(const MaterialParameters& m) {
+  AxisymmetricMeshOptions o;
+  o.radius_m = 1e-3;
+  o.h_m = 1e-4;
+  o.fine_radius_m = 3e-4;
+  o.fine_depth_m = 3e-4;
+  return AxisymmetricModel(make_axisymmetric_mesh({{2e-4, m}, {8e-4, m}}, o), {m, m});
+}
+
+TEST(AxisymmetricTipStress, UniformLinearStressAveragesToItsPrincipalValue) {
+  const MaterialParameters m = material(MaterialModel::Linear, 1e5, 0.3);
+  AxisymmetricModel fe = small_model(m);
+  const double a = 1e-3, b = -3e-3;
+  const Eigen::VectorXd u = homogeneous_solution(fe, a, b);
+  const Material law(m);
+  const double tr = 2 * a + b;
+  const double hoop = law.lambda() * tr + 2 * law.mu() * a;  // = sigma_rr, the largest here
+  const double axial = law.lambda() * tr + 2 * law.mu() * b;
+  ASSERT_GT(hoop, axial);
+  for (double length : {5e-5, 1.5e-4, 5e-4}) {
+    const double s = fe.averaged_max_principal_stress(u, Eigen::Vector2d::Zero(), length, 0);
+    EXPECT_NEAR(s, hoop, 1e-9 * std::abs(hoop)) << "length " << length;
+  }
+  // Layer 1 lies 200 um below the surface point: out of reach of a 100 um ball.
+  EXPECT_EQ(fe.averaged_max_principal_stress(u, Eigen::Vector2d::Zero(), 1e-4, 1), 0.0);
+  EXPECT_THROW(fe.averaged_max_principal_stress(u, Eigen::Vector2d::Zero(), 0.0, 0), InputError);
+}
+
+TEST(AxisymmetricTipStress, NeoHookeanAverageIsTheCauchyStress) {
+  const MaterialParameters m = material(MaterialModel::NeoHookean, 1e5, 0.3);
+  AxisymmetricModel fe = small_model(m);
+  const double a = 0.05, b = 0.2;  // stretch 1.05 radially and in hoop, 1.2 axially
+  const Eigen::VectorXd u = homogeneous_solution(fe, a, b);
+  const Material law(m);
+  const double J = (1 + a) * (1 + a) * (1 + b);
+  // Compressible neo-Hookean: sigma = (mu (B - I) + lambda ln J I) / J, B = F F^T.
+  const double axial = (law.mu() * ((1 + b) * (1 + b) - 1) + law.lambda() * std::log(J)) / J;
+  const double s = fe.averaged_max_principal_stress(u, Eigen::Vector2d::Zero(), 1.5e-4, 0);
+  EXPECT_NEAR(s, axial, 1e-9 * std::abs(axial));
+}
+
+// A cone on paper A's stiff stratum corneum: the bent plate's averaged stress is tensile and
+// converges under refinement once the averaging length spans several elements.
+TEST(AxisymmetricTipStress, ConeOnStiffLayerConvergesUnderRefinement) {
+  auto run = [](Fidelity f) {
+    AxisymmetricProblem p;
+    p.layers = {{15e-6, material(MaterialModel::Linear, 1e9, 0.4)},
+                {100e-6, material(MaterialModel::Linear, 0.134e6, 0.4)},
+                {1035e-6, material(MaterialModel::Linear, 0.08e6, 0.4)}};
+    p.radius_m = equal_area_radius(3e-3);
+    p.needle = AxisymmetricNeedle::cone(std::atan(115.0 / 1000.0), 115e-6);
+    p.depth_m = 100e-6;
+    p.fidelity = f;
+    p.output_steps = 2;
+    p.stress_average_length_m = 30e-6;
+    return simulate_axisymmetric(p).steps.back().tip_stress_Pa;
+  };
+  const double fast = run(Fidelity::Fast), standard = run(Fidelity::Standard);
+  std::cout << "tip stress fast " << fast << " standard " << standard << " Pa\n";
+  EXPECT_GT(standard, 0.0);
+  EXPECT_NEAR(fast / standard, 1.0, 0.1);
+}
+
+TEST(AxisymmetricVtu, WritesOneParaViewFilePerStepWithAllFields) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mneedle_axi_vtu_test";
+  std::filesystem::remove_all(dir);
+  AxisymmetricProblem p = punch_problem(MaterialModel::NeoHookean);
+  p.output_steps = 2;
+  p.vtu_directory = dir.string();
+  const InsertionResult r = simulate_axisymmetric(p);
+  for (int k = 1; k <= 2; ++k) {
+    std::ifstream in(dir / ("step_" + std::to_string(k) + ".vtu"));
+    ASSERT_TRUE(in) << "step " << k;
+    std::stringstream text;
+    text << in.rdbuf();
+    const std::string s = text.str();
+    EXPECT_NE(s.find("NumberOfPoints=\"" + std::to_string(r.nodes) + "\""), std::string::npos);
+    EXPECT_NE(s.find("NumberOfCells=\"" + std::to_string(r.elements) + "\""), std::string::npos);
+    for (const char* name :
+         {"displacement_m", "von_mises_Pa", "energy_density_J_per_m3", "Name=\"layer\"", "\n22\n"})
+      EXPECT_NE(s.find(name), std::string::npos) << name;
+    EXPECT_EQ(s.find("nan"), std::string::npos);
+    EXPECT_EQ(s.find("inf"), std::string::npos);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "step_3.vtu"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(AxisymmetricVtu, EnergyDensityIntegratesToTheStrainEnergy) {
+  const MaterialParameters m = material(MaterialModel::NeoHookean, 1e5, 0.3);
+  AxisymmetricModel fe = small_model(m);
+  const Eigen::VectorXd u = homogeneous_solution(fe, 0.02, -0.05);
+  double energy = 0.0;
+  fe.internal_force(u, &energy, nullptr);
+  const std::vector<double> w = fe.energy_density(u);
+  const std::vector<double> vm = fe.von_mises(u);
+  // Uniform field: every element carries the same density and stress.
+  for (std::size_t e = 1; e < w.size(); ++e) {
+    EXPECT_NEAR(w[e], w[0], 1e-9 * w[0]);
+    EXPECT_NEAR(vm[e], vm[0], 1e-9 * vm[0]);
+  }
+  const double volume = kPi * 1e-3 * 1e-3 * 1e-3;
+  EXPECT_NEAR(w[0] * volume, energy, 1e-9 * energy);
+}
+
+TEST(AxisymmetricCrack, RingCrackDoublesTheLineNodesExceptTheFront) {
+  const MaterialParameters m = material(MaterialModel::Linear, 1e5, 0.3);
+  AxisymmetricMeshOptions o;
+  o.radius_m = 1e-3;
+  o.h_m = 2.5e-5;
+  o.fine_radius_m = 2e-4;
+  o.fine_depth_m = 2e-4;
+  o.radial_breaks_m = {1e-4};
+  o.depth_breaks_m = {1e-4};
+  const AxisymmetricMesh mesh = make_axisymmetric_mesh({{1e-3, m}}, o);
+  double area = 0.0;
+  const AxisymmetricMesh cracked = crack_axisymmetric_mesh(mesh, 1e-4, 1e-4, &area);
+  // 4 elements of 25 um down the line: 9 nodes, the front shared -> 8 copies.
+  EXPECT_EQ(cracked.nodes.size(), mesh.nodes.size() + 8);
+  // The outer copy of the mouth node is not a contact node: the needle presses the inside.
+  EXPECT_EQ(cracked.surface_nodes, mesh.surface_nodes);
+  EXPECT_NEAR(area, 2 * kPi * 1e-4 * 1e-4, 1e-20);
+  // No element uses both copies of a node: the faces are free.
+  EXPECT_THROW(crack_axisymmetric_mesh(mesh, 1.1e-4, 1e-4, nullptr), InputError);  // no column
+  EXPECT_THROW(crack_axisymmetric_mesh(mesh, 1e-4, 1.1e-4, nullptr), InputError);  // no row
+}
+
+AxisymmetricProblem cracked_punch(Fidelity f, MaterialModel model, double depth) {
+  AxisymmetricProblem p = punch_problem(model);
+  p.fidelity = f;
+  p.depth_m = depth;
+  p.crack_depth_m = 2e-5;  // c = a / 5 at the punch edge
+  return p;
+}
+
+TEST(AxisymmetricCrack, EnergyReleaseRateIsPositiveAndQuadraticInDepth) {
+  const InsertionResult r =
+      simulate_axisymmetric(cracked_punch(Fidelity::Fast, MaterialModel::Linear, 2e-6));
+  ASSERT_EQ(r.steps.size(), 2u);
+  const double G1 = r.steps[0].energy_release_rate_J_per_m2;
+  const double G2 = r.steps[1].energy_release_rate_J_per_m2;
+  EXPECT_NEAR(r.steps[1].crack_area_m2, 2 * kPi * 1e-4 * 2e-5, 1e-18);
+  EXPECT_GT(G1, 0.0);
+  // Linear, every node under the flat face captured at once: U and G scale with d^2.
+  EXPECT_NEAR(G2 / G1, 4.0, 4e-6);
+}
+
+TEST(AxisymmetricCrack, EnergyReleaseRateConvergesUnderRefinement) {
+  std::vector<double> G;
+  for (Fidelity f : {Fidelity::Fast, Fidelity::Standard, Fidelity::Fine})
+    G.push_back(simulate_axisymmetric(cracked_punch(f, MaterialModel::Linear, 2e-6))
+                    .steps.back()
+                    .energy_release_rate_J_per_m2);
+  std::cout << "G fast " << G[0] << " standard " << G[1] << " fine " << G[2] << " J/m^2\n";
+  EXPECT_LT(std::abs(G[2] - G[1]), std::abs(G[1] - G[0]));
+  EXPECT_NEAR(G[2] / G[1], 1.0, 0.05);
+}
+
+TEST(AxisymmetricCrack, NonlinearTwinMatchesLinearAtSmallStrain) {
+  const double linear =
+      simulate_axisymmetric(cracked_punch(Fidelity::Fast, MaterialModel::Linear, 1e-8))
+          .steps.back()
+          .energy_release_rate_J_per_m2;
+  const double neo =
+      simulate_axisymmetric(cracked_punch(Fidelity::Fast, MaterialModel::NeoHookean, 1e-8))
+          .steps.back()
+          .energy_release_rate_J_per_m2;
+  // Strain ~ d / a = 1e-4: the models differ by O(strain) in U; G is a difference of two U
+  // about 10 % apart, so the relative difference grows to ~1e-3.
+  EXPECT_NEAR(neo / linear, 1.0, 1e-2);
+}
+
+TEST(AxisymmetricCrack, ConeCrackRadiusIsTheFootprintAtTheFinalDepth) {
+  const AxisymmetricNeedle cone = AxisymmetricNeedle::cone(kPi / 4, 1e-3);
+  EXPECT_NEAR(ring_crack_radius(cone, 2e-4), 2e-4, 1e-15);
+  EXPECT_NEAR(ring_crack_radius(AxisymmetricNeedle::flat_punch(1e-4), 5e-5), 1e-4, 1e-18);
+  EXPECT_NEAR(ring_crack_radius(cone, 5e-3), 1e-3, 1e-15);  // beyond the cone: its base
+  AxisymmetricProblem p;
+  p.layers = {{2e-3, material(MaterialModel::Linear, 1e5, 0.3)}};
+  p.radius_m = 2e-3;
+  p.needle = cone;
+  p.depth_m = 1e-4;
+  p.fidelity = Fidelity::Fast;
+  p.output_steps = 2;
+  p.crack_depth_m = 3e-5;
+  const InsertionResult r = simulate_axisymmetric(p);
+  EXPECT_GT(r.steps.back().energy_release_rate_J_per_m2, 0.0);
+  EXPECT_NEAR(r.steps.back().crack_area_m2, 2 * kPi * 1e-4 * 3e-5, 1e-18);
+}
+
+}  // namespace
+}  // namespace mneedle::fe

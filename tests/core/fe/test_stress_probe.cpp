@@ -1,0 +1,162 @@
+#include "mneedle/fe/stress_probe.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+
+#include "mneedle/error.h"
+#include "mneedle/fe/indentation3d.h"
+#include "mneedle/fe/material.h"
+#include "mneedle/fe/tissue_mesh.h"
+#include "needle_meshes.h"
+
+namespace {
+
+using namespace mneedle::fe;
+
+// 1 x 1 mm block: a 0.2 mm top layer on a 0.8 mm substrate, graded toward the centre.
+TetMesh two_layer_block(int order, double nu, MaterialModel model = MaterialModel::Linear) {
+  TissueBlockSpec spec;
+  spec.size_x = spec.size_y = 1e-3;
+  spec.layers = {{"top", 0.2e-3, {model, 1e6, nu, 0.0, 0.0}},
+                 {"bottom", 0.8e-3, {model, 1e5, nu, 0.0, 0.0}}};
+  spec.sites = {{0.0, 0.0, 0.1e-3}};
+  spec.fidelity = Fidelity::Fast;
+  spec.order = order;
+  spec.insertion_depth = 0.2e-3;
+  return generate_tissue_mesh(spec);
+}
+
+// Nodal values of a displacement field given as a function of the reference position.
+template <typename Field>
+Eigen::VectorXd interpolate(const TetMesh& mesh, Field field) {
+  Eigen::VectorXd u(3 * static_cast<Eigen::Index>(mesh.nodes.size()));
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n)
+    u.segment<3>(3 * static_cast<Eigen::Index>(n)) = field(mesh.nodes[n]);
+  return u;
+}
+
+double max_principal(const Eigen::Matrix3d& sigma) {
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(sigma).eigenvalues().maxCoeff();
+}
+
+class StressProbeOrder : public ::testing::TestWithParam<int> {};
+
+TEST_P(StressProbeOrder, UniformStrainGivesTheExactMaxPrincipalStress) {
+  const double E = 1e6, nu = 0.3;
+  const TetMesh mesh = two_layer_block(GetParam(), nu);
+  Eigen::Matrix3d gradient;
+  gradient << 1e-3, 4e-4, -2e-4, 1e-4, -5e-4, 3e-4, 2e-4, 0.0, 2e-3;
+  const Eigen::VectorXd u =
+      interpolate(mesh, [&](const Eigen::Vector3d& x) { return Eigen::Vector3d(gradient * x); });
+  const Eigen::Matrix3d strain = 0.5 * (gradient + gradient.transpose());
+  const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
+  const Eigen::Matrix3d sigma =
+      lambda * strain.trace() * Eigen::Matrix3d::Identity() + 2 * mu * strain;
+  const double expected = max_principal(sigma);
+  const double probed = averaged_max_principal_stress(mesh, u, {0.0, 0.0, 0.0}, 0.1e-3, 0);
+  EXPECT_NEAR(probed, expected, 1e-9 * std::abs(expected));
+  // A reach beyond the whole block averages the whole layer: still the same constant.
+  EXPECT_NEAR(averaged_max_principal_stress(mesh, u, {0.0, 0.0, 0.0}, 1.0, 0), expected,
+              1e-9 * std::abs(expected));
+}
+
+INSTANTIATE_TEST_SUITE_P(Orders, StressProbeOrder, ::testing::Values(1, 2));
+
+// u_x = k x^2 / 2 with nu = 0: sigma_xx = E k x, the other components zero, so the max principal
+// stress is E k x where x > 0. Its mean over a half-ball centred at x0 (on the surface) is E k x0.
+// A 10-node element reproduces the quadratic field exactly; what is left is the volume error of
+// cutting the sphere out of the elements (split 4 levels deep: ~1e-3 of the volume).
+TEST(StressProbe, LinearStressFieldAveragesToItsCentreValue) {
+  const double E = 1e6, k = 2.0;
+  const TetMesh mesh = two_layer_block(2, 0.0);
+  const Eigen::VectorXd u = interpolate(mesh, [&](const Eigen::Vector3d& x) {
+    return Eigen::Vector3d(0.5 * k * x.x() * x.x(), 0.0, 0.0);
+  });
+  const double x0 = 0.25e-3, reach = 0.1e-3;
+  const double probed = averaged_max_principal_stress(mesh, u, {x0, 0.05e-3, 0.0}, reach, 0);
+  EXPECT_NEAR(probed, E * k * x0, 3e-3 * E * k * x0);
+}
+
+TEST(StressProbe, LayerOutOfReachGivesZero) {
+  const TetMesh mesh = two_layer_block(2, 0.3);
+  const Eigen::VectorXd u = interpolate(
+      mesh, [](const Eigen::Vector3d& x) { return Eigen::Vector3d(1e-3 * x.x(), 0.0, 0.0); });
+  // 0.05 mm around a surface point does not reach the substrate below 0.2 mm ...
+  EXPECT_EQ(averaged_max_principal_stress(mesh, u, {0.0, 0.0, 0.0}, 0.05e-3, 1), 0.0);
+  // ... and 0.05 mm around a point 0.5 mm deep does not reach the top layer.
+  EXPECT_EQ(averaged_max_principal_stress(mesh, u, {0.0, 0.0, -0.5e-3}, 0.05e-3, 0), 0.0);
+  EXPECT_GT(averaged_max_principal_stress(mesh, u, {0.0, 0.0, -0.5e-3}, 0.05e-3, 1), 0.0);
+}
+
+// Only the stress of the chosen layer enters: the substrate's strain is ignored even when the
+// sphere reaches deep into it.
+TEST(StressProbe, AveragesOnlyTheChosenLayer) {
+  const TetMesh mesh = two_layer_block(1, 0.0);
+  const Eigen::VectorXd u = interpolate(mesh, [](const Eigen::Vector3d& x) {
+    // Stretch in x only below z = -0.2 mm (piecewise linear in z, continuous).
+    return Eigen::Vector3d(x.z() < -0.2e-3 ? -1e-3 * (x.z() + 0.2e-3) * x.x() / 1e-3 : 0.0, 0.0,
+                           0.0);
+  });
+  EXPECT_NEAR(averaged_max_principal_stress(mesh, u, {0.0, 0.0, 0.0}, 0.15e-3, 0), 0.0, 1e-6);
+}
+
+TEST(StressProbe, LargeStrainUsesTheCauchyStress) {
+  // Neo-Hookean uniaxial-like stretch: the probe must agree with sigma = F S F^T / J.
+  const TetMesh mesh = two_layer_block(1, 0.3, MaterialModel::NeoHookean);
+  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+  F(0, 0) = 1.3;
+  F(1, 1) = 0.9;
+  F(2, 2) = 0.95;
+  const Eigen::VectorXd u = interpolate(mesh, [&](const Eigen::Vector3d& x) {
+    return Eigen::Vector3d((F - Eigen::Matrix3d::Identity()) * x);
+  });
+  const Material material({MaterialModel::NeoHookean, 1e6, 0.3, 0.0, 0.0});
+  const Eigen::Matrix3d S = material.evaluate(F).S;
+  const double expected = max_principal(F * S * F.transpose() / F.determinant());
+  EXPECT_NEAR(averaged_max_principal_stress(mesh, u, {0.0, 0.0, 0.0}, 0.1e-3, 0), expected,
+              1e-9 * expected);
+}
+
+TEST(StressProbe, RejectsBadLengthAndLayer) {
+  const TetMesh mesh = two_layer_block(1, 0.3);
+  const Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(mesh.nodes.size()));
+  EXPECT_THROW(averaged_max_principal_stress(mesh, u, {0, 0, 0}, 0.0, 0), mneedle::InputError);
+  EXPECT_THROW(averaged_max_principal_stress(mesh, u, {0, 0, 0}, NAN, 0), mneedle::InputError);
+  EXPECT_THROW(averaged_max_principal_stress(mesh, u, {0, 0, 0}, 1e-4, 2), mneedle::InputError);
+  EXPECT_THROW(averaged_max_principal_stress(mesh, Eigen::VectorXd::Zero(3), {0, 0, 0}, 1e-4, 0),
+               mneedle::InputError);
+}
+
+// Regression of the refinement study (docs/_parts/crack-validation.md, c): under a sharp cone the
+// stress at the tip point keeps growing as the mesh refines while its 50 um mean settles; from
+// 50 to 30 um tip elements (TET4) the local value moved 39%, the mean 15%.
+double tip_stress(double tip_size, double length_or_zero) {
+  TissueBlockSpec block;
+  block.size_x = block.size_y = 3e-3;
+  block.layers = {{"block", 1.5e-3, {MaterialModel::Linear, 1e6, 0.45, 0.0, 0.0}}};
+  block.sites = {{0.0, 0.0, 115e-6}};
+  block.order = 1;
+  block.insertion_depth = 200e-6;
+  block.overrides.tip_size_m = tip_size;
+  block.half_y = true;
+  const TetMesh mesh = generate_tissue_mesh(block);
+  Indentation3d run(
+      mesh, {{"cone", mneedle::test::cone_needle(std::acos(-1.0) / 6, 115e-6, 1e-3), 0.0, 0.0}},
+      200e-6);
+  for (int k = 1; k <= 5; ++k) run.advance_to(200e-6 * k / 5);
+  const double length = length_or_zero > 0.0 ? length_or_zero : 0.25 * tip_size;
+  return averaged_max_principal_stress(mesh, run.displacement(), {0, 0, 0}, length, 0);
+}
+
+TEST(StressProbe, AveragedTipStressMovesLessUnderRefinementThanTheLocalValue) {
+  const double mean_coarse = tip_stress(50e-6, 50e-6), mean_fine = tip_stress(30e-6, 50e-6);
+  const double local_coarse = tip_stress(50e-6, 0.0), local_fine = tip_stress(30e-6, 0.0);
+  const double mean_change = std::abs(mean_fine / mean_coarse - 1.0);
+  const double local_change = std::abs(local_fine / local_coarse - 1.0);
+  EXPECT_LT(mean_change, 0.25);
+  EXPECT_GT(local_change, 2.0 * mean_change);
+}
+
+}  // namespace
