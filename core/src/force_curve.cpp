@@ -44,8 +44,24 @@ std::string where(const std::string& source, std::size_t line) {
   return source + ":" + std::to_string(line);
 }
 
+// The unit written in brackets at the end of a column name ("z [mm]" -> "mm"), or "".
+std::string bracketed_unit(const std::string& column) {
+  if (column.size() < 3) return {};
+  const char close = column.back();
+  const char open = close == ']' ? '[' : close == ')' ? '(' : '\0';
+  const auto at = open ? column.rfind(open) : std::string::npos;
+  if (at == std::string::npos) return {};
+  return trim(column.substr(at + 1, column.size() - at - 2));
+}
+
+// The column name without a bracketed unit ("z [mm]" -> "z").
+std::string name_without_unit(const std::string& column) {
+  if (bracketed_unit(column).empty()) return column;
+  return trim(column.substr(0, column.find_last_of(column.back() == ']' ? '[' : '(')));
+}
+
 // Index of the column called `wanted`, or (when empty) of the first column starting with one of
-// `prefixes` followed by '_' or the end of the name.
+// `prefixes` followed by '_' or the end of the name (a bracketed unit not counted).
 std::optional<std::size_t> find_column(const std::vector<std::string>& header,
                                        const std::string& wanted,
                                        const std::vector<std::string>& prefixes) {
@@ -54,7 +70,7 @@ std::optional<std::size_t> find_column(const std::vector<std::string>& header,
       if (header[i] == wanted) return i;
       continue;
     }
-    const auto name = lower(header[i]);
+    const auto name = lower(name_without_unit(header[i]));
     for (const auto& p : prefixes) {
       if (name == p || name.rfind(p + "_", 0) == 0) return i;
     }
@@ -71,10 +87,10 @@ std::size_t require_column(const std::vector<std::string>& header, const std::st
   throw InputError(where(source, 1) + ": " + asked + " (columns: " + joined(header) + ")");
 }
 
-// SI factor of a column from an explicit unit or the suffix after the last '_'.
+// SI factor of a column from an explicit unit, a bracketed unit or the suffix after the last '_'.
 double column_scale(const std::string& column, const std::string& unit, Dimension dimension,
                     const std::string& source) {
-  std::string text = unit;
+  std::string text = unit.empty() ? bracketed_unit(column) : unit;
   if (text.empty()) {
     const auto underscore = column.rfind('_');
     if (underscore == std::string::npos) {
@@ -156,8 +172,9 @@ ForceCurve read_force_curve_csv(const std::filesystem::path& file, const CurveCo
   }
   if (header.empty()) throw InputError(curve.source + ":1: empty file, no header line");
   const std::size_t header_line = line_number;
-  const auto depth_col = require_column(
-      header, columns.depth, {"depth", "travel", "displacement", "z"}, "depth", curve.source);
+  const auto depth_col =
+      require_column(header, columns.depth, {"depth", "travel", "position", "displacement", "z"},
+                     "depth", curve.source);
   const auto force_col =
       require_column(header, columns.force, {"force", "fz", "f"}, "force", curve.source);
   const auto time_col = find_column(header, columns.time, {"time", "t"});
@@ -242,6 +259,28 @@ LoadingBranch extract_loading_branch(const ForceCurve& raw, const LoadingBranchO
   for (auto& f : b.curve.force_N) f -= b.baseline_N;
   b.summary = describe_cut(raw, b);
   return b;
+}
+
+MonotoneCurve merge_repeated_depths(const ForceCurve& curve) {
+  MonotoneCurve out;
+  out.curve.source = curve.source;
+  const bool timed = curve.time_s.size() == curve.depth_m.size();
+  std::size_t members = 0;  // samples in the current group
+  for (std::size_t i = 0; i < curve.depth_m.size(); ++i) {
+    const double z = curve.depth_m[i];
+    if (members > 0 && z <= out.curve.depth_m.back()) {
+      ++(z == out.curve.depth_m.back() ? out.repeated_samples : out.receding_samples);
+      auto& mean = out.curve.force_N.back();
+      mean += (curve.force_N[i] - mean) / static_cast<double>(++members);
+      continue;
+    }
+    out.curve.depth_m.push_back(z);
+    out.curve.force_N.push_back(curve.force_N[i]);
+    if (timed) out.curve.time_s.push_back(curve.time_s[i]);
+    if (i < curve.line.size()) out.curve.line.push_back(curve.line[i]);
+    members = 1;
+  }
+  return out;
 }
 
 ForceCurve hold_segment(const ForceCurve& raw, const LoadingBranch& branch) {

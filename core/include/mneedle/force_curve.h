@@ -19,9 +19,11 @@ struct ForceCurve {
   std::vector<std::size_t> line;  ///< 1-based line of each sample in the source file
 };
 
-/// Which CSV columns to read. An empty name picks the first column whose name starts with one of
-/// the usual prefixes (depth: depth, travel, displacement, z; force: force, fz, f; time: time, t).
-/// An empty unit is read from the column name's suffix after the last '_' (`travel_mm`, `fz_N`).
+/// Which CSV columns to read. An empty name picks the first column whose name (without its unit)
+/// is, or starts with followed by '_', one of the usual prefixes (depth: depth, travel, position,
+/// displacement, z; force: force, fz, f; time: time, t). An empty unit is read from the column
+/// name: a trailing `[unit]` or `(unit)` (`z [mm]`, `Force (mN)`), else the suffix after the last
+/// '_' (`travel_mm`, `fz_N`). A name without either needs the unit given explicitly.
 struct CurveColumns {
   std::string depth;
   std::string force;
@@ -61,6 +63,17 @@ struct LoadingBranch {
 /// noise, or the needle does not advance after contact).
 LoadingBranch extract_loading_branch(const ForceCurve& raw,
                                      const LoadingBranchOptions& options = {});
+
+/// A curve whose depth only increases: each sample that does not go deeper than every sample
+/// before it (a repeated depth, or a digitising step back) is merged into the point it fails to
+/// pass, whose force becomes the mean of the merged samples.
+struct MonotoneCurve {
+  ForceCurve curve;  ///< strictly increasing depth; time and line of each group's first sample
+  std::size_t repeated_samples = 0;  ///< merged samples at exactly the group's depth
+  std::size_t receding_samples = 0;  ///< merged samples shallower than the group's depth
+};
+
+MonotoneCurve merge_repeated_depths(const ForceCurve& curve);
 
 /// Samples of `raw` after the loading branch while the travel stays at its maximum, as
 /// (time from the end of loading, force minus baseline). Empty without a time column.
