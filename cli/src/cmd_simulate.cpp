@@ -1,26 +1,26 @@
-// `mneedle simulate SCENE [--fidelity ...] [--contact ...] [--json|--csv]`: the pre-puncture
-// finite element stage. An axisymmetric needle (cylinder or cone plugin) alone runs on the
-// axisymmetric model; bevels, STL needles and arrays run on the 3-D tetrahedral model.
+// `mneedle simulate SCENE [--fidelity ...] [--contact ...] [--criterion ...] [--model ...]
+// [--json|--csv] [--vtu DIR]`: the two-stage insertion of paper A (run_insertion). The scene
+// planner picks the pre-puncture model (axisymmetric for one needle of revolution on the axis,
+// a half 3-D model for mirror-symmetric needles on y = 0, the full 3-D block otherwise), stops it
+// where the puncture criterion fires, and continues with the post-puncture surface loads.
 #include <CLI/CLI.hpp>
 
-#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "commands.h"
+#include "json_output.h"
 #include "mneedle/design_source.h"
 #include "mneedle/error.h"
-#include "mneedle/fe/axisymmetric.h"
-#include "mneedle/fe/indentation3d.h"
+#include "mneedle/fe/tissue_mesh.h"
+#include "mneedle/insertion_run.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene.h"
-#include "mneedle/units.h"
 
 namespace mneedle::cli {
 namespace {
@@ -29,274 +29,221 @@ struct SimulateOptions {
   std::filesystem::path scene;
   std::string fidelity;
   std::string contact;
+  std::string criterion;
   std::string model = "auto";
   std::string vtu;
   bool json = false;
   bool csv = false;
 };
 
-fe::MaterialModel to_fe(MaterialModel m) {
-  switch (m) {
-    case MaterialModel::Linear:
-      return fe::MaterialModel::Linear;
-    case MaterialModel::StVenantKirchhoff:
-      return fe::MaterialModel::StVenantKirchhoff;
-    case MaterialModel::NeoHookean:
-      return fe::MaterialModel::NeoHookean;
-    case MaterialModel::MooneyRivlin:
-      return fe::MaterialModel::MooneyRivlin;
+fe::Fidelity to_fe(Fidelity f) {
+  return f == Fidelity::Fast   ? fe::Fidelity::Fast
+         : f == Fidelity::Fine ? fe::Fidelity::Fine
+                               : fe::Fidelity::Standard;
+}
+
+InsertionRunOptions run_options(const Scene& scene, const SimulateOptions& o) {
+  InsertionRunOptions r;
+  r.fidelity = to_fe(scene.model.fidelity);
+  if (o.fidelity == "fast") r.fidelity = fe::Fidelity::Fast;
+  if (o.fidelity == "standard") r.fidelity = fe::Fidelity::Standard;
+  if (o.fidelity == "fine") r.fidelity = fe::Fidelity::Fine;
+  r.contact = scene.model.contact;
+  if (o.contact == "sticking") r.contact = Contact::Sticking;
+  if (o.contact == "frictionless") r.contact = Contact::Frictionless;
+  r.criterion = scene.model.criterion;
+  if (o.criterion == "pressure") r.criterion = PunctureCriterion::Pressure;
+  if (o.criterion == "energy") r.criterion = PunctureCriterion::Energy;
+  if (o.criterion == "stress") r.criterion = PunctureCriterion::Stress;
+  r.model = o.model == "analytic"       ? PreModel::Analytic
+            : o.model == "axisymmetric" ? PreModel::Axisymmetric
+            : o.model == "3d"           ? PreModel::Full3d
+                                        : PreModel::Auto;
+  r.vtu_directory = o.vtu;
+  if (r.vtu_directory.empty() && scene.model.wants(Output::Fields)) {
+    // The scene asks for fields: write them beside the working directory, named after it.
+    r.vtu_directory = o.scene.stem().string() + "_fields";
+    std::cerr << "mneedle: the scene asks for fields: writing VTU files to " << r.vtu_directory
+              << "/\n";
   }
-  return fe::MaterialModel::Linear;
+  return r;
 }
 
-std::vector<fe::AxisymmetricLayer> layers_of(const Scene& scene) {
-  std::vector<fe::AxisymmetricLayer> layers;
-  for (const TissueLayer& l : scene.tissue.layers) {
-    fe::MaterialParameters p;
-    p.model = to_fe(l.material.model);
-    p.E = l.material.youngs_modulus;
-    p.nu = l.material.poisson_ratio;
-    p.c10 = l.material.c10;
-    p.c01 = l.material.c01;
-    try {
-      fe::Material check(p);
-    } catch (const InputError& e) {
-      throw InputError(scene.source_name + ":" + std::to_string(l.line) + ": layer '" + l.name +
-                       "': " + e.what());
-    }
-    layers.push_back({l.thickness, p});
+const char* stage_name(Stage s) {
+  return s == Stage::Pre ? "pre" : "post";
+}
+
+nlohmann::json point_json(const RunPoint& p, std::optional<PunctureCriterion> criterion) {
+  nlohmann::json j = {
+      {"depth_m", p.depth_m}, {"force_N", p.force_N}, {"stage", stage_name(p.stage)}};
+  if (p.stage == Stage::Pre) {
+    j["lateral_force_N"] = {p.lateral_force_N[0], p.lateral_force_N[1]};
+    j["contact_area_m2"] = p.contact_area_m2;
+    j["contact_pressure_Pa"] = p.contact_pressure_Pa;
+    j["strain_energy_J"] = p.strain_energy_J;
+    if (criterion == PunctureCriterion::Stress) j["tip_stress_Pa"] = p.tip_stress_Pa;
+    if (criterion == PunctureCriterion::Energy)
+      j["energy_release_rate_J_per_m2"] = p.energy_release_rate_J_per_m2;
+  } else {
+    j["alpha_N"] = p.alpha_N;
+    j["beta_N"] = p.beta_N;
+    j["friction_N"] = p.friction_N;
   }
-  return layers;
+  return j;
 }
 
-// The needle's outer profile from the plugin's section area A(h) = pi (r_out^2 - r_bore^2).
-fe::AxisymmetricNeedle axisymmetric_needle(const Scene& scene, const NeedleSpec& spec,
-                                           const PluginRegistry& registry) {
-  const std::string where =
-      scene.source_name + ":" + std::to_string(spec.line) + ": needle '" + spec.name + "'";
-  const auto* plugin = std::get_if<PluginGeometry>(&spec.geometry);
-  if (plugin == nullptr || (plugin->plugin != "cylinder" && plugin->plugin != "cone"))
-    throw InputError(where +
-                     ": only the axisymmetric cylinder and cone plugins can be simulated yet; "
-                     "this needle needs the 3-D model");
-  std::map<std::string, double> si;
-  for (const auto& [name, quantity] : plugin->parameters) si[name] = quantity.value_si;
-  const PluginShapeInfo& shape = registry.shape(plugin->plugin);
-  const std::vector<double> values = registry.resolve_parameters(plugin->plugin, si);
-  std::map<std::string, double> resolved;
-  for (std::size_t i = 0; i < shape.parameters.size(); ++i)
-    resolved[shape.parameters[i].name] = values[i];
-  const double radius = 0.5 * resolved.at("diameter");
-  const double bore = resolved.count("bore") ? 0.5 * resolved["bore"] : 0.0;
-  if (plugin->plugin == "cylinder") return fe::AxisymmetricNeedle::flat_punch(radius, bore);
-  // Cone: sample the section so a rounded tip (tip_radius) is followed too.
-  const double length = resolved.at("length");
-  const double taper = (radius - bore) / std::tan(resolved.at("half_angle"));
-  const double top = std::min(length, 1.05 * taper);
-  fe::AxisymmetricNeedle needle;
-  needle.bore_radius_m = bore;
-  constexpr int kSamples = 200;
-  for (int i = 0; i <= kSamples; ++i) {
-    const double h = top * i / kSamples;
-    const std::optional<double> area = registry.section_area(plugin->plugin, resolved, h);
-    if (!area) throw InputError(where + ": the cone plugin gives no section area");
-    const double r = std::sqrt(std::max(*area / M_PI + bore * bore, 0.0));
-    const double previous = needle.radii_m.empty() ? 0.0 : needle.radii_m.back();
-    needle.heights_m.push_back(h);
-    needle.radii_m.push_back(std::max({r, previous, bore}));
-  }
-  return needle;
+nlohmann::json curve_json(const std::vector<RunPoint>& curve,
+                          std::optional<PunctureCriterion> criterion) {
+  nlohmann::json c = nlohmann::json::array();
+  for (const RunPoint& p : curve) c.push_back(point_json(p, criterion));
+  return c;
 }
 
-fe::Fidelity fidelity_of(const Scene& scene, const std::string& option) {
-  const std::string name = option.empty() ? std::string(to_string(scene.model.fidelity)) : option;
-  if (name == "fast") return fe::Fidelity::Fast;
-  if (name == "fine") return fe::Fidelity::Fine;
-  return fe::Fidelity::Standard;
-}
-
-fe::ContactMode contact_of(const Scene& scene, const std::string& option) {
-  const std::string name = option.empty() ? std::string(to_string(scene.model.contact)) : option;
-  return name == "frictionless" ? fe::ContactMode::Frictionless : fe::ContactMode::Sticking;
-}
-
-nlohmann::json to_json(const std::string& name, const fe::InsertionResult& r) {
-  nlohmann::json curve = nlohmann::json::array();
-  for (const fe::InsertionStep& s : r.steps)
-    curve.push_back({{"depth_m", s.depth_m},
-                     {"force_N", s.force_N},
-                     {"lateral_force_N", {0.0, 0.0}},
-                     {"contact_area_m2", s.contact_area_m2},
-                     {"contact_pressure_Pa", s.contact_pressure_Pa},
-                     {"strain_energy_J", s.strain_energy_J}});
-  return {{"needles", {{{"name", name}, {"curve", curve}}}},
-          {"mesh",
-           {{"nodes", r.nodes}, {"elements", r.elements}, {"order", 2}, {"axisymmetric", true}}}};
-}
-
-void print_csv(const fe::InsertionResult& r) {
-  std::cout << "depth_m,force_N,lateral_force_x_N,lateral_force_y_N,contact_area_m2,"
-               "contact_pressure_Pa,strain_energy_J,newton_iterations\n";
-  std::cout << std::setprecision(9);
-  for (const fe::InsertionStep& s : r.steps)
-    std::cout << s.depth_m << "," << s.force_N << ",0,0," << s.contact_area_m2 << ","
-              << s.contact_pressure_Pa << "," << s.strain_energy_J << "," << s.newton_iterations
-              << "\n";
-}
-
-void print_table(const std::string& name, const fe::InsertionResult& r) {
-  std::cout << "needle " << name << " (axisymmetric, " << r.nodes << " nodes, " << r.elements
-            << " 6-node triangles, " << std::setprecision(3) << r.solve_seconds << " s)\n";
-  std::cout << "  depth [um]   force [mN]   area [um^2]   pressure [MPa]   energy [uJ]   iter\n";
-  for (const fe::InsertionStep& s : r.steps)
-    std::cout << std::fixed << std::setprecision(2) << std::setw(12) << s.depth_m * 1e6
-              << std::setprecision(4) << std::setw(13) << s.force_N * 1e3 << std::setprecision(1)
-              << std::setw(14) << s.contact_area_m2 * 1e12 << std::setprecision(4) << std::setw(17)
-              << s.contact_pressure_Pa * 1e-6 << std::setprecision(4) << std::setw(14)
-              << s.strain_energy_J * 1e6 << std::setw(7) << s.newton_iterations << "\n";
-}
-
-bool axisymmetric_scene(const Scene& scene) {
-  if (scene.needles.size() != 1) return false;
-  const auto* plugin = std::get_if<PluginGeometry>(&scene.needles.front().geometry);
-  return plugin != nullptr && (plugin->plugin == "cylinder" || plugin->plugin == "cone");
-}
-
-fe::TissueBlockSpec block_of(const Scene& scene) {
-  fe::TissueBlockSpec block;
-  block.size_x = scene.tissue.size[0];
-  block.size_y = scene.tissue.size[1];
-  const auto layers = layers_of(scene);
-  for (std::size_t i = 0; i < layers.size(); ++i)
-    block.layers.push_back(
-        {scene.tissue.layers[i].name, layers[i].thickness_m, layers[i].material});
-  return block;
-}
-
-nlohmann::json to_json_3d(const fe::Simulation3dResult& r) {
+nlohmann::json to_json(const InsertionRun& run) {
   nlohmann::json needles = nlohmann::json::array();
-  for (std::size_t n = 0; n < (r.steps.empty() ? 0 : r.steps.front().needles.size()); ++n) {
-    nlohmann::json curve = nlohmann::json::array();
-    for (const fe::Step3d& s : r.steps) {
-      const fe::NeedleStep3d& ns = s.needles[n];
-      curve.push_back({{"depth_m", s.depth_m},
-                       {"force_N", ns.force_N},
-                       {"lateral_force_N", {ns.lateral_force_N[0], ns.lateral_force_N[1]}},
-                       {"contact_area_m2", ns.contact_area_m2},
-                       {"contact_pressure_Pa", ns.contact_pressure_Pa},
-                       {"strain_energy_J", s.strain_energy_J}});
-    }
-    needles.push_back({{"name", r.steps.front().needles[n].name}, {"curve", curve}});
+  for (const NeedleRun& n : run.needles) {
+    nlohmann::json puncture = nullptr;
+    if (n.puncture)
+      puncture = {{"depth_m", n.puncture->depth_m},
+                  {"force_N", n.puncture->force_N},
+                  {"criterion", to_string(n.puncture->criterion)},
+                  {"post_force_N", n.puncture->post_force_N}};
+    needles.push_back({{"name", n.name},
+                       {"curve", curve_json(n.curve, run.criterion)},
+                       {"puncture", puncture},
+                       {"max_force_N", n.max_force_N}});
+  }
+  nlohmann::json mesh = {{"nodes", run.nodes},
+                         {"elements", run.elements},
+                         {"order", run.order},
+                         {"axisymmetric", run.axisymmetric}};
+  if (run.min_dihedral_deg > 0.0) {
+    mesh["min_dihedral_deg"] = run.min_dihedral_deg;
+    mesh["max_aspect_ratio"] = run.max_aspect_ratio;
+  }
+  nlohmann::json reductions = nlohmann::json::array();
+  for (const Reduction& r : run.reductions) {
+    nlohmann::json j = {{"name", r.name}, {"detail", r.detail}};
+    j["measured_effect"] = r.measured_effect ? nlohmann::json(*r.measured_effect) : nullptr;
+    reductions.push_back(j);
+  }
+  nlohmann::json criterion = nullptr;
+  if (run.criterion) {
+    criterion = {{"name", to_string(*run.criterion)}, {"threshold", *run.threshold}};
+    if (*run.criterion == PunctureCriterion::Energy) criterion["crack_depth_m"] = run.crack_depth_m;
   }
   return {{"needles", needles},
-          {"mesh",
-           {{"nodes", r.nodes},
-            {"elements", r.elements},
-            {"order", r.order},
-            {"axisymmetric", false},
-            {"min_dihedral_deg", r.quality.min_dihedral_deg},
-            {"max_aspect_ratio", r.quality.max_aspect_ratio}}}};
+          {"mesh", mesh},
+          {"total_curve", curve_json(run.total_curve, std::nullopt)},
+          {"models_run", run.models_run},
+          {"reductions", reductions},
+          {"fidelity", fe::to_string(run.fidelity)},
+          {"criterion", criterion},
+          {"seconds", run.seconds}};
 }
 
-void print_3d(const fe::Simulation3dResult& r, bool csv) {
-  if (csv)
-    std::cout << "needle,depth_m,force_N,lateral_force_x_N,lateral_force_y_N,contact_area_m2,"
-                 "contact_pressure_Pa,strain_energy_J,newton_iterations\n";
-  else
-    std::cout << "3-D model: " << r.nodes << " nodes, " << r.elements << " TET"
-              << (r.order == 2 ? 10 : 4) << ", " << std::setprecision(3) << r.timing.total_s
-              << " s (" << r.solver_backend
-              << ")\n  needle          depth [um]   force [mN]   lateral x, y [mN]\n";
-  for (const fe::Step3d& s : r.steps)
-    for (const fe::NeedleStep3d& n : s.needles) {
-      if (csv) {
-        std::cout << std::setprecision(9) << n.name << "," << s.depth_m << "," << n.force_N << ","
-                  << n.lateral_force_N[0] << "," << n.lateral_force_N[1] << "," << n.contact_area_m2
-                  << "," << n.contact_pressure_Pa << "," << s.strain_energy_J << ","
-                  << s.newton_iterations << "\n";
-      } else {
-        std::cout << "  " << std::left << std::setw(14) << n.name << std::right << std::fixed
-                  << std::setprecision(2) << std::setw(12) << s.depth_m * 1e6
-                  << std::setprecision(4) << std::setw(13) << n.force_N * 1e3 << "   "
-                  << n.lateral_force_N[0] * 1e3 << ", " << n.lateral_force_N[1] * 1e3 << "\n";
-        std::cout.unsetf(std::ios::fixed);
-      }
+void print_csv(const InsertionRun& run) {
+  std::cout << "depth_m,force_N,stage,lateral_force_x_N,lateral_force_y_N,contact_area_m2,"
+               "contact_pressure_Pa,strain_energy_J,alpha_N,beta_N,friction_N,needle\n";
+  std::cout << std::setprecision(9);
+  auto rows = [](const std::vector<RunPoint>& curve, const std::string& name) {
+    for (const RunPoint& p : curve)
+      std::cout << p.depth_m << "," << p.force_N << "," << stage_name(p.stage) << ","
+                << p.lateral_force_N[0] << "," << p.lateral_force_N[1] << "," << p.contact_area_m2
+                << "," << p.contact_pressure_Pa << "," << p.strain_energy_J << "," << p.alpha_N
+                << "," << p.beta_N << "," << p.friction_N << "," << name << "\n";
+  };
+  for (const NeedleRun& n : run.needles) rows(n.curve, n.name);
+  if (run.needles.size() > 1) rows(run.total_curve, "total");
+}
+
+void print_table(const InsertionRun& run) {
+  std::cout << "models: ";
+  for (std::size_t i = 0; i < run.models_run.size(); ++i)
+    std::cout << (i ? " + " : "") << run.models_run[i];
+  std::cout << " (" << fe::to_string(run.fidelity) << ", " << std::setprecision(3) << run.seconds
+            << " s";
+  if (run.nodes > 0)
+    std::cout << "; mesh " << run.nodes << " nodes, " << run.elements << " elements"
+              << (run.axisymmetric ? ", axisymmetric" : "");
+  std::cout << ")\n";
+  for (const Reduction& r : run.reductions)
+    std::cout << "  reduction " << r.name << ": " << r.detail << "\n";
+  for (const NeedleRun& n : run.needles) {
+    std::cout << "needle " << n.name << ": ";
+    if (n.puncture)
+      std::cout << std::fixed << std::setprecision(1) << "punctures at "
+                << n.puncture->depth_m * 1e6 << " um (" << to_string(n.puncture->criterion)
+                << " criterion), force " << std::setprecision(3) << n.puncture->force_N * 1e3
+                << " mN, then " << n.puncture->post_force_N * 1e3 << " mN post-puncture";
+    else if (run.criterion)
+      std::cout << "no puncture within the insertion depth";
+    else
+      std::cout << "no puncture data in the scene: pre-puncture stage only";
+    std::cout << std::fixed << std::setprecision(3) << "; max force " << n.max_force_N * 1e3
+              << " mN\n";
+    const bool stress = run.criterion == PunctureCriterion::Stress;
+    const bool energy = run.criterion == PunctureCriterion::Energy;
+    std::cout << "  depth [um]  stage   force [mN]   pressure [MPa]"
+              << (stress   ? "   tip stress [MPa]"
+                  : energy ? "   G [J/m^2]"
+                           : "")
+              << "\n";
+    for (const RunPoint& p : n.curve) {
+      std::cout << std::setprecision(2) << std::setw(12) << p.depth_m * 1e6 << "  " << std::setw(5)
+                << stage_name(p.stage) << std::setprecision(4) << std::setw(13) << p.force_N * 1e3
+                << std::setw(17) << p.contact_pressure_Pa * 1e-6;
+      if (stress && p.stage == Stage::Pre) std::cout << std::setw(19) << p.tip_stress_Pa * 1e-6;
+      if (energy && p.stage == Stage::Pre)
+        std::cout << std::setw(13) << p.energy_release_rate_J_per_m2;
+      std::cout << "\n";
     }
-}
-
-void run_3d(const Scene& scene, const SimulateOptions& o) {
-  if (contact_of(scene, o.contact) == fe::ContactMode::Frictionless)
-    throw InputError(scene.source_name +
-                     ": model.contact: frictionless contact is not available in the 3-D model yet "
-                     "(use sticking, or an axisymmetric needle)");
-  const PluginRegistry registry = PluginRegistry::discover();
-  std::vector<fe::Needle3d> needles;
-  for (const NeedleSpec& spec : scene.needles)
-    needles.push_back({spec.name, needle_from_scene(registry, spec).mesh, spec.at[0], spec.at[1]});
-  fe::Simulation3dOptions options;
-  options.fidelity = fidelity_of(scene, o.fidelity);
-  options.depth = scene.insertion.depth;
-  options.vtu_directory = o.vtu;
-  const fe::Simulation3dResult result = fe::simulate_3d(block_of(scene), needles, options);
-  if (o.json)
-    std::cout << to_json_3d(result).dump(2) << "\n";
-  else
-    print_3d(result, o.csv);
+    std::cout.unsetf(std::ios::fixed);
+  }
 }
 
 void run(const SimulateOptions& o) {
   const Scene scene = load_scene(o.scene);
-  const bool axisymmetric =
-      o.model == "axisymmetric" || (o.model == "auto" && axisymmetric_scene(scene));
-  if (!axisymmetric || !o.vtu.empty()) {
-    if (o.model == "axisymmetric")
-      throw InputError("simulate: --vtu is written by the 3-D model only (use --model 3d)");
-    run_3d(scene, o);
-    return;
-  }
-  if (scene.needles.size() != 1)
-    throw InputError(scene.source_name + ": needles: " + std::to_string(scene.needles.size()) +
-                     " needles need the 3-D model; the axisymmetric solver takes exactly one");
   const PluginRegistry registry = PluginRegistry::discover();
-  const NeedleSpec& spec = scene.needles.front();
-  fe::AxisymmetricProblem problem;
-  problem.layers = layers_of(scene);
-  // A cylinder with the block's cross-section area (see docs: fe_model).
-  problem.radius_m = std::sqrt(scene.tissue.size[0] * scene.tissue.size[1] / M_PI);
-  problem.needle = axisymmetric_needle(scene, spec, registry);
-  problem.depth_m = scene.insertion.depth;
-  problem.fidelity = fidelity_of(scene, o.fidelity);
-  problem.contact = contact_of(scene, o.contact);
-  const fe::InsertionResult result = fe::simulate_axisymmetric(problem);
+  const InsertionRun result =
+      run_insertion(scene, prepare_needles(registry, scene), run_options(scene, o));
+  // Every format prints the numbers of this tree: check them once, before anything is printed.
+  const nlohmann::json tree = to_json(result);
+  require_finite_json(tree, o.scene.string());
   if (o.json)
-    std::cout << to_json(spec.name, result).dump(2) << "\n";
+    std::cout << tree.dump(2) << "\n";
   else if (o.csv)
     print_csv(result);
   else
-    print_table(spec.name, result);
+    print_table(result);
 }
 
 }  // namespace
 
 void add_simulate_command(CLI::App& app) {
   auto options = std::make_shared<SimulateOptions>();
-  CLI::App* cmd =
-      app.add_subcommand("simulate", "Pre-puncture finite element insertion (axisymmetric or 3-D)");
+  CLI::App* cmd = app.add_subcommand(
+      "simulate",
+      "Two-stage insertion: pre-puncture FE until the puncture criterion fires, then "
+      "the post-puncture distributed loads");
   cmd->add_option("scene", options->scene, "scene file (TOML)")->required();
   cmd->add_option("--fidelity", options->fidelity, "mesh fidelity (default: the scene's)")
       ->check(CLI::IsMember({"fast", "standard", "fine"}));
   cmd->add_option("--contact", options->contact, "needle contact (default: the scene's)")
       ->check(CLI::IsMember({"sticking", "frictionless"}));
+  cmd->add_option("--criterion", options->criterion, "puncture criterion (default: the scene's)")
+      ->check(CLI::IsMember({"pressure", "energy", "stress"}));
   cmd->add_option("--model", options->model,
-                  "auto (axisymmetric when the scene allows it), axisymmetric or 3d")
-      ->check(CLI::IsMember({"auto", "axisymmetric", "3d"}))
+                  "pre-puncture model: auto (the planner decides), analytic, axisymmetric or 3d")
+      ->check(CLI::IsMember({"auto", "analytic", "axisymmetric", "3d"}))
       ->capture_default_str();
-  cmd->add_option("--vtu", options->vtu, "write step_<k>.vtu per depth step here (3-D model)");
+  cmd->add_option("--vtu", options->vtu, "write step_<k>.vtu per pre-puncture depth step here");
   cmd->footer(
-      "Examples:\n  mneedle simulate designs/scenes/human_skin.toml --fidelity fast --json\n"
+      "Examples:\n  mneedle simulate designs/scenes/silicone_phantom.toml --fidelity fast\n"
+      "  mneedle simulate designs/scenes/human_skin.toml --criterion stress --json\n"
       "  mneedle simulate tests/assets/scenes/axisymmetric_punch.toml --csv");
-  auto* json = cmd->add_flag("--json", options->json, "print the curve as JSON");
-  cmd->add_flag("--csv", options->csv, "print the curve as CSV")->excludes(json);
+  auto* json = cmd->add_flag("--json", options->json, "print the run as JSON");
+  cmd->add_flag("--csv", options->csv, "print the curves as CSV")->excludes(json);
   cmd->callback([options]() { run(*options); });
 }
 

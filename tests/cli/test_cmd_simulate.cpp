@@ -1,5 +1,5 @@
-// Runs the built `mneedle simulate` on small axisymmetric scenes and checks exit status and
-// output.
+// Runs the built `mneedle simulate` on small scenes and checks exit status and output: the FE
+// keys of issue #4 and the two-stage keys of issue #5 (stage, puncture, total curve, planner).
 
 #include <gtest/gtest.h>
 
@@ -83,6 +83,94 @@ TEST(CmdSimulate, FrictionlessIsRefusedUntilImplemented) {
       run_mneedle("simulate '" + scene("axisymmetric_punch.toml") + "' --contact frictionless");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("frictionless"), std::string::npos) << run.err;
+}
+
+TEST(CmdSimulate, PunctureJsonHasStagesPunctureAndPlannerKeys) {
+  const CommandRun run = run_mneedle("simulate '" + scene("puncture_punch.toml") + "' --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["fidelity"], "fast");
+  EXPECT_EQ(j["models_run"], nlohmann::json({"axisymmetric_fe", "surface_loads"}));
+  ASSERT_TRUE(j["reductions"].is_array());
+  EXPECT_EQ(j["reductions"][0]["name"], "axisymmetric");
+  const auto& needle = j["needles"].at(0);
+  const auto& p = needle["puncture"];
+  ASSERT_TRUE(p.is_object());
+  EXPECT_EQ(p["criterion"], "pressure");
+  for (const char* key : {"depth_m", "force_N", "post_force_N"})
+    EXPECT_TRUE(p.contains(key)) << key;
+  // Flat punch, P = F / (pi a^2) reaches 0.3 MPa near 200 um (see test_insertion_run).
+  EXPECT_GT(p["depth_m"].get<double>(), 150e-6);
+  EXPECT_LT(p["depth_m"].get<double>(), 260e-6);
+  EXPECT_NEAR(p["force_N"].get<double>(), 0.3e6 * M_PI * 115e-6 * 115e-6, 2e-4);
+  std::string previous = "pre";
+  for (const auto& point : needle["curve"]) {
+    const std::string stage = point["stage"];
+    EXPECT_TRUE(stage == "pre" || stage == "post") << stage;
+    if (stage == "post") {
+      for (const char* key : {"alpha_N", "beta_N", "friction_N"})
+        EXPECT_TRUE(point.contains(key)) << key;
+      EXPECT_NEAR(point["force_N"].get<double>(),
+                  point["alpha_N"].get<double>() + point["beta_N"].get<double>() +
+                      point["friction_N"].get<double>(),
+                  1e-12);
+    }
+    EXPECT_FALSE(previous == "post" && stage == "pre");
+    previous = stage;
+  }
+  EXPECT_EQ(previous, "post");
+  EXPECT_GE(needle["max_force_N"].get<double>(), p["force_N"].get<double>());
+  EXPECT_EQ(j["total_curve"].size(), needle["curve"].size());
+}
+
+TEST(CmdSimulate, SceneWithoutFractureDataHasNullPuncture) {
+  const CommandRun run = run_mneedle("simulate '" + scene("axisymmetric_punch.toml") + "' --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_TRUE(j["needles"][0]["puncture"].is_null());
+  EXPECT_TRUE(j["criterion"].is_null());
+  for (const auto& point : j["needles"][0]["curve"]) EXPECT_EQ(point["stage"], "pre");
+}
+
+TEST(CmdSimulate, CriterionWithoutItsDataNamesTheLayerAndKey) {
+  const CommandRun run =
+      run_mneedle("simulate '" + scene("puncture_punch.toml") + "' --criterion stress");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("puncture_punch.toml:"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("strength: missing"), std::string::npos) << run.err;
+}
+
+TEST(CmdSimulate, BevelPuncturesOnAHalfModelAndReportsIt) {
+  const CommandRun run = run_mneedle("simulate '" + scene("puncture_bevel.toml") + "' --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  bool half = false;
+  for (const auto& r : j["reductions"]) half = half || r["name"] == "half_model";
+  EXPECT_TRUE(half) << j["reductions"].dump();
+  const auto& p = j["needles"][0]["puncture"];
+  ASSERT_TRUE(p.is_object());
+  // The mean pressure at the located puncture is the threshold (interpolated between steps).
+  const auto& curve = j["needles"][0]["curve"];
+  bool found = false;
+  for (const auto& point : curve)
+    if (point["stage"] == "pre" && point["depth_m"] == p["depth_m"]) {
+      found = true;
+      EXPECT_NEAR(point["contact_pressure_Pa"].get<double>(), 0.1e6, 0.01e6);
+    }
+  EXPECT_TRUE(found);
+  EXPECT_LT(p["depth_m"].get<double>(), 100e-6);
+}
+
+TEST(CmdSimulate, CsvHasAStageColumn) {
+  const CommandRun run = run_mneedle("simulate '" + scene("puncture_punch.toml") + "' --csv");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  std::istringstream lines(run.out);
+  std::string header, row;
+  std::getline(lines, header);
+  EXPECT_EQ(header.rfind("depth_m,force_N,stage,", 0), 0u) << header;
+  int post = 0;
+  while (std::getline(lines, row)) post += row.find(",post,") != std::string::npos ? 1 : 0;
+  EXPECT_GT(post, 0);
 }
 
 }  // namespace

@@ -36,9 +36,12 @@ struct InsertionRunOptions {
   Contact contact = Contact::Sticking;
   PunctureCriterion criterion = PunctureCriterion::Pressure;
   PreModel model = PreModel::Auto;
-  bool allow_reductions = true;  ///< half models, domain cut, layer merging
-  int steps = 0;                 ///< output depth steps; 0: from the fidelity
-  std::string vtu_directory;     ///< fields per step when set (or when the scene asks for them)
+  bool allow_reductions = true;  ///< half models, layer merging
+  /// Largest relative force change a measured reduction may cause; empty: from the fidelity
+  /// (fast 5 %, standard 2 %, fine 1 %).
+  std::optional<double> reduction_tolerance;
+  int steps = 0;              ///< output depth steps; 0: from the fidelity
+  std::string vtu_directory;  ///< fields per step when set (or when the scene asks for them)
 };
 
 enum class Stage { Pre, Post };
@@ -52,6 +55,9 @@ struct RunPoint {
   double contact_area_m2 = 0.0;
   double contact_pressure_Pa = 0.0;
   double strain_energy_J = 0.0;
+  /// Criterion quantities, computed only for the criterion in use (else 0).
+  double tip_stress_Pa = 0.0;                 ///< stress: averaged max principal stress
+  double energy_release_rate_J_per_m2 = 0.0;  ///< energy: G of the crack under the tip
   // Post-puncture split (paper A eqs. 18-20, friction); zero before puncture.
   double alpha_N = 0.0;
   double beta_N = 0.0;
@@ -85,11 +91,18 @@ struct InsertionRun {
   std::vector<std::string> models_run;  ///< "analytic", "axisymmetric_fe", "fe_3d", "surface_loads"
   std::vector<Reduction> reductions;
   fe::Fidelity fidelity = fe::Fidelity::Standard;
+  /// The criterion evaluated; empty when the scene has no puncture data (pre-puncture stage only)
+  /// or no pre-puncture model ran.
+  std::optional<PunctureCriterion> criterion;
+  std::optional<double> threshold;  ///< the criterion's threshold (Pa or J/m^2)
+  double crack_depth_m = 0.0;       ///< energy criterion: depth of the crack G is computed with
   // Mesh summary of the FE stage (zeros when none ran).
   int nodes = 0;
   int elements = 0;
   int order = 0;
   bool axisymmetric = false;
+  double min_dihedral_deg = 0.0;  ///< 3-D mesh quality (0 for the axisymmetric model)
+  double max_aspect_ratio = 0.0;
   double seconds = 0.0;
 };
 
