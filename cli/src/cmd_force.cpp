@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "json_output.h"
 #include "mneedle/design_source.h"
 #include "mneedle/error.h"
 #include "mneedle/plugin_host.h"
@@ -72,7 +73,7 @@ std::vector<NeedleCurve> compute(const ForceOptions& options) {
   return curves;
 }
 
-void print_json(const std::vector<NeedleCurve>& curves) {
+nlohmann::json to_json(const std::vector<NeedleCurve>& curves) {
   nlohmann::json needles = nlohmann::json::array();
   for (const NeedleCurve& c : curves) {
     nlohmann::json points = nlohmann::json::array();
@@ -85,7 +86,7 @@ void print_json(const std::vector<NeedleCurve>& curves) {
     }
     needles.push_back({{"name", c.name}, {"curve", points}});
   }
-  std::cout << nlohmann::json{{"needles", needles}}.dump(2) << "\n";
+  return nlohmann::json{{"needles", needles}};
 }
 
 void print_csv(const std::vector<NeedleCurve>& curves) {
@@ -124,8 +125,11 @@ void add_force_command(CLI::App& app) {
   cmd->add_option("--plugin-dir", options->plugin_dirs, "Extra folder to search for plugins");
   cmd->callback([options] {
     const std::vector<NeedleCurve> curves = compute(*options);
+    // Every format prints the same numbers: one check of the tree covers the CSV and table too.
+    const nlohmann::json tree = to_json(curves);
+    require_finite_json(tree, "force");
     if (options->json) {
-      print_json(curves);
+      std::cout << tree.dump(2) << "\n";
     } else if (options->csv) {
       print_csv(curves);
     } else {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "json_output.h"
 #include "mneedle/error.h"
 #include "mneedle/mesh.h"
 #include "mneedle/mesh_io.h"
@@ -66,10 +67,18 @@ void run_generate(const GenerateOptions& options) {
   const PluginShapeInfo& shape = registry.shape(options.name);
   const auto si = parse_settings(options.settings, shape);
   const TriangleMesh mesh = registry.generate(options.name, si);
+  // A plugin is foreign code: no non-finite coordinate may reach the STL file.
+  const std::string context = "generate " + shape.name;
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Vec3& v = mesh.vertices[i];
+    require_finite_row({v[0], v[1], v[2]}, {"x_m", "y_m", "z_m"}, "vertex " + std::to_string(i),
+                       context);
+  }
+  const double volume = require_finite(signed_volume(mesh), "volume_m3", context);
   write_stl_binary(mesh, options.output, metres_per_unit, "mneedle generate " + shape.name);
   std::cout << "wrote " << options.output.string() << " (" << shape.name << ", "
-            << mesh.triangles.size() << " triangles, volume " << signed_volume(mesh)
-            << " m^3, unit " << options.unit << ")\n";
+            << mesh.triangles.size() << " triangles, volume " << volume << " m^3, unit "
+            << options.unit << ")\n";
 }
 
 }  // namespace

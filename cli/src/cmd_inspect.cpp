@@ -19,6 +19,7 @@
 #include "mneedle/needle_frame.h"
 #include "mneedle/units.h"
 
+#include "json_output.h"
 #include "surface_report_json.h"
 
 namespace mneedle::cli {
@@ -179,7 +180,10 @@ void run_inspect(const InspectOptions& options) {
     }
     throw;
   }
-  if (options.json) std::cout << to_json(result).dump(2) << "\n";
+  // The text report prints numbers of the same tree: one check covers both formats.
+  const nlohmann::json tree = to_json(result);
+  require_finite_json(tree, "inspect " + options.file);
+  if (options.json) std::cout << tree.dump(2) << "\n";
   if (!result.validation.valid) throw InputError(defects_line(result));
   if (!options.json) print_text(result, std::cout);
 }

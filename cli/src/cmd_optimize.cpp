@@ -1,10 +1,11 @@
-// mneedle optimize: search a plugin's tip parameters (issue 6 §2). The objective is the peak
-// post-puncture force up to the target depth; the puncture-depth objective comes with the
-// puncture model.
+// mneedle optimize: search a plugin's tip parameters (issue 6 §2). Default objective: the
+// puncture depth of the two-stage model at one fixed mesh setting for the whole run; or the peak
+// force up to the target depth.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -12,9 +13,11 @@
 #include <sstream>
 
 #include "commands.h"
+#include "json_output.h"
 #include "mneedle/design_evaluation.h"
 #include "mneedle/design_source.h"
 #include "mneedle/error.h"
+#include "mneedle/fe/tissue_mesh.h"
 #include "mneedle/mesh_io.h"
 #include "mneedle/tip_optimizer.h"
 #include "mneedle/units.h"
@@ -29,13 +32,23 @@ struct OptimizeArgs {
   std::vector<std::string> settings;
   std::vector<std::string> bounds;
   std::string material;
+  std::string objective = "puncture-depth";
+  std::string fidelity = "fast";
+  std::string model = "auto";
   std::string algorithm = "cobyla";
+  std::string local = "bobyqa";
+  int starts = 1;
   int max_evals = 60;
+  std::string max_time;
   unsigned seed = 1;
   std::string min_feature = "5um";
   std::string out;
   bool json = false;
 };
+
+constexpr const char* kConstraintNames[] = {"strength_constraint", "feature_constraint",
+                                            "target_depth_constraint"};
+constexpr int kConstraints = 3;
 
 std::vector<std::string> split(const std::string& text, char sep) {
   std::vector<std::string> parts;
@@ -73,93 +86,194 @@ std::vector<DesignVariable> variables(const PluginShapeInfo& shape, const Optimi
   return out;
 }
 
+struct Problem {
+  const Scene& scene;
+  const PluginRegistry& registry;
+  const OptimizeArgs& args;
+  std::map<std::string, double> fixed;
+  std::string material;
+  double min_feature = 5e-6;
+  EvaluationOptions evaluation;
+
+  NeedleSource needle(const std::map<std::string, double>& values) const {
+    auto p = fixed;
+    for (const auto& [k, v] : values) p[k] = v;
+    return needle_from_plugin(registry, args.plugin, p);
+  }
+
+  // The optimiser's cache holds scores; this one keeps the evaluations so the best design's
+  // report does not rerun its insertion.
+  mutable std::map<std::map<std::string, double>, DesignEvaluation> evaluated;
+
+  DesignEvaluation evaluate(const NeedleSource& n) const {
+    if (const auto it = evaluated.find(n.params); it != evaluated.end()) return it->second;
+    EvaluationOptions o = evaluation;
+    o.axisymmetric = axisymmetric_profile(registry, n, "optimize: " + args.plugin);
+    o.mirror_symmetric_y0 = o.axisymmetric.has_value() || mirror_symmetric_y0(n.mesh);
+    return evaluated[n.params] = evaluate_design(n.mesh, scene, material, o);
+  }
+
+  double wall(const NeedleSource& n) const {
+    const double bore = n.params.count("bore") ? n.params.at("bore") : 0.0;
+    return bore > 0 ? (n.params.at("diameter") - bore) / 2.0 : n.params.at("diameter") / 2.0;
+  }
+
+  // Objective (m or N) and constraints, each satisfied when <= 0 and scaled to be O(1):
+  // margin >= safety factor, wall >= minimum feature, puncture at or above the target depth.
+  DesignScore score(const std::map<std::string, double>& values) const {
+    const NeedleSource n = needle(values);
+    const DesignEvaluation e = evaluate(n);
+    const double sf = e.safety_factor;
+    const double margin = std::isfinite(e.margin) ? e.margin : 1e6;
+    const double objective =
+        args.objective == "peak-force" ? e.peak_force_n : e.puncture_objective_m;
+    return DesignScore{objective,
+                       {(sf - margin) / sf, (min_feature - wall(n)) / min_feature,
+                        (e.puncture_objective_m - e.depth_m) / e.depth_m}};
+  }
+};
+
+std::string objective_text(const std::string& objective, double value) {
+  if (!std::isfinite(value)) return "none yet";
+  return objective == "peak-force" ? "peak force " + format_quantity(value, Dimension::Force)
+                                   : "puncture depth " + format_quantity(value, Dimension::Length);
+}
+
 void write_outputs(const std::filesystem::path& dir, const OptimizerResult& r,
                    const std::vector<DesignVariable>& vars, const TriangleMesh& best_mesh,
-                   const nlohmann::json& summary) {
+                   const nlohmann::json& summary, const std::string& objective_key) {
   std::filesystem::create_directories(dir);
   write_stl_binary(best_mesh, dir / "best.stl", 1e-3, "mneedle optimize best design (mm)");
   std::ofstream csv(dir / "history.csv");
   for (const auto& v : vars) csv << v.name << "_SI,";
-  csv << "peak_force_N,strength_constraint,feature_constraint,feasible,failed,seconds,error\n";
+  csv << objective_key;
+  for (const char* c : kConstraintNames) csv << "," << c;
+  csv << ",feasible,failed,start,seconds,error\n";
   for (const auto& e : r.history) {
-    for (const auto& v : vars) csv << e.values.at(v.name) << ",";
-    csv << (e.failed ? "" : std::to_string(e.objective)) << ","
-        << (e.failed ? "" : std::to_string(e.constraints[0])) << ","
-        << (e.failed ? "" : std::to_string(e.constraints[1])) << "," << e.feasible << ","
-        << e.failed << "," << e.seconds << ",\"" << e.error << "\"\n";
+    std::vector<double> numbers;
+    std::vector<std::string> columns;
+    for (const auto& v : vars) {
+      numbers.push_back(e.values.at(v.name));
+      columns.push_back(v.name);
+    }
+    require_finite_row(numbers, columns, "history row", "optimize");
+    for (double x : numbers) csv << x << ",";
+    csv << (e.failed ? "" : std::to_string(e.objective));
+    for (int i = 0; i < kConstraints; ++i)
+      csv << "," << (e.failed ? "" : std::to_string(e.constraints[i]));
+    std::string error = e.error;
+    std::replace(error.begin(), error.end(), '"', '\'');
+    csv << "," << e.feasible << "," << e.failed << "," << e.start << "," << e.seconds << ",\""
+        << error << "\"\n";
   }
+  require_finite_json(summary, "optimize");
   std::ofstream(dir / "summary.json") << summary.dump(2) << "\n";
+}
+
+nlohmann::json number_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+// One element size at the tip for every design of the run (from the start design's radius), so
+// the tissue mesh does not jump between designs and the objective stays smooth.
+double fixed_tip_size(const Problem& p, const std::vector<DesignVariable>& vars) {
+  std::map<std::string, double> middle;
+  for (const auto& v : vars) middle[v.name] = 0.5 * (v.lower + v.upper);
+  NeedleSource n;
+  try {
+    n = p.needle(middle);
+  } catch (const std::exception&) {
+    n = p.needle({});  // the middle is not a valid shape: the plugin's defaults are
+  }
+  const double depth = p.scene.requirements.target_depth.value_or(p.scene.insertion.depth);
+  const double block = std::max(p.scene.tissue.size[0], p.scene.tissue.size[1]);
+  return fe::mesh_sizing(p.evaluation.fidelity, 2, max_radius_up_to(n.mesh, depth), block)
+      .fine_size;
 }
 
 void run_optimize(const OptimizeArgs& a) {
   const Scene scene = load_scene(a.scene);
   const auto registry = PluginRegistry::discover();
   const PluginShapeInfo& shape = registry.shape(a.plugin);
-  const auto fixed = parse_parameter_settings(shape, a.settings);
+  Problem problem{scene,      registry,
+                  a,          parse_parameter_settings(shape, a.settings),
+                  a.material, parse_quantity(a.min_feature, Dimension::Length),
+                  {},         {}};
   const auto vars = variables(shape, a);
-  const double min_feature = parse_quantity(a.min_feature, Dimension::Length);
-  if (!(min_feature > 0.0))
+  if (!(problem.min_feature > 0.0))
     throw InputError("--min-feature: must be a positive length, got '" + a.min_feature + "'");
-  std::string material = a.material;
-  if (material.empty())
+  if (problem.material.empty())
     for (const auto& n : scene.needles)
-      if (n.material && material.empty()) material = *n.material;
-  if (material.empty()) material = "silicon";
+      if (n.material && problem.material.empty()) problem.material = *n.material;
+  if (problem.material.empty()) problem.material = "silicon";
+  problem.evaluation.fidelity = parse_fidelity(a.fidelity);
+  problem.evaluation.model = parse_pre_model(a.model);
+  problem.evaluation.overrides.tip_size_m = fixed_tip_size(problem, vars);
 
-  auto params_of = [&](const std::map<std::string, double>& values) {
-    auto p = fixed;
-    for (const auto& [k, v] : values) p[k] = v;
-    return p;
-  };
-  // Objective: peak force (N); constraints: margin ≥ safety factor, wall ≥ minimum feature.
-  const DesignFunction f = [&](const std::map<std::string, double>& values) {
-    const NeedleSource needle = needle_from_plugin(registry, a.plugin, params_of(values));
-    const DesignEvaluation e = evaluate_design(needle.mesh, scene, material);
-    const double sf = e.safety_factor;
-    const double margin = std::isfinite(e.margin) ? e.margin : 1e6;
-    const double bore = needle.params.count("bore") ? needle.params.at("bore") : 0.0;
-    const double wall =
-        bore > 0 ? (needle.params.at("diameter") - bore) / 2.0 : needle.params.at("diameter") / 2.0;
-    return DesignScore{e.peak_force_n, {(sf - margin) / sf, (min_feature - wall) / min_feature}};
-  };
   OptimizerOptions o;
   o.algorithm = a.algorithm;
+  o.local_algorithm = a.local;
+  o.starts = a.starts;
   o.max_evaluations = a.max_evals;
   o.seed = a.seed;
-  o.progress = [&](int n, double best) {
-    if (!a.json && n % 10 == 0)
-      std::cerr << "evaluation " << n << ": best feasible peak force "
-                << (std::isfinite(best) ? format_quantity(best, Dimension::Force) : "none yet")
-                << "\n";
+  if (!a.max_time.empty()) {
+    o.max_time_s = parse_quantity(a.max_time, Dimension::Time);
+    if (!(o.max_time_s > 0.0))
+      throw InputError("--max-time: must be a positive time, got '" + a.max_time + "'");
+  }
+  o.progress = [&](const OptimizerProgress& p) {
+    std::fprintf(stderr, "optimize: %d evaluations, %.0f s, best %s (%s), start %d of %d\n",
+                 p.evaluations, p.elapsed_s, objective_text(a.objective, p.best_objective).c_str(),
+                 p.feasible ? "feasible" : "none feasible yet", p.start, p.starts);
   };
-  const OptimizerResult r = optimize_design(vars, f, 2, o);
+  const OptimizerResult r = optimize_design(
+      vars, [&](const auto& values) { return problem.score(values); }, kConstraints, o);
   if (r.best.empty())
     throw SolverError("optimize: every evaluation failed (" + r.stop_reason + ")");
 
-  const NeedleSource best = needle_from_plugin(registry, a.plugin, params_of(r.best));
-  const DesignEvaluation e = evaluate_design(best.mesh, scene, material);
+  const NeedleSource best = problem.needle(r.best);
+  const DesignEvaluation e = problem.evaluate(best);
+  const std::string objective_key =
+      a.objective == "peak-force" ? "peak_force_N" : "puncture_depth_m";
   nlohmann::json summary = {
       {"best",
        {{"params", best.params},
-        {"puncture_depth_m", nullptr},
+        {"puncture_depth_m", e.puncture ? nlohmann::json(e.puncture->depth_m) : nullptr},
+        {"puncture_force_N", e.puncture ? nlohmann::json(e.puncture->force_N) : nullptr},
+        {"target_depth_m", e.depth_m},
+        {"reaches_target_depth", e.reaches_target},
         {"peak_force_N", e.peak_force_n},
-        {"margin", std::isfinite(e.margin) ? nlohmann::json(e.margin) : nlohmann::json(nullptr)}}},
-      {"objective", "peak_force_N"},
+        {"capacity_N", e.strength.capacity_n},
+        {"margin", number_or_null(e.margin)},
+        {"safety_factor", e.safety_factor},
+        {"models_run", e.models_run}}},
+      {"objective", objective_key},
       {"evaluations", r.evaluations},
       {"feasible", r.feasible},
       {"algorithm", r.algorithm},
+      {"local_algorithm", a.algorithm == "mlsl" ? nlohmann::json(a.local) : nullptr},
+      {"starts", r.starts.size()},
+      {"stop", to_string(r.stop)},
       {"stop_reason", r.stop_reason},
-      {"material", material}};
-  if (!a.out.empty()) write_outputs(a.out, r, vars, best.mesh, summary);
+      {"seconds", r.seconds},
+      {"fidelity", a.fidelity},
+      {"tip_element_size_m", *problem.evaluation.overrides.tip_size_m},
+      {"material", problem.material}};
+  if (!a.out.empty()) write_outputs(a.out, r, vars, best.mesh, summary, objective_key);
   if (a.json) {
-    std::cout << summary.dump(2) << "\n";
+    print_checked_json(std::cout, summary, "optimize");
     return;
   }
   std::cout << (r.feasible ? "best design" : "INFEASIBLE: least-violated design") << " of "
-            << r.evaluations << " evaluations (" << r.algorithm << ", " << r.stop_reason << ")\n";
+            << r.evaluations << " evaluations in " << static_cast<int>(std::round(r.seconds))
+            << " s (" << r.algorithm << "; " << r.stop_reason << ")\n";
   for (const auto& v : vars)
     std::cout << "  " << v.name << " = " << best.params.at(v.name) << " (SI)\n";
-  std::cout << "  peak post-puncture force " << format_quantity(e.peak_force_n, Dimension::Force)
+  std::cout << "  puncture "
+            << (e.puncture ? "at " + format_quantity(e.puncture->depth_m, Dimension::Length) +
+                                 " under " + format_quantity(e.puncture->force_N, Dimension::Force)
+                           : "not reached before " + format_quantity(e.depth_m, Dimension::Length))
+            << "\n  peak force " << format_quantity(e.peak_force_n, Dimension::Force)
             << ", strength margin " << e.margin << " (safety factor " << e.safety_factor << ")\n";
 }
 
@@ -169,8 +283,9 @@ void add_optimize_command(CLI::App& app) {
   auto a = std::make_shared<OptimizeArgs>();
   auto* cmd = app.add_subcommand("optimize", "Search a tip shape's parameters with NLopt");
   cmd->footer(
-      "Objective: the peak post-puncture force up to the scene's target depth, subject to\n"
-      "strength margin >= safety factor and wall >= --min-feature.\n"
+      "Objective: the puncture depth (two-stage model, one tissue mesh for the whole run) or the\n"
+      "peak force up to the target depth, subject to strength margin >= safety factor,\n"
+      "wall >= --min-feature and puncture before the scene's target depth.\n"
       "Example:\n  mneedle optimize --plugin sharp_bevel --scene designs/scenes/human_skin.toml "
       "\\\n"
       "    --vary bevel_angle,diameter --bound diameter=150um:300um --material silicon --out opt");
@@ -181,10 +296,31 @@ void add_optimize_command(CLI::App& app) {
   cmd->add_option("--bound", a->bounds, "Narrower bounds, name=low:high with units (repeatable)");
   cmd->add_option("--material", a->material,
                   "Needle material (default: the scene's, else silicon)");
-  cmd->add_option("--algorithm", a->algorithm, "cobyla, bobyqa (in AUGLAG) or isres")
+  cmd->add_option("--objective", a->objective, "puncture-depth or peak-force")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"puncture-depth", "peak-force"}));
+  cmd->add_option("--fidelity", a->fidelity, "FE mesh level: fast, standard or fine")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"fast", "standard", "fine"}));
+  cmd->add_option("--model", a->model, "Pre-puncture model: auto, analytic, axisymmetric or 3d")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "analytic", "axisymmetric", "3d"}));
+  cmd->add_option("--algorithm", a->algorithm,
+                  "cobyla, bobyqa (in AUGLAG), isres (global) or mlsl (global, with --local)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"cobyla", "bobyqa", "isres", "mlsl"}));
+  cmd->add_option("--local", a->local, "mlsl's local search: cobyla or bobyqa")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"cobyla", "bobyqa"}));
+  cmd->add_option("--starts", a->starts,
+                  "cobyla/bobyqa: runs from the start point and scattered points, best kept")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-evals", a->max_evals, "Evaluation budget (distinct designs)")
       ->capture_default_str();
-  cmd->add_option("--max-evals", a->max_evals, "Evaluation budget")->capture_default_str();
-  cmd->add_option("--seed", a->seed, "Seed for the global algorithm")->capture_default_str();
+  cmd->add_option("--max-time", a->max_time, "Wall-time budget with a unit, e.g. 300s");
+  cmd->add_option("--seed", a->seed, "Seed of the scattered starts, ISRES and MLSL")
+      ->capture_default_str();
   cmd->add_option("--min-feature", a->min_feature, "Smallest manufacturable wall")
       ->capture_default_str();
   cmd->add_option("--out", a->out, "Folder for best.stl (mm), history.csv and summary.json");

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "json_output.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/units.h"
 
@@ -64,10 +65,12 @@ void print_warnings(const PluginRegistry& registry) {
 
 void run_list(const PluginsOptions& options) {
   const PluginRegistry registry = PluginRegistry::discover(options.plugin_dirs);
+  Json shapes = Json::array();
+  for (const auto& s : registry.shapes()) shapes.push_back(shape_json(s));
+  const Json tree{{"shapes", shapes}, {"warnings", registry.warnings()}};
+  require_finite_json(tree, "plugins list");
   if (options.json) {
-    Json shapes = Json::array();
-    for (const auto& s : registry.shapes()) shapes.push_back(shape_json(s));
-    std::cout << Json{{"shapes", shapes}, {"warnings", registry.warnings()}}.dump(2) << "\n";
+    std::cout << tree.dump(2) << "\n";
     return;
   }
   print_warnings(registry);
@@ -85,8 +88,10 @@ void run_list(const PluginsOptions& options) {
 void run_describe(const PluginsOptions& options) {
   const PluginRegistry registry = PluginRegistry::discover(options.plugin_dirs);
   const PluginShapeInfo& s = registry.shape(options.name);
+  const Json tree = shape_json(s);
+  require_finite_json(tree, "plugins describe " + s.name);
   if (options.json) {
-    std::cout << shape_json(s).dump(2) << "\n";
+    std::cout << tree.dump(2) << "\n";
     return;
   }
   std::cout << s.name << ": " << s.help << "\n"

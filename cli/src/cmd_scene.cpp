@@ -9,6 +9,7 @@
 #include <variant>
 
 #include "commands.h"
+#include "json_output.h"
 #include "mneedle/scene.h"
 #include "mneedle/units.h"
 
@@ -258,8 +259,11 @@ void add_scene_command(CLI::App& app) {
       "An invalid scene prints one line naming file:line, the key and the problem; exit 1.\n");
   check->callback([opts] {
     const Scene s = load_scene(opts->file);
+    // The summary prints the same values as the JSON: one check covers both.
+    const Json tree = scene_to_json(s);
+    require_finite_json(tree, "scene " + opts->file);
     if (opts->json) {
-      std::cout << scene_to_json(s).dump(2) << "\n";
+      std::cout << tree.dump(2) << "\n";
     } else {
       print_summary(std::cout, s);
     }

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "json_output.h"
 #include "mneedle/error.h"
 #include "mneedle/screening.h"
 #include "mneedle/units.h"
@@ -18,7 +19,8 @@ struct ScreenArgs {
   std::string scene;
   std::string unit = "mm";
   std::string material;
-  std::string fidelity;
+  std::string fidelity = "fast";
+  std::string model = "auto";
   int jobs = 1;
   std::string out;
   bool json = false;
@@ -38,11 +40,13 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
                   .c_str(),
               material.c_str(), scene.requirements.safety_factor);
   std::printf(
-      "Ranked by peak post-puncture force up to that depth (paper A's distributed loads);\n"
-      "the puncture depth is not modelled yet, so every design is taken as punctured at the "
-      "surface.\n\n");
-  std::printf("%-4s %-24s %-6s %-12s %-12s %-12s %-8s %-9s\n", "rank", "design", "status",
-              "peak force", "capacity", "governing", "margin", "tip");
+      "Ranked by puncture depth, then puncture force (two-stage model: FE until the %s "
+      "criterion fires, then paper A's distributed loads); designs that do not puncture "
+      "before the target depth come last. pass = punctures before the target depth and "
+      "margin (capacity / peak force) >= safety factor.\n\n",
+      std::string(to_string(scene.model.criterion)).c_str());
+  std::printf("%-4s %-24s %-6s %-11s %-11s %-11s %-11s %-9s %-8s %s\n", "rank", "design", "status",
+              "puncture at", "force", "peak force", "capacity", "governing", "margin", "model");
   int rank = 0;
   for (const auto& row : ranked) {
     if (!row.ok) {
@@ -52,11 +56,18 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
     const auto j = nlohmann::json::parse(row.json);
     const std::string margin =
         j["margin"].is_null() ? "inf" : std::to_string(row.margin).substr(0, 6);
-    std::printf("%-4d %-24s %-6s %-12s %-12s %-12s %-8s %-9s\n", ++rank, row.design.c_str(),
-                row.passes ? "pass" : "FAIL", cell(row.peak_force_n, Dimension::Force).c_str(),
+    std::string models;
+    for (const auto& m : j["models_run"])
+      models += (models.empty() ? "" : "+") + m.get<std::string>();
+    const std::string depth =
+        row.puncture_depth_m ? cell(*row.puncture_depth_m, Dimension::Length) : "none";
+    const std::string force =
+        row.puncture_depth_m ? cell(row.puncture_force_n, Dimension::Force) : "-";
+    std::printf("%-4d %-24s %-6s %-11s %-11s %-11s %-11s %-9s %-8s %s\n", ++rank,
+                row.design.c_str(), row.passes ? "pass" : "FAIL", depth.c_str(), force.c_str(),
+                cell(row.peak_force_n, Dimension::Force).c_str(),
                 cell(j["capacity_N"].get<double>(), Dimension::Force).c_str(),
-                j["governing"].get<std::string>().c_str(), margin.c_str(),
-                cell(j["tip_length_m"].get<double>(), Dimension::Length).c_str());
+                j["governing"].get<std::string>().c_str(), margin.c_str(), models.c_str());
   }
 }
 
@@ -73,8 +84,8 @@ void run_screen(const ScreenArgs& args) {
   if (!args.material.empty()) options.material = args.material;
   if (!args.out.empty()) options.out = args.out;
   options.resume = args.resume;
-  options.fidelity =
-      args.fidelity.empty() ? std::string(to_string(scene.model.fidelity)) : args.fidelity;
+  options.fidelity = args.fidelity;
+  options.model = args.model;
   if (options.resume && !options.out) throw InputError("screen: --resume needs --out DIR");
 
   const auto rows = rank_rows(
@@ -84,14 +95,17 @@ void run_screen(const ScreenArgs& args) {
   std::size_t failed = 0;
   for (const auto& r : rows) failed += r.ok ? 0 : 1;
   if (args.json) {
-    nlohmann::json out = {
-        {"scene", args.scene}, {"ranking", "peak_force_N"}, {"designs", nlohmann::json::array()}};
+    nlohmann::json out = {{"scene", args.scene},
+                          {"fidelity", options.fidelity},
+                          {"model", options.model},
+                          {"ranking", {"puncture_depth_m", "puncture_force_N"}},
+                          {"designs", nlohmann::json::array()}};
     for (const auto& r : rows) {
       auto j = nlohmann::json::parse(r.json);
       j["resumed"] = r.resumed;
       out["designs"].push_back(j);
     }
-    std::cout << out.dump(2) << "\n";
+    print_checked_json(std::cout, out, "screen");
   } else {
     std::string material = args.material;
     for (const auto& r : rows)
@@ -121,9 +135,18 @@ void add_screen_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--material", args->material,
                   "Needle material (default: the scene's, else silicon)");
-  cmd->add_option("--fidelity", args->fidelity, "fast, standard or fine (default: the scene's)")
+  cmd->add_option("--fidelity", args->fidelity,
+                  "FE mesh level of the pre-puncture stage: fast, standard or fine")
+      ->capture_default_str()
       ->check(CLI::IsMember({"fast", "standard", "fine"}));
-  cmd->add_option("--jobs", args->jobs, "Designs evaluated at once")->check(CLI::PositiveNumber);
+  cmd->add_option("--model", args->model,
+                  "Pre-puncture model: auto (axisymmetric for cylinders and cones on the axis, "
+                  "else 3-D), analytic, axisymmetric or 3d")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "analytic", "axisymmetric", "3d"}));
+  cmd->add_option("--jobs", args->jobs,
+                  "Designs evaluated at once (each with one OpenBLAS thread when > 1)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--out", args->out,
                   "Folder for results.csv and results.jsonl, written as designs finish");
   cmd->add_flag("--resume", args->resume, "Skip designs already in --out for the same inputs");

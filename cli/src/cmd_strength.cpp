@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "json_output.h"
 #include "mneedle/design_source.h"
 #include "mneedle/error.h"
 #include "mneedle/needle_strength.h"
@@ -87,6 +88,8 @@ void run_strength(const StrengthArgs& args) {
                         {"critical_height_m", r.critical_height_m},
                         {"capacity_N", r.capacity_n},
                         {"governing", r.governing}};
+  // Text and JSON print the same numbers: check them once, before either.
+  require_finite_json(out, "strength");
   if (args.json) {
     std::cout << out.dump(2) << "\n";
     return;

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "json_output.h"
 #include "mneedle/anova.h"
 #include "mneedle/curve_metrics.h"
 #include "mneedle/error.h"
@@ -178,6 +179,11 @@ void write_fit_files(const std::string& dir, const nlohmann::json& report, const
   for (std::size_t i = 0; i < curves.size(); ++i) {
     const auto& c = curves[i].curve;
     const auto predicted = predict_loading(model, c, fit.curves[i].offset_m);
+    for (std::size_t j = 0; j < c.depth_m.size(); ++j) {
+      require_finite_row({c.depth_m[j], c.force_N[j], predicted[j]},
+                         {"depth_m", "measured_N", "model_N"},
+                         c.name + " row " + std::to_string(j + 1), "fit");
+    }
     std::ofstream csv(std::filesystem::path(dir) /
                       (std::filesystem::path(c.name).stem().string() + "_fit.csv"));
     csv << "depth_m,measured_N,model_N\n" << std::setprecision(8);
@@ -223,6 +229,7 @@ void run_fit(const FitArgs& args) {
   options.free = args.free;
   const auto fit = fit_triforce(data, options);
   const auto report = fit_json(fit, curves);
+  require_finite_json(report, "fit");
   if (!args.out_dir.empty()) write_fit_files(args.out_dir, report, fit, curves);
   if (args.json) {
     std::cout << report.dump(2) << "\n";
@@ -329,6 +336,14 @@ void run_predict(const PredictArgs& args) {
     throw InputError("predict: give --depth (or --compare CURVE.csv to use its depth)");
   }
   const auto samples = model.simulate(protocol);
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const auto& s = samples[i];
+    require_finite_row(
+        {s.time_s, s.depth_m, s.force.total_N(), s.force.cutting_N, s.force.stiffness_N,
+         s.force.friction_N, s.force.viscous_N},
+        {"time_s", "depth_m", "force_N", "cutting_N", "stiffness_N", "friction_N", "viscous_N"},
+        "sample " + std::to_string(i + 1), "predict");
+  }
   nlohmann::json comparison;
   if (measured) {
     const double offset = mean_fitted_offset(args.params_file);
@@ -340,6 +355,7 @@ void run_predict(const PredictArgs& args) {
                   {"max_error_N", m.max_error_N},
                   {"samples", m.samples},
                   {"loading_branch", measured->branch.summary}};
+    require_finite_json(comparison, "predict: comparison");
     if (!args.json) {
       std::cerr << measured->branch.summary << "\nprediction vs " << measured->curve.name
                 << ": RMSE " << m.rmse_N << " N, R2 " << m.r2 << ", max error " << m.max_error_N
@@ -377,7 +393,7 @@ void run_predict(const PredictArgs& args) {
         {"friction_N", ff},
         {"viscous_N", fv}};
     if (measured) out["comparison"] = comparison;
-    std::cout << out.dump(2) << "\n";
+    print_checked_json(std::cout, out, "predict");
     return;
   }
   std::cout << "time_s,depth_m,phase,force_N,cutting_N,stiffness_N,friction_N,viscous_N\n"
@@ -403,7 +419,7 @@ void run_stats(const StatsArgs& args) {
   std::vector<double> values;
   read_grouped_csv(args.file, args.value, args.group, labels, values);
   const auto r = one_way_anova(labels, values, args.alpha);
-  if (args.json) {
+  {
     nlohmann::json groups = nlohmann::json::array(), pairs = nlohmann::json::array();
     for (const auto& g : r.groups)
       groups.push_back({{"name", g.name}, {"n", g.n}, {"mean", g.mean}, {"sd", g.sd}});
@@ -417,23 +433,26 @@ void run_stats(const StatsArgs& args) {
                        {"reject", c.reject}});
     }
     const auto& a = r.anova;
-    std::cout << nlohmann::json{{"value", args.value},
-                                {"groups", groups},
-                                {"anova",
-                                 {{"ss_between", a.ss_between},
-                                  {"ss_within", a.ss_within},
-                                  {"df_between", a.df_between},
-                                  {"df_within", a.df_within},
-                                  {"ms_between", a.ms_between},
-                                  {"ms_within", a.ms_within},
-                                  {"F", a.f},
-                                  {"p", a.p}}},
-                                {"alpha", r.alpha},
-                                {"q_critical", r.q_critical},
-                                {"tukey_hsd", pairs}}
-                     .dump(2)
-              << "\n";
-    return;
+    const nlohmann::json tree{{"value", args.value},
+                              {"groups", groups},
+                              {"anova",
+                               {{"ss_between", a.ss_between},
+                                {"ss_within", a.ss_within},
+                                {"df_between", a.df_between},
+                                {"df_within", a.df_within},
+                                {"ms_between", a.ms_between},
+                                {"ms_within", a.ms_within},
+                                {"F", a.f},
+                                {"p", a.p}}},
+                              {"alpha", r.alpha},
+                              {"q_critical", r.q_critical},
+                              {"tukey_hsd", pairs}};
+    // The text report prints the same numbers: one check covers both formats.
+    require_finite_json(tree, "stats");
+    if (args.json) {
+      std::cout << tree.dump(2) << "\n";
+      return;
+    }
   }
   std::cout << "one-way ANOVA of '" << args.value << "' by '" << args.group << "'\n";
   for (const auto& g : r.groups) {

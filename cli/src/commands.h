@@ -21,5 +21,6 @@ void add_fit_command(CLI::App& app);
 void add_predict_command(CLI::App& app);
 void add_stats_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
+void add_toughness_command(CLI::App& app);
 
 }  // namespace mneedle::cli

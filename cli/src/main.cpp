@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   mneedle::cli::add_predict_command(app);
   mneedle::cli::add_stats_command(app);
   mneedle::cli::add_simulate_command(app);
+  mneedle::cli::add_toughness_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

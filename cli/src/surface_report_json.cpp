@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "json_output.h"
 #include "mneedle/surface_report.h"
 
 namespace mneedle::cli {
@@ -18,7 +19,9 @@ nlohmann::json surface_report_json(const TriangleMesh& mesh, const std::vector<d
   for (const TipAreaPoint& p : report.tip_area) {
     tip_area.push_back({{"height_m", p.height_m}, {"area_m2", p.area_m2}});
   }
-  return {{"groups", groups}, {"tip_area", tip_area}};
+  nlohmann::json out = {{"groups", groups}, {"tip_area", tip_area}};
+  require_finite_json(out, "surface report");
+  return out;
 }
 
 }  // namespace mneedle::cli
