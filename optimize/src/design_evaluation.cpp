@@ -28,6 +28,81 @@ double evaluation_depth(const Scene& scene) {
   return scene.requirements.target_depth.value_or(scene.insertion.depth);
 }
 
+std::string fidelity_name(fe::Fidelity f) {
+  switch (f) {
+    case fe::Fidelity::Fast:
+      return "fast";
+    case fe::Fidelity::Standard:
+      return "standard";
+    case fe::Fidelity::Fine:
+      return "fine";
+  }
+  return "standard";
+}
+
+// The scene as run_insertion sees it for one design: one needle where the scene's first one is,
+// inserted to the target depth, asking for the puncture and the force curve (no field output).
+Scene design_scene(const Scene& scene, double depth_m) {
+  Scene s = scene;
+  NeedleSpec spec;
+  if (!scene.needles.empty()) spec = scene.needles.front();
+  if (spec.name.empty()) spec.name = "design";
+  s.needles = {spec};
+  s.insertion.depth = depth_m;
+  s.model.outputs = {Output::Puncture, Output::ForceCurve};
+  return s;
+}
+
+// Pressure criterion only: how close the run came to puncturing, max contact pressure over the
+// threshold. The other criteria's values are not on the curve; 0 then.
+double criterion_ratio(const InsertionRun& run, const NeedleRun& needle) {
+  if (!run.criterion || !run.threshold || *run.criterion != PunctureCriterion::Pressure ||
+      !(*run.threshold > 0.0))
+    return 0.0;
+  double peak = 0.0;
+  for (const RunPoint& p : needle.curve)
+    if (p.stage == Stage::Pre) peak = std::max(peak, p.contact_pressure_Pa);
+  return std::clamp(peak / *run.threshold, 0.0, 1.0);
+}
+
+void add_insertion(DesignEvaluation& e, const TriangleMesh& mesh, const Scene& scene,
+                   const EvaluationOptions& options) {
+  PreparedNeedle needle;
+  needle.mesh = mesh;
+  needle.axisymmetric = options.axisymmetric;
+  needle.mirror_symmetric_y0 = options.mirror_symmetric_y0;
+  const Scene s = design_scene(scene, e.depth_m);
+  needle.name = s.needles.front().name;
+  needle.x = s.needles.front().at[0];
+  needle.y = s.needles.front().at[1];
+  InsertionRunOptions ro;
+  ro.fidelity = options.fidelity;
+  ro.overrides = options.overrides;
+  ro.contact = scene.model.contact;
+  ro.criterion = scene.model.criterion;
+  ro.model = options.model;
+  const InsertionRun run = run_insertion(s, {needle}, ro);
+  const NeedleRun& n = run.needles.front();
+  e.models_run = run.models_run;
+  for (const auto& r : run.reductions) e.reductions.push_back(r.name);
+  e.insertion_seconds = run.seconds;
+  for (const RunPoint& p : n.curve)
+    if (p.depth_m <= e.depth_m * (1.0 + 1e-9)) e.peak_force_n = std::max(e.peak_force_n, p.force_N);
+  if (!n.curve.empty()) e.force_at_depth_n = n.curve.back().force_N;
+  if (n.puncture && n.puncture->depth_m <= e.depth_m * (1.0 + 1e-9)) {
+    e.puncture = PunctureSummary{n.puncture->depth_m, n.puncture->force_N, n.puncture->post_force_N,
+                                 std::string(to_string(n.puncture->criterion))};
+    e.puncture_objective_m = n.puncture->depth_m;
+    e.reaches_target = true;
+  } else {
+    e.puncture_objective_m = e.depth_m * (2.0 - criterion_ratio(run, n));
+    e.notes.push_back(run.criterion ? "no puncture up to the target depth " +
+                                          format_quantity(e.depth_m, Dimension::Length)
+                                    : "the scene's top layer has no puncture data (fracture or "
+                                      "strength): the puncture is not modelled");
+  }
+}
+
 }  // namespace
 
 std::vector<NeedleMaterial> scene_needle_materials(const Scene& scene) {
@@ -38,6 +113,42 @@ std::vector<NeedleMaterial> scene_needle_materials(const Scene& scene) {
   return out;
 }
 
+double max_radius_up_to(const TriangleMesh& mesh, double height_m) {
+  double r = 0.0;
+  for (const auto& v : mesh.vertices)
+    if (v[2] <= height_m) r = std::max(r, std::hypot(v[0], v[1]));
+  return r;
+}
+
+fe::Fidelity parse_fidelity(const std::string& text) {
+  if (text == "fast") return fe::Fidelity::Fast;
+  if (text == "standard") return fe::Fidelity::Standard;
+  if (text == "fine") return fe::Fidelity::Fine;
+  throw InputError("fidelity '" + text + "': expected fast, standard or fine");
+}
+
+PreModel parse_pre_model(const std::string& text) {
+  if (text == "auto") return PreModel::Auto;
+  if (text == "analytic") return PreModel::Analytic;
+  if (text == "axisymmetric") return PreModel::Axisymmetric;
+  if (text == "3d") return PreModel::Full3d;
+  throw InputError("model '" + text + "': expected auto, analytic, axisymmetric or 3d");
+}
+
+std::string to_string(PreModel model) {
+  switch (model) {
+    case PreModel::Auto:
+      return "auto";
+    case PreModel::Analytic:
+      return "analytic";
+    case PreModel::Axisymmetric:
+      return "axisymmetric";
+    case PreModel::Full3d:
+      return "3d";
+  }
+  return "auto";
+}
+
 DesignEvaluation evaluate_design(const TriangleMesh& mesh, const Scene& scene,
                                  const std::string& needle_material,
                                  const EvaluationOptions& options) {
@@ -45,16 +156,11 @@ DesignEvaluation evaluate_design(const TriangleMesh& mesh, const Scene& scene,
   const SectionTable sections = SectionTable::from_mesh(mesh);
   e.geometry = describe(mesh, sections);
   e.depth_m = evaluation_depth(scene);
+  e.fidelity = fidelity_name(options.fidelity);
   if (e.depth_m >= e.geometry.length_m)
     throw InputError("needle of length " + format_quantity(e.geometry.length_m, Dimension::Length) +
                      " cannot reach the depth " + format_quantity(e.depth_m, Dimension::Length));
-
-  const SurfaceLoadModel loads(mesh, load_constants(scene));
-  for (int i = 1; i <= options.depth_steps; ++i) {
-    const LoadSample s = loads.at(e.depth_m * i / options.depth_steps);
-    e.peak_force_n = std::max(e.peak_force_n, s.force_N);
-    e.force_at_depth_n = s.force_N;
-  }
+  add_insertion(e, mesh, scene, options);
 
   const NeedleMaterial material =
       find_needle_material(needle_material, scene_needle_materials(scene));
@@ -67,8 +173,9 @@ DesignEvaluation evaluate_design(const TriangleMesh& mesh, const Scene& scene,
   e.strength = needle_strength(options.section_hook.value_or(sections.profile()), material, so);
   e.margin = strength_margin(e.strength.capacity_n, e.peak_force_n);
   e.safety_factor = scene.requirements.safety_factor;
-  e.passes = e.margin >= e.safety_factor;
-  if (!e.passes)
+  const bool strong = e.margin >= e.safety_factor;
+  e.passes = strong && e.reaches_target;
+  if (!strong)
     e.notes.push_back("strength margin " + std::to_string(e.margin) + " below the safety factor " +
                       std::to_string(e.safety_factor));
   return e;

@@ -1,5 +1,8 @@
 #include "mneedle/design_source.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "mneedle/error.h"
 #include "mneedle/mesh_io.h"
 #include "mneedle/mesh_validation.h"
@@ -89,6 +92,72 @@ NeedleSource needle_from_scene(const PluginRegistry& registry, const NeedleSpec&
       registry, plugin.plugin, scene_parameters(info, plugin.parameters, "needles." + spec.name));
   n.name = spec.name;
   return n;
+}
+
+std::optional<fe::AxisymmetricNeedle> axisymmetric_profile(const PluginRegistry& registry,
+                                                           const NeedleSource& needle,
+                                                           const std::string& where) {
+  if (!needle.plugin || (*needle.plugin != "cylinder" && *needle.plugin != "cone"))
+    return std::nullopt;
+  const std::map<std::string, double>& p = needle.params;
+  const double radius = 0.5 * p.at("diameter");
+  const double bore = p.count("bore") ? 0.5 * p.at("bore") : 0.0;
+  if (*needle.plugin == "cylinder") return fe::AxisymmetricNeedle::flat_punch(radius, bore);
+  // Cone: sample the section so that a rounded tip (tip_radius) is followed too.
+  const double length = p.at("length");
+  const double taper = (radius - bore) / std::tan(p.at("half_angle"));
+  const double top = std::min(length, 1.05 * taper);
+  fe::AxisymmetricNeedle profile;
+  profile.bore_radius_m = bore;
+  constexpr int kSamples = 200;
+  for (int i = 0; i <= kSamples; ++i) {
+    const double h = top * i / kSamples;
+    const std::optional<double> area = registry.section_area(*needle.plugin, p, h);
+    if (!area) throw InputError(where + ": the cone plugin gives no section area");
+    const double r = std::sqrt(std::max(*area / M_PI + bore * bore, 0.0));
+    const double previous = profile.radii_m.empty() ? 0.0 : profile.radii_m.back();
+    profile.heights_m.push_back(h);
+    profile.radii_m.push_back(std::max({r, previous, bore}));
+  }
+  return profile;
+}
+
+bool mirror_symmetric_y0(const TriangleMesh& mesh) {
+  if (mesh.vertices.empty()) return false;
+  const BoundingBox box = bounding_box(mesh);
+  const double size =
+      std::hypot(box.max[0] - box.min[0], box.max[1] - box.min[1], box.max[2] - box.min[2]);
+  const double tol = 1e-6 * size;
+  std::vector<Vec3> sorted = mesh.vertices;
+  std::sort(sorted.begin(), sorted.end());
+  for (const Vec3& v : mesh.vertices) {
+    const Vec3 m{v[0], -v[1], v[2]};
+    // Candidates share x within the tolerance: scan that slice of the sorted list.
+    auto it = std::lower_bound(sorted.begin(), sorted.end(), Vec3{m[0] - tol, -1e300, -1e300});
+    bool found = false;
+    for (; it != sorted.end() && (*it)[0] <= m[0] + tol && !found; ++it)
+      found = std::abs((*it)[1] - m[1]) <= tol && std::abs((*it)[2] - m[2]) <= tol;
+    if (!found) return false;
+  }
+  return true;
+}
+
+std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, const Scene& scene) {
+  std::vector<PreparedNeedle> prepared;
+  for (const NeedleSpec& spec : scene.needles) {
+    const std::string where =
+        scene.source_name + ":" + std::to_string(spec.line) + ": needle '" + spec.name + "'";
+    NeedleSource source = needle_from_scene(registry, spec);
+    PreparedNeedle n;
+    n.name = spec.name;
+    n.x = spec.at[0];
+    n.y = spec.at[1];
+    n.axisymmetric = axisymmetric_profile(registry, source, where);
+    n.mirror_symmetric_y0 = n.axisymmetric.has_value() || mirror_symmetric_y0(source.mesh);
+    n.mesh = std::move(source.mesh);
+    prepared.push_back(std::move(n));
+  }
+  return prepared;
 }
 
 }  // namespace mneedle

@@ -10,10 +10,12 @@
 #include <fstream>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
 
+#include "mneedle/blas_threads.h"
 #include "mneedle/design_source.h"
 #include "mneedle/error.h"
 
@@ -116,12 +118,45 @@ std::string design_fingerprint(const DesignInput& d) {
   return text;
 }
 
-TriangleMesh design_mesh(const DesignInput& d, const PluginRegistry& registry) {
-  if (!d.plugin) return needle_from_file(d.file, d.metres_per_unit).mesh;
-  const auto& info = registry.shape(*d.plugin);
-  return needle_from_plugin(registry, *d.plugin,
-                            scene_parameters(info, d.parameters, d.file.string() + ": " + d.name))
-      .mesh;
+// The design's mesh with what lets run_insertion reduce the model: an axisymmetric profile for
+// the cylinder and cone plugins, the y = 0 mirror symmetry (a vertex lookup) for any mesh.
+struct ScreenedNeedle {
+  TriangleMesh mesh;
+  EvaluationOptions options;
+};
+
+ScreenedNeedle design_needle(const DesignInput& d, const PluginRegistry& registry,
+                             const ScreeningOptions& o) {
+  const std::string where = d.file.string() + ": " + d.name;
+  const NeedleSource source =
+      d.plugin
+          ? needle_from_plugin(registry, *d.plugin,
+                               scene_parameters(registry.shape(*d.plugin), d.parameters, where))
+          : needle_from_file(d.file, d.metres_per_unit);
+  ScreenedNeedle n;
+  n.options.fidelity = parse_fidelity(o.fidelity);
+  n.options.model = parse_pre_model(o.model);
+  n.options.axisymmetric = axisymmetric_profile(registry, source, where);
+  n.options.mirror_symmetric_y0 =
+      n.options.axisymmetric.has_value() || mirror_symmetric_y0(source.mesh);
+  n.mesh = source.mesh;
+  return n;
+}
+
+// No NaN or Inf may reach results.jsonl/csv (nlohmann would write them as null).
+std::optional<std::string> non_finite_key(const json& j, const std::string& path = "") {
+  if (j.is_number_float() && !std::isfinite(j.get<double>())) return path;
+  if (j.is_object())
+    for (const auto& [k, v] : j.items())
+      if (auto bad = non_finite_key(v, path.empty() ? k : path + "." + k)) return bad;
+  if (j.is_array())
+    for (std::size_t i = 0; i < j.size(); ++i)
+      if (auto bad = non_finite_key(j[i], path + "[" + std::to_string(i) + "]")) return bad;
+  return std::nullopt;
+}
+
+json optional_number(const std::optional<double>& v) {
+  return v ? json(*v) : json(nullptr);
 }
 
 std::string scene_material(const Scene& scene, const ScreeningOptions& o) {
@@ -144,7 +179,24 @@ json evaluation_json(const DesignEvaluation& e) {
           {"depth_m", e.depth_m},
           {"force_at_depth_N", e.force_at_depth_n},
           {"peak_force_N", e.peak_force_n},
-          {"puncture", nullptr},
+          {"puncture", e.puncture ? json{{"depth_m", e.puncture->depth_m},
+                                         {"force_N", e.puncture->force_N},
+                                         {"post_force_N", e.puncture->post_force_N},
+                                         {"criterion", e.puncture->criterion}}
+                                  : json(nullptr)},
+          {"punctured", e.puncture.has_value()},
+          {"puncture_depth_m",
+           optional_number(e.puncture ? std::optional(e.puncture->depth_m) : std::nullopt)},
+          {"puncture_force_N",
+           optional_number(e.puncture ? std::optional(e.puncture->force_N) : std::nullopt)},
+          {"post_puncture_force_N",
+           optional_number(e.puncture ? std::optional(e.puncture->post_force_N) : std::nullopt)},
+          {"puncture_criterion", e.puncture ? json(e.puncture->criterion) : json(nullptr)},
+          {"target_depth_m", e.depth_m},
+          {"reaches_target_depth", e.reaches_target},
+          {"models_run", e.models_run},
+          {"reductions", e.reductions},
+          {"insertion_seconds", e.insertion_seconds},
           {"material", e.material},
           {"buckling_N", s.buckling_n},
           {"strength_N", s.strength_n},
@@ -159,13 +211,16 @@ json evaluation_json(const DesignEvaluation& e) {
 // The hash names a design's inputs, so --resume can tell which finished rows still apply.
 std::string row_hash(const DesignInput& d, const std::string& scene_hash,
                      const std::string& fidelity, const std::string& material) {
+  // Version 2 rows carry the puncture; rows of the surface-load-only screening are redone.
+  constexpr const char* kRowVersion = "2";
   std::string fingerprint;
   try {
     fingerprint = design_fingerprint(d);
   } catch (const std::exception&) {
     fingerprint = d.name + d.file.string();  // unreadable: evaluation reports why
   }
-  return hex(fnv1a(fingerprint + "|" + scene_hash + "|" + fidelity + "|" + material));
+  return hex(
+      fnv1a(fingerprint + "|" + scene_hash + "|" + fidelity + "|" + material + "|" + kRowVersion));
 }
 
 ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::string& hash,
@@ -177,12 +232,20 @@ ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::s
   const auto start = std::chrono::steady_clock::now();
   json j = {{"design", d.name}, {"source", d.file.string()}};
   try {
-    const DesignEvaluation e = evaluate_design(design_mesh(d, registry), scene, material);
+    const ScreenedNeedle needle = design_needle(d, registry, o);
+    const DesignEvaluation e = evaluate_design(needle.mesh, scene, material, needle.options);
     row.ok = true;
     row.peak_force_n = e.peak_force_n;
+    if (e.puncture) {
+      row.puncture_depth_m = e.puncture->depth_m;
+      row.puncture_force_n = e.puncture->force_N;
+    }
     row.margin = e.margin;
     row.passes = e.passes;
-    j.update(evaluation_json(e));
+    const json evaluation = evaluation_json(e);
+    if (const auto key = non_finite_key(evaluation))
+      throw SolverError("non-finite value of " + *key + " (not written)");
+    j.update(evaluation);
   } catch (const std::exception& e) {
     row.ok = false;
     row.error = e.what();
@@ -191,6 +254,7 @@ ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::s
   j["hash"] = row.hash;
   j["ok"] = row.ok;
   j["fidelity"] = o.fidelity;
+  j["model"] = o.model;
   j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   row.json = j.dump();
   return row;
@@ -206,6 +270,10 @@ ScreeningRow row_from_json(const std::string& line) {
   row.json = line;
   if (row.ok) {
     row.peak_force_n = j.at("peak_force_N").get<double>();
+    if (!j.at("puncture_depth_m").is_null()) {
+      row.puncture_depth_m = j.at("puncture_depth_m").get<double>();
+      row.puncture_force_n = j.at("puncture_force_N").get<double>();
+    }
     row.margin = j.at("margin").is_null() ? INFINITY : j.at("margin").get<double>();
     row.passes = j.at("passes").get<bool>();
   } else {
@@ -239,10 +307,29 @@ std::string csv_field(const json& j, const char* key) {
   return j[key].dump();
 }
 
-constexpr const char* kCsvColumns[] = {
-    "design",       "ok",     "peak_force_N", "force_at_depth_N", "depth_m",   "capacity_N",
-    "governing",    "margin", "passes",       "material",         "triangles", "volume_m3",
-    "tip_length_m", "error",  "hash"};
+constexpr const char* kCsvColumns[] = {"design",
+                                       "ok",
+                                       "puncture_depth_m",
+                                       "puncture_force_N",
+                                       "post_puncture_force_N",
+                                       "puncture_criterion",
+                                       "target_depth_m",
+                                       "reaches_target_depth",
+                                       "peak_force_N",
+                                       "force_at_depth_N",
+                                       "capacity_N",
+                                       "governing",
+                                       "margin",
+                                       "passes",
+                                       "material",
+                                       "fidelity",
+                                       "model",
+                                       "triangles",
+                                       "volume_m3",
+                                       "tip_length_m",
+                                       "seconds",
+                                       "error",
+                                       "hash"};
 
 class ResultWriter {
  public:
@@ -313,6 +400,8 @@ std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs
                                          const PluginRegistry& registry,
                                          const ScreeningOptions& options,
                                          const std::function<void(const ScreeningRow&)>& on_row) {
+  parse_fidelity(options.fidelity);  // bad names fail the run, not every row
+  parse_pre_model(options.model);
   const std::string scene_hash = hex(fnv1a(read_bytes(scene_file)));
   std::map<std::string, ScreeningRow> done;
   if (options.resume && options.out) done = finished_rows(*options.out / "results.jsonl");
@@ -324,7 +413,8 @@ std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs
   const std::string material = scene_material(scene, options);
   auto worker = [&] {
     for (std::size_t i = next++; i < designs.size(); i = next++) {
-      const std::string hash = row_hash(designs[i], scene_hash, options.fidelity, material);
+      const std::string hash =
+          row_hash(designs[i], scene_hash, options.fidelity + "|" + options.model, material);
       const auto previous = done.find(hash);
       const bool skip = previous != done.end();
       ScreeningRow row = skip ? previous->second
@@ -336,6 +426,9 @@ std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs
     }
   };
   const int jobs = std::max(1, std::min<int>(options.jobs, static_cast<int>(designs.size())));
+  // Each job factorises with CHOLMOD; OpenBLAS would start a thread per core in every one of them.
+  std::optional<BlasThreadLimit> blas;
+  if (jobs > 1) blas.emplace(1);
   std::vector<std::thread> pool;
   for (int j = 1; j < jobs; ++j) pool.emplace_back(worker);
   worker();
@@ -347,7 +440,11 @@ std::vector<ScreeningRow> rank_rows(std::vector<ScreeningRow> rows) {
   std::stable_sort(rows.begin(), rows.end(), [](const ScreeningRow& a, const ScreeningRow& b) {
     if (a.ok != b.ok) return a.ok;
     if (!a.ok) return false;
-    if (a.passes != b.passes) return a.passes;
+    if (a.puncture_depth_m.has_value() != b.puncture_depth_m.has_value())
+      return a.puncture_depth_m.has_value();
+    if (a.puncture_depth_m && *a.puncture_depth_m != *b.puncture_depth_m)
+      return *a.puncture_depth_m < *b.puncture_depth_m;
+    if (a.puncture_force_n != b.puncture_force_n) return a.puncture_force_n < b.puncture_force_n;
     return a.peak_force_n < b.peak_force_n;
   });
   return rows;

@@ -5,7 +5,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
 
+#include "mneedle/blas_threads.h"
 #include "mneedle/error.h"
 
 namespace {
@@ -41,6 +44,13 @@ class Screening : public ::testing::Test {
     return lines;
   }
 
+  // The closed-form pre-puncture model: the screening machinery at a few ms per design.
+  static mneedle::ScreeningOptions analytic() {
+    mneedle::ScreeningOptions o;
+    o.model = "analytic";
+    return o;
+  }
+
   fs::path dir_;
   fs::path scene_file_ = kRoot + "/designs/scenes/human_skin.toml";
   mneedle::Scene scene_;
@@ -69,7 +79,7 @@ TEST_F(Screening, DesignListErrorsNameFileAndLine) {
 }
 
 TEST_F(Screening, BadDesignGetsAnErrorRowAndEveryOtherIsEvaluatedAndWritten) {
-  mneedle::ScreeningOptions options;
+  mneedle::ScreeningOptions options = analytic();
   options.out = dir_ / "out";
   options.jobs = 2;
   const auto designs = mneedle::collect_designs({dir_ / "in", dir_ / "list.toml"}, 1e-3);
@@ -84,7 +94,7 @@ TEST_F(Screening, BadDesignGetsAnErrorRowAndEveryOtherIsEvaluatedAndWritten) {
 }
 
 TEST_F(Screening, ResumeRedoesOnlyWhatAKilledRunHadNotFinished) {
-  mneedle::ScreeningOptions options;
+  mneedle::ScreeningOptions options = analytic();
   options.out = dir_ / "out";
   const auto designs = mneedle::collect_designs({dir_ / "in"}, 1e-3);
   const auto first = mneedle::screen_designs(designs, scene_, scene_file_, registry_, options);
@@ -105,11 +115,12 @@ TEST_F(Screening, ResumeRedoesOnlyWhatAKilledRunHadNotFinished) {
   for (std::size_t i = 0; i < 4; ++i) {
     EXPECT_EQ(second[i].hash, first[i].hash);
     EXPECT_DOUBLE_EQ(second[i].peak_force_n, first[i].peak_force_n);
+    EXPECT_EQ(second[i].puncture_depth_m, first[i].puncture_depth_m);
   }
 }
 
 TEST_F(Screening, ChangedDesignBytesAreNotResumed) {
-  mneedle::ScreeningOptions options;
+  mneedle::ScreeningOptions options = analytic();
   options.out = dir_ / "out";
   auto designs = mneedle::collect_designs({dir_ / "in" / "cone.stl"}, 1e-3);
   mneedle::screen_designs(designs, scene_, scene_file_, registry_, options);
@@ -118,6 +129,64 @@ TEST_F(Screening, ChangedDesignBytesAreNotResumed) {
   options.resume = true;
   const auto rows = mneedle::screen_designs(designs, scene_, scene_file_, registry_, options);
   EXPECT_FALSE(rows[0].resumed);
+}
+
+TEST_F(Screening, RowsCarryThePunctureWithUnitsInTheirKeys) {
+  const auto designs = mneedle::collect_designs({dir_ / "list.toml"}, 1e-3);
+  const auto rows = mneedle::screen_designs(designs, scene_, scene_file_, registry_, analytic());
+  ASSERT_EQ(rows.size(), 1u);
+  ASSERT_TRUE(rows[0].ok) << rows[0].error;
+  ASSERT_TRUE(rows[0].puncture_depth_m.has_value());
+  EXPECT_GT(*rows[0].puncture_depth_m, 0.0);
+  EXPECT_LE(*rows[0].puncture_depth_m, 200e-6);
+  const auto j = nlohmann::json::parse(rows[0].json);
+  EXPECT_DOUBLE_EQ(j["puncture_depth_m"].get<double>(), *rows[0].puncture_depth_m);
+  EXPECT_DOUBLE_EQ(j["puncture"]["depth_m"].get<double>(), *rows[0].puncture_depth_m);
+  EXPECT_DOUBLE_EQ(j["puncture_force_N"].get<double>(), rows[0].puncture_force_n);
+  for (const char* key : {"post_puncture_force_N", "target_depth_m", "reaches_target_depth",
+                          "peak_force_N", "margin", "passes", "models_run"})
+    EXPECT_TRUE(j.contains(key)) << key;
+}
+
+TEST(ScreeningRank, PuncturedByDepthThenForceUnpuncturedThenErrors) {
+  auto row = [](const char* name, std::optional<double> depth, double force, bool ok = true) {
+    mneedle::ScreeningRow r;
+    r.design = name;
+    r.ok = ok;
+    r.puncture_depth_m = depth;
+    r.puncture_force_n = force;
+    r.peak_force_n = 1.0;
+    return r;
+  };
+  const auto ranked =
+      mneedle::rank_rows({row("error", std::nullopt, 0, false), row("never", std::nullopt, 0),
+                          row("deep", 80e-6, 0.01), row("shallow_strong", 30e-6, 0.02),
+                          row("shallow_light", 30e-6, 0.01)});
+  std::vector<std::string> order;
+  for (const auto& r : ranked) order.push_back(r.design);
+  EXPECT_EQ(order, (std::vector<std::string>{"shallow_light", "shallow_strong", "deep", "never",
+                                             "error"}));
+}
+
+TEST_F(Screening, ParallelJobsHoldOpenBlasAtOneThreadEach) {
+  // Two cylinders: the axisymmetric FE model (a CHOLMOD factorisation each).
+  std::ofstream(dir_ / "cylinders.toml")
+      << "[[designs]]\nplugin = \"cylinder\"\ndiameter = \"200 um\"\n"
+         "[[designs]]\nplugin = \"cylinder\"\ndiameter = \"230 um\"\n";
+  const int before = mneedle::blas_threads();
+  if (before == 0) GTEST_SKIP() << "the BLAS of this process is not OpenBLAS";
+  mneedle::ScreeningOptions options;
+  options.jobs = 2;
+  std::vector<int> during;
+  const auto rows = mneedle::screen_designs(
+      mneedle::collect_designs({dir_ / "cylinders.toml"}, 1e-3), scene_, scene_file_, registry_,
+      options, [&](const mneedle::ScreeningRow&) { during.push_back(mneedle::blas_threads()); });
+  for (const auto& r : rows) {
+    ASSERT_TRUE(r.ok) << r.error;
+    EXPECT_NE(r.json.find("axisymmetric_fe"), std::string::npos) << r.json;
+  }
+  EXPECT_EQ(during, (std::vector<int>{1, 1}));
+  EXPECT_EQ(mneedle::blas_threads(), before);
 }
 
 }  // namespace

@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <set>
+#include <string>
+#include <thread>
 
 #include "mneedle/error.h"
 
@@ -69,12 +73,158 @@ TEST(TipOptimizer, GlobalSearchIsDeterministicUnderASeed) {
   EXPECT_NEAR(a.best.at("x") + a.best.at("y"), 2.0, 0.2);
 }
 
+// Two minima along x: (x² − 1)² + 0.3 x + y². The global one is at x ≈ −1.04 (f ≈ −0.31), a
+// local one at x ≈ +0.96 (f ≈ +0.29). Every search starts at x = 1.2, in the local basin.
+mneedle::DesignScore two_wells(const std::map<std::string, double>& v) {
+  const double x = v.at("x"), y = v.at("y");
+  return {(x * x - 1) * (x * x - 1) + 0.3 * x + y * y, {}};
+}
+const std::vector<mneedle::DesignVariable> kWells = {{"x", -1.5, 2.5}, {"y", -1.0, 1.0}};
+const std::vector<double> kWellsStart = {1.2, 0.3};
+constexpr double kGlobalX = -1.0356;  // root of 4x(x² − 1) + 0.3 = 0 near −1
+constexpr double kLocalX = 0.9603;
+
+TEST(TipOptimizer, SingleLocalStartStaysInTheLocalMinimumOfTwoWells) {
+  mneedle::OptimizerOptions o;
+  o.start = kWellsStart;
+  o.max_evaluations = 200;
+  o.relative_tolerance = 1e-6;
+  for (const char* algorithm : {"cobyla", "bobyqa"}) {
+    o.algorithm = algorithm;
+    const auto r = mneedle::optimize_design(kWells, two_wells, 0, o);
+    EXPECT_NEAR(r.best.at("x"), kLocalX, 1e-2) << algorithm;
+    EXPECT_EQ(r.starts.size(), 1u);
+  }
+}
+
+TEST(TipOptimizer, MultiStartFindsTheGlobalMinimumOfTwoWells) {
+  for (const char* algorithm : {"cobyla", "bobyqa"}) {
+    mneedle::OptimizerOptions o;
+    o.algorithm = algorithm;
+    o.start = kWellsStart;
+    o.starts = 4;
+    o.max_evaluations = 800;
+    o.seed = 7;
+    const auto r = mneedle::optimize_design(kWells, two_wells, 0, o);
+    EXPECT_NEAR(r.best.at("x"), kGlobalX, 1e-2) << algorithm;
+    EXPECT_NEAR(r.best.at("y"), 0.0, 1e-2) << algorithm;
+    EXPECT_EQ(r.starts.size(), 4u) << algorithm;
+    EXPECT_LE(r.evaluations, 800) << algorithm;
+    EXPECT_DOUBLE_EQ(r.starts[0].start.at("x"), 1.2) << algorithm;
+    if (std::string(algorithm) == "bobyqa") {  // COBYLA may use a start's whole share here
+      EXPECT_EQ(r.stop, mneedle::StopKind::Converged) << r.stop_reason;
+    }
+    // The scattered starts lie in different thirds of x's range (a Latin hypercube).
+    std::set<int> thirds;
+    for (std::size_t s = 1; s < r.starts.size(); ++s)
+      thirds.insert(static_cast<int>((r.starts[s].start.at("x") + 1.5) / 4.0 * 3.0));
+    EXPECT_EQ(thirds.size(), 3u) << algorithm;
+  }
+}
+
+TEST(TipOptimizer, MlslFindsTheGlobalMinimumOfTwoWells) {
+  for (const char* local : {"bobyqa", "cobyla"}) {
+    mneedle::OptimizerOptions o;
+    o.algorithm = "mlsl";
+    o.local_algorithm = local;
+    o.max_evaluations = 300;
+    o.relative_tolerance = 1e-6;
+    const auto r = mneedle::optimize_design(kWells, two_wells, 0, o);
+    EXPECT_NEAR(r.best.at("x"), kGlobalX, 1e-2) << local;
+    EXPECT_EQ(r.stop, mneedle::StopKind::MaxEvaluations) << local;  // MLSL runs to its budget
+  }
+}
+
+TEST(TipOptimizer, MlslWithConstraintsFindsTheActiveConstraintOptimum) {
+  mneedle::OptimizerOptions o;
+  o.algorithm = "mlsl";
+  o.max_evaluations = 600;
+  o.relative_tolerance = 1e-7;
+  const auto r = mneedle::optimize_design(kBox, constrained_bowl, 1, o);
+  EXPECT_TRUE(r.feasible);
+  EXPECT_NEAR(r.best.at("x"), 1.5, 2e-2);
+  EXPECT_NEAR(r.best.at("y"), 0.5, 2e-2);
+}
+
+TEST(TipOptimizer, MultiStartIsDeterministicUnderASeedAndTheSeedMoves) {
+  mneedle::OptimizerOptions o;
+  o.starts = 5;
+  o.max_evaluations = 150;
+  o.seed = 3;
+  const auto a = mneedle::optimize_design(kWells, two_wells, 0, o);
+  const auto b = mneedle::optimize_design(kWells, two_wells, 0, o);
+  ASSERT_EQ(a.history.size(), b.history.size());
+  for (std::size_t i = 0; i < a.history.size(); ++i)
+    EXPECT_EQ(a.history[i].values, b.history[i].values) << i;
+  EXPECT_EQ(a.best, b.best);
+  o.seed = 4;
+  const auto c = mneedle::optimize_design(kWells, two_wells, 0, o);
+  EXPECT_NE(a.starts[1].start, c.starts[1].start);
+}
+
+TEST(TipOptimizer, WallTimeBudgetStopsTheSearch) {
+  // Each design takes 10 ms; 10 000 evaluations would take 100 s, the budget is 0.3 s.
+  auto slow = [](const std::map<std::string, double>& v) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    return two_wells(v);
+  };
+  for (const char* algorithm : {"cobyla", "isres"}) {
+    mneedle::OptimizerOptions o;
+    o.algorithm = algorithm;
+    o.max_evaluations = 10000;
+    o.relative_tolerance = 1e-15;
+    o.max_time_s = 0.3;
+    const auto r = mneedle::optimize_design(kWells, slow, 0, o);
+    EXPECT_EQ(r.stop, mneedle::StopKind::MaxTime) << algorithm << ": " << r.stop_reason;
+    EXPECT_NE(r.stop_reason.find("time"), std::string::npos) << r.stop_reason;
+    EXPECT_LT(r.evaluations, 1000) << algorithm;
+    EXPECT_GE(r.evaluations, 1) << algorithm;
+    EXPECT_FALSE(r.best.empty());
+  }
+}
+
+TEST(TipOptimizer, EvaluationBudgetIsReportedAsTheStopReason) {
+  mneedle::OptimizerOptions o;
+  o.algorithm = "isres";
+  o.max_evaluations = 50;
+  const auto r = mneedle::optimize_design(kWells, two_wells, 0, o);
+  EXPECT_EQ(r.stop, mneedle::StopKind::MaxEvaluations);
+  EXPECT_EQ(r.evaluations, 50);
+  EXPECT_STREQ(mneedle::to_string(r.stop), "max_evaluations");
+}
+
+TEST(TipOptimizer, ProgressIsReportedWithTheBestSoFar) {
+  std::vector<mneedle::OptimizerProgress> seen;
+  mneedle::OptimizerOptions o;
+  o.max_evaluations = 40;
+  o.progress_interval_s = 0.0;  // every evaluation
+  o.progress = [&](const mneedle::OptimizerProgress& p) { seen.push_back(p); };
+  const auto r = mneedle::optimize_design(kBox, constrained_bowl, 1, o);
+  ASSERT_EQ(static_cast<int>(seen.size()), r.evaluations);
+  for (std::size_t i = 1; i < seen.size(); ++i) {
+    EXPECT_EQ(seen[i].evaluations, seen[i - 1].evaluations + 1);
+    if (seen[i - 1].feasible) {
+      EXPECT_TRUE(seen[i].feasible);
+      EXPECT_LE(seen[i].best_objective, seen[i - 1].best_objective);
+    }
+  }
+  EXPECT_TRUE(seen.back().feasible);
+  EXPECT_DOUBLE_EQ(seen.back().best_objective, r.best_objective);
+}
+
 TEST(TipOptimizer, RejectsBadProblems) {
   mneedle::OptimizerOptions o;
   EXPECT_THROW(mneedle::optimize_design({}, constrained_bowl, 1, o), mneedle::InputError);
   EXPECT_THROW(mneedle::optimize_design({{"x", 1.0, 1.0}}, constrained_bowl, 1, o),
                mneedle::InputError);
   o.algorithm = "simplex-of-doom";
+  EXPECT_THROW(mneedle::optimize_design(kBox, constrained_bowl, 1, o), mneedle::InputError);
+  o.algorithm = "isres";
+  o.starts = 3;  // global algorithms scatter their own points
+  EXPECT_THROW(mneedle::optimize_design(kBox, constrained_bowl, 1, o), mneedle::InputError);
+  o.algorithm = "mlsl";
+  o.starts = 1;
+  o.local_algorithm = "newton";
   EXPECT_THROW(mneedle::optimize_design(kBox, constrained_bowl, 1, o), mneedle::InputError);
 }
 

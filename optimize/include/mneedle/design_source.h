@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "mneedle/fe/axisymmetric.h"
+#include "mneedle/insertion_run.h"
 #include "mneedle/mesh.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene.h"
@@ -39,5 +41,19 @@ NeedleSource needle_from_plugin(const PluginRegistry& registry, const std::strin
                                 const std::map<std::string, double>& params_si);
 
 NeedleSource needle_from_scene(const PluginRegistry& registry, const NeedleSpec& spec);
+
+/// The outer profile of a body-of-revolution plugin needle (the cylinder and cone plugins),
+/// sampled from the plugin's section area A(h) = pi (r_out^2 - r_bore^2); nullopt for any other
+/// shape. `where` prefixes messages.
+std::optional<fe::AxisymmetricNeedle> axisymmetric_profile(const PluginRegistry& registry,
+                                                           const NeedleSource& needle,
+                                                           const std::string& where);
+
+/// True when the mirror image (x, -y, z) of every vertex is a vertex (within 1e-6 of the mesh
+/// size): the needle is symmetric about its y = 0 plane (bevels, bodies of revolution).
+bool mirror_symmetric_y0(const TriangleMesh& mesh);
+
+/// Every needle of the scene ready for run_insertion, in the scene's order.
+std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, const Scene& scene);
 
 }  // namespace mneedle

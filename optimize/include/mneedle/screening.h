@@ -35,7 +35,8 @@ struct ScreeningOptions {
   std::optional<std::string> material;       // overrides the scene's needle material
   std::optional<std::filesystem::path> out;  // folder for results.csv and results.jsonl
   bool resume = false;                       // skip designs already in out/results.jsonl
-  std::string fidelity = "standard";
+  std::string fidelity = "fast";  // fast | standard | fine: the FE stage of run_insertion
+  std::string model = "auto";     // auto | analytic | axisymmetric | 3d
 };
 
 /// One row of a screening: an evaluation or the reason there is none. `json` is the row as
@@ -47,6 +48,8 @@ struct ScreeningRow {
   bool resumed = false;
   std::string error;
   std::string json;
+  std::optional<double> puncture_depth_m;  // empty: no puncture up to the target depth
+  double puncture_force_n = 0.0;
   double peak_force_n = 0.0;
   double margin = 0.0;
   bool passes = false;
@@ -61,8 +64,9 @@ std::vector<ScreeningRow> screen_designs(
     const std::filesystem::path& scene_file, const PluginRegistry& registry,
     const ScreeningOptions& options, const std::function<void(const ScreeningRow&)>& on_row = {});
 
-/// Sorted for the table: successful rows first, passing before failing, then by peak force;
-/// error rows last in input order.
+/// Sorted for the table: successful rows first; designs that puncture by puncture depth, then
+/// puncture force; designs that never puncture after them (by peak force); error rows last in
+/// input order. Pass/fail does not reorder: it is a column.
 std::vector<ScreeningRow> rank_rows(std::vector<ScreeningRow> rows);
 
 }  // namespace mneedle

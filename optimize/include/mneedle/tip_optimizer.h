@@ -1,6 +1,7 @@
 #pragma once
 // NLopt searches over named design parameters (issue 6 §2): scaled bounds, an evaluation cache,
-// failed evaluations as penalised points, infeasible problems reported as such.
+// failed evaluations as penalised points, infeasible problems reported as such, multi-start and
+// MLSL for problems with more than one minimum, evaluation and wall-time budgets.
 
 #include <functional>
 #include <map>
@@ -24,14 +25,29 @@ struct DesignScore {
 
 using DesignFunction = std::function<DesignScore(const std::map<std::string, double>& values)>;
 
+/// A snapshot for a progress line: how far the search is and what it has found.
+struct OptimizerProgress {
+  int evaluations = 0;
+  double best_objective = 0.0;  // best feasible, else the least-violated design's objective
+  bool feasible = false;        // whether any feasible design has been found
+  double elapsed_s = 0.0;
+  int start = 1;  // which of the multi-start runs is going (1-based)
+  int starts = 1;
+};
+
 struct OptimizerOptions {
-  std::string algorithm = "cobyla";  // cobyla | bobyqa (inside AUGLAG) | isres
-  int max_evaluations = 100;
-  double max_time_s = 0.0;           // 0 = no limit
+  /// cobyla | bobyqa (inside AUGLAG) | isres | mlsl (NLopt's MLSL with low-discrepancy points and
+  /// the local algorithm below, inside AUGLAG when there are constraints)
+  std::string algorithm = "cobyla";
+  std::string local_algorithm = "bobyqa";  // mlsl's local search: cobyla | bobyqa
+  int starts = 1;  // local algorithms: runs from the start point and scattered points, best kept
+  int max_evaluations = 100;         // distinct designs over all starts
+  double max_time_s = 0.0;           // wall time over all starts; 0 = no limit
   double relative_tolerance = 1e-4;  // on the scaled variables
-  unsigned seed = 1;
-  std::vector<double> start;  // SI; empty = the middle of the bounds
-  std::function<void(int evaluation, double best)> progress;  // optional, serialised
+  unsigned seed = 1;                 // scattered starts, ISRES and MLSL
+  std::vector<double> start;         // SI; empty = the middle of the bounds
+  double progress_interval_s = 2.0;  // at most one progress call per interval
+  std::function<void(const OptimizerProgress&)> progress;  // optional
 };
 
 struct EvaluationRecord {
@@ -42,7 +58,19 @@ struct EvaluationRecord {
   bool failed = false;
   std::string error;
   double seconds = 0.0;
+  int start = 1;  // the multi-start run that asked for it (1-based)
 };
+
+/// One local run of a multi-start search.
+struct StartRecord {
+  std::map<std::string, double> start;  // SI
+  int evaluations = 0;                  // distinct designs this run added
+  std::string stop_reason;
+};
+
+/// Why the whole search stopped, as a short key for JSON and scripts.
+enum class StopKind { Converged, MaxEvaluations, MaxTime, RoundoffLimited, Failed };
+const char* to_string(StopKind kind);
 
 struct OptimizerResult {
   std::map<std::string, double> best;  // best feasible, else least violated
@@ -50,12 +78,15 @@ struct OptimizerResult {
   bool feasible = false;
   int evaluations = 0;  // distinct designs evaluated (cache hits not counted)
   std::string algorithm;
-  std::string stop_reason;
+  StopKind stop = StopKind::Converged;
+  std::string stop_reason;  // human-readable, with the per-start reasons for a multi-start
+  double seconds = 0.0;
+  std::vector<StartRecord> starts;
   std::vector<EvaluationRecord> history;
 };
 
 /// Runs NLopt on `f` over `variables`. InputError for empty or inverted bounds, an unknown
-/// algorithm, or a start point outside the bounds.
+/// algorithm, a start point outside the bounds, or --starts with a global algorithm.
 OptimizerResult optimize_design(const std::vector<DesignVariable>& variables,
                                 const DesignFunction& f, int constraint_count,
                                 const OptimizerOptions& options);

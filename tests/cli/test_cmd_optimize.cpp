@@ -1,0 +1,142 @@
+// `mneedle optimize` end to end: the puncture-depth objective with its target-depth constraint,
+// the JSON summary, the outputs on disk, multi-start and MLSL from the CLI, the time budget and
+// bad input. The analytic pre-puncture model keeps each run to a second or two; the FE models are
+// the same code path in run_insertion.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "run_mneedle.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using mneedle::test::run_mneedle;
+
+const std::string kRoot = MNEEDLE_SOURCE_ROOT;
+const std::string kSkin = kRoot + "/designs/scenes/human_skin.toml";
+constexpr double kPi = 3.14159265358979323846;
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("mneedle_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+TEST(OptimizeCommand, PunctureDepthIsTheDefaultObjectiveAndTheSummaryHasItsKeys) {
+  const fs::path dir = temp_dir("optimize_depth");
+  const auto run =
+      run_mneedle("optimize --plugin sharp_bevel --scene '" + kSkin +
+                  "' --vary bevel_angle --bound bevel_angle=15deg:60deg"
+                  " --model analytic --material silicon --max-evals 20 --json --out '" +
+                  dir.string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["objective"], "puncture_depth_m");
+  EXPECT_EQ(j["algorithm"], "cobyla");
+  EXPECT_TRUE(j["feasible"].get<bool>());
+  EXPECT_LE(j["evaluations"].get<int>(), 20);
+  const auto& best = j["best"];
+  ASSERT_TRUE(best["puncture_depth_m"].is_number()) << j.dump(2);
+  const double depth = best["puncture_depth_m"].get<double>();
+  EXPECT_GE(depth, 0.0);  // the analytic model's sharp tip punctures almost at once
+  EXPECT_LE(depth, best["target_depth_m"].get<double>());
+  EXPECT_GT(best["margin"].get<double>(), best["safety_factor"].get<double>());
+  EXPECT_TRUE(best["params"].contains("bevel_angle"));
+  EXPECT_FALSE(j["stop_reason"].get<std::string>().empty());
+  EXPECT_TRUE(fs::exists(dir / "best.stl"));
+  EXPECT_TRUE(fs::exists(dir / "summary.json"));
+  std::ifstream history(dir / "history.csv");
+  std::string header;
+  std::getline(history, header);
+  EXPECT_NE(header.find("puncture_depth_m"), std::string::npos) << header;
+  EXPECT_NE(header.find("target_depth_constraint"), std::string::npos) << header;
+  fs::remove_all(dir);
+}
+
+TEST(OptimizeCommand, PeakForceObjectiveReportsTheLowestFeasiblePeakForceOfItsHistory) {
+  const fs::path dir = temp_dir("optimize_force");
+  const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSkin +
+                               "' --vary bevel_angle --bound bevel_angle=20deg:60deg"
+                               " --objective peak-force --model analytic --material silicon"
+                               " --max-evals 25 --json --out '" +
+                               dir.string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["objective"], "peak_force_N");
+  EXPECT_TRUE(j["feasible"].get<bool>());
+  // history.csv: bevel_angle_SI, peak_force_N, 3 constraints, feasible, ...
+  std::ifstream history(dir / "history.csv");
+  std::string line;
+  std::getline(history, line);
+  double lowest = 1e300;
+  int rows = 0;
+  while (std::getline(history, line)) {
+    std::vector<std::string> cells;
+    std::stringstream cs(line);
+    for (std::string c; std::getline(cs, c, ',');) cells.push_back(c);
+    ASSERT_GE(cells.size(), 6u) << line;
+    if (cells[5] == "1") lowest = std::min(lowest, std::stod(cells[1]));
+    ++rows;
+  }
+  EXPECT_EQ(rows, j["evaluations"].get<int>());
+  EXPECT_NEAR(j["best"]["peak_force_N"].get<double>() / lowest, 1.0, 1e-5);
+  fs::remove_all(dir);
+}
+
+TEST(OptimizeCommand, MultiStartAndMlslRunFromTheCommandLine) {
+  const std::string common = "optimize --plugin sharp_bevel --scene '" + kSkin +
+                             "' --vary bevel_angle --bound bevel_angle=15deg:60deg"
+                             " --model analytic --material silicon --json";
+  const auto multi = run_mneedle(common + " --starts 3 --max-evals 30 --seed 5");
+  ASSERT_EQ(multi.exit_code, 0) << multi.err;
+  const auto m = nlohmann::json::parse(multi.out);
+  EXPECT_EQ(m["starts"].get<int>(), 3);
+  const auto again =
+      nlohmann::json::parse(run_mneedle(common + " --starts 3 --max-evals 30 --seed 5").out);
+  EXPECT_EQ(m["best"]["params"], again["best"]["params"]);
+  EXPECT_EQ(m["evaluations"], again["evaluations"]);
+
+  const auto mlsl = run_mneedle(common + " --algorithm mlsl --local cobyla --max-evals 30");
+  ASSERT_EQ(mlsl.exit_code, 0) << mlsl.err;
+  const auto g = nlohmann::json::parse(mlsl.out);
+  EXPECT_EQ(g["algorithm"], "mlsl");
+  EXPECT_EQ(g["local_algorithm"], "cobyla");
+  EXPECT_LE(g["evaluations"].get<int>(), 30);
+}
+
+TEST(OptimizeCommand, TimeBudgetStopsTheSearchAndSaysSo) {
+  const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSkin +
+                               "' --vary bevel_angle,diameter --model analytic --material silicon"
+                               " --algorithm isres --max-evals 100000 --max-time 1s --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["stop"], "max_time") << j["stop_reason"];
+  EXPECT_LT(j["evaluations"].get<int>(), 100000);
+}
+
+TEST(OptimizeCommand, BadInputIsAClearError) {
+  auto run = run_mneedle("optimize --plugin cone --scene '" + kSkin + "' --vary bevel_angle");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("has no parameter 'bevel_angle'"), std::string::npos) << run.err;
+  run = run_mneedle("optimize --plugin cone --scene '" + kSkin +
+                    "' --vary half_angle --min-feature -5um");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("--min-feature"), std::string::npos) << run.err;
+  run = run_mneedle("optimize --plugin cone --scene '" + kSkin +
+                    "' --vary half_angle --algorithm isres --starts 3");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("--starts"), std::string::npos) << run.err;
+  run = run_mneedle("optimize --plugin cone --scene '" + kSkin +
+                    "' --vary half_angle --max-time 5kg");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("5kg"), std::string::npos) << run.err;
+}
+
+}  // namespace
