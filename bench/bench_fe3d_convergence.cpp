@@ -1,6 +1,6 @@
 // Convergence studies of the 3-D model through its public API (docs/_parts/crack-validation.md,
 // crack-performance.md). Run on demand, never from ctest:
-//   bench_fe3d_convergence [punch] [skin] [stress] [crack] [held]   (no argument: all five)
+//   bench_fe3d_convergence [punch] [frictionless] [skin] [stress] [crack] [held]   (none: all)
 // Prints one table per study; each run's time is the process CPU time (the machine is shared).
 #include <Eigen/Core>
 #include <cmath>
@@ -115,6 +115,29 @@ void punch_study() {
                   s.force, s.force / exact - 1.0);
       std::fflush(stdout);
     }
+}
+
+// a'. The same punch in frictionless contact against Hayes' frictionless layer, F = 2 a E* d
+// kappa, beside the sticking punch on the same meshes: quadrature-point contact on the faces that
+// straddle the rim holds the tissue a little beyond a (too stiff), captured nodes strictly inside
+// a stop short of it (too soft); both must close on the closed form as the tip size falls.
+void frictionless_punch_study() {
+  const double a = 200e-6, E = 1e6, nu = 0.45, h = 1e-3;
+  const double polygon = std::sqrt(96.0 / (2 * kPi) * std::sin(2 * kPi / 96.0));
+  const double beta = (1 - nu) * std::log(3 - 4 * nu) / (1 - 2 * nu);
+  const double frictionless = 2 * a * polygon * E / (1 - nu * nu) * 1.252 * kDepth;
+  const Needle3d punch{"punch", mneedle::test::cylinder_needle(a, 1000e-6, 96), 0.0, 0.0};
+  const TissueBlockSpec block = homogeneous_block(8e-3, h, E, nu);
+  std::printf("\n# a'. flat punch, frictionless vs sticking, Hayes F = %.6g N (bonded x%.4f)\n",
+              frictionless, beta);
+  std::printf("order tip_size_um nodes cpu_s frictionless_rel sticking_rel\n");
+  for (double per_radius : {1.5, 2.0, 3.0, 4.0, 6.0}) {
+    const Sample f = simulate(block, punch, 2, a / per_radius, ContactMode::Frictionless, 1);
+    const Sample s = simulate(block, punch, 2, a / per_radius, ContactMode::Sticking, 1);
+    std::printf("2 %.1f %d %.2f %+.4f %+.4f\n", f.tip_size * 1e6, f.nodes, f.seconds + s.seconds,
+                f.force / frictionless - 1.0, s.force / (frictionless * beta) - 1.0);
+    std::fflush(stdout);
+  }
 }
 
 // a/b. Three-layer skin, sticking cone: force at 200 um against the finest TET10, and the
@@ -279,10 +302,12 @@ void held_contact_study() {
 int main(int argc, char** argv) {
   try {
     std::vector<std::string> studies(argv + 1, argv + argc);
-    if (studies.empty()) studies = {"punch", "skin", "stress", "crack", "held"};
+    if (studies.empty()) studies = {"punch", "frictionless", "skin", "stress", "crack", "held"};
     for (const std::string& study : studies) {
       if (study == "punch")
         punch_study();
+      else if (study == "frictionless")
+        frictionless_punch_study();
       else if (study == "skin")
         skin_study();
       else if (study == "stress")

@@ -170,7 +170,8 @@ void require_grid_plane(const TetMesh& mesh, const std::vector<double>& distance
 
 }  // namespace
 
-TetMesh crack_mesh(const TetMesh& mesh, const PlanarCrack& crack, double* area_m2) {
+TetMesh crack_mesh(const TetMesh& mesh, const PlanarCrack& crack, double* area_m2,
+                   std::vector<int>* original_node) {
   Eigen::Vector3d lo = mesh.nodes.empty() ? Eigen::Vector3d::Zero() : mesh.nodes.front();
   Eigen::Vector3d hi = lo;
   for (const auto& p : mesh.nodes) {
@@ -238,6 +239,14 @@ TetMesh crack_mesh(const TetMesh& mesh, const PlanarCrack& crack, double* area_m
   link_neighbours(cracked);
   collect_top_faces(cracked);
   if (area_m2) *area_m2 = area;
+  if (original_node) {
+    original_node->resize(cracked.nodes.size());
+    for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
+      (*original_node)[n] = static_cast<int>(n);
+      if (copy_of[n] >= 0)
+        (*original_node)[static_cast<std::size_t>(copy_of[n])] = static_cast<int>(n);
+    }
+  }
   return cracked;
 }
 

@@ -45,8 +45,8 @@ constexpr int kMaxCaptureRounds = 60;
 constexpr int kMaxNewtonIterations = 40;
 constexpr int kMaxLineSearchHalvings = 6;
 constexpr int kMaxStepCuts = 12;
-// Frictionless contact: Uzawa updates of the multipliers until the largest change of a point's
-// force is below kUzawaTolerance of the summed contact force (ε = 100 E*/h: about 10 updates).
+// Frictionless contact: Uzawa updates of the multipliers until no nodal contact force changes by
+// more than kUzawaTolerance of the summed contact force (ε = 100 E*/h: about 10 updates).
 constexpr int kMaxUzawa = 50;
 constexpr double kUzawaTolerance = 1e-4;
 constexpr int kMaxContactNewton = 60;
@@ -55,9 +55,9 @@ constexpr int kMaxContactNewton = 60;
 
 struct Indentation3d::Impl {
   Impl(const TetMesh& m, std::vector<Needle3d> n, const Indentation3dOptions& o)
-      : mesh(m), model(m), needles(std::move(n)), options(o) {}
+      : mesh(m), model(mesh), needles(std::move(n)), options(o) {}
 
-  const TetMesh& mesh;
+  const TetMesh mesh;  // a copy: callers may pass a temporary
   SolidModel model;
   std::vector<Needle3d> needles;
   Indentation3dOptions options;
@@ -90,6 +90,9 @@ struct Indentation3d::Impl {
   std::vector<int> involved_index;  // node -> column block or -1
   Eigen::VectorXd contact_load;     // force on the tissue at the involved nodes (linear path)
   std::vector<ContactPointState> contact_states;
+  // Cracked twin: the run whose captures this one copies, and each node's node in its mesh.
+  const Impl* leader = nullptr;
+  std::vector<int> leader_node;
 
   Eigen::Vector3d tip(int needle, double at_depth) const {
     const auto& n = needles[static_cast<std::size_t>(needle)];
@@ -130,6 +133,7 @@ struct Indentation3d::Impl {
   // Candidates whose current position lies inside a needle at `at_depth` are captured onto the
   // needle face right below them (the face that swept over them).
   std::vector<CapturedNode> find_new_captures(double at_depth, const auto& displacement_of) const {
+    if (leader) return captures_from_leader();
     std::vector<CapturedNode> found;
     for (int node : candidates) {
       if (captured_by[static_cast<std::size_t>(node)] >= 0) continue;
@@ -140,6 +144,20 @@ struct Indentation3d::Impl {
         found.push_back({node, static_cast<int>(n), shapes[n].lower_surface_below(local)});
         break;
       }
+    }
+    return found;
+  }
+
+  // The leader's captures this run does not hold yet, on every copy of each captured node.
+  std::vector<CapturedNode> captures_from_leader() const {
+    std::vector<CapturedNode> found;
+    for (int node : candidates) {
+      if (captured_by[static_cast<std::size_t>(node)] >= 0) continue;
+      const int in_leader = leader_node[static_cast<std::size_t>(node)];
+      const int needle = leader->captured_by[static_cast<std::size_t>(in_leader)];
+      if (needle < 0) continue;
+      for (const CapturedNode& c : leader->captured)
+        if (c.node == in_leader) found.push_back({node, needle, c.anchor});
     }
     return found;
   }
@@ -527,6 +545,23 @@ struct Indentation3d::Impl {
     return c;
   }
 
+  // Uzawa has settled when the nodal contact forces stop changing. The point multipliers
+  // themselves are not a good measure: with more contact points than face nodes, patterns of λ
+  // that the face interpolation cannot see keep drifting without changing any force.
+  bool multipliers_settled(Eigen::VectorXd* previous) const {
+    const auto& nodes = contact->nodes();
+    Eigen::VectorXd forces = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(nodes.size()));
+    contact->for_each_force(contact_states, [&](int node, const Eigen::Vector3d& f) {
+      const auto at = std::lower_bound(nodes.begin(), nodes.end(), node) - nodes.begin();
+      forces.segment<3>(3 * at) += f;
+    });
+    const bool settled =
+        previous->size() == forces.size() &&
+        (forces - *previous).lpNorm<Eigen::Infinity>() <= kUzawaTolerance * needle_force_scale();
+    *previous = std::move(forces);
+    return settled;
+  }
+
   double needle_force_scale() const {
     double total = 0.0;
     contact->for_each_force(contact_states,
@@ -538,10 +573,11 @@ struct Indentation3d::Impl {
     if (!linear_factorized) factorize_linear();
     const auto start = Clock::now();
     int solves = 0;
+    Eigen::VectorXd previous_forces;
     for (int update = 0; update < kMaxUzawa; ++update) {
       solves += solve_condensed(at_depth);
-      const double change = contact->update_multipliers(contact_states);
-      if (change <= kUzawaTolerance * needle_force_scale()) {
+      contact->update_multipliers(contact_states);
+      if (multipliers_settled(&previous_forces)) {
         timing.contact_s += seconds_since(start);
         return solves;
       }
@@ -613,12 +649,13 @@ struct Indentation3d::Impl {
 
   int solve_frictionless_nonlinear_at(double at_depth) {
     int total = 0;
+    Eigen::VectorXd previous_forces;
     for (int update = 0; update < kMaxUzawa; ++update) {
       total += newton_frictionless(at_depth);
       contact_states = contact->evaluate(
           at_depth, [&](int node) -> Eigen::Vector3d { return u.segment<3>(3 * node); });
-      const double change = contact->update_multipliers(contact_states);
-      if (change <= kUzawaTolerance * needle_force_scale()) return total;
+      contact->update_multipliers(contact_states);
+      if (multipliers_settled(&previous_forces)) return total;
     }
     throw SolverError("frictionless multipliers did not settle");
   }
@@ -798,6 +835,18 @@ Indentation3d::Indentation3d(const TetMesh& mesh, std::vector<Needle3d> needles,
 
 Indentation3d::~Indentation3d() = default;
 
+void Indentation3d::hold_contact_of(const Indentation3d& leader, std::vector<int> leader_node) {
+  if (impl_->frictionless() || leader.impl_->frictionless())
+    throw InputError("3-D indentation: a held contact needs sticking contact");
+  if (leader_node.size() != impl_->mesh.nodes.size())
+    throw InputError("3-D indentation: held contact: one leader node per node expected");
+  for (int node : leader_node)
+    if (node < 0 || static_cast<std::size_t>(node) >= leader.impl_->mesh.nodes.size())
+      throw InputError("3-D indentation: held contact: leader node out of range");
+  impl_->leader = leader.impl_.get();
+  impl_->leader_node = std::move(leader_node);
+}
+
 Step3d Indentation3d::advance_to(double depth) {
   if (!(depth >= impl_->depth) || !std::isfinite(depth))
     throw InputError("3-D indentation: depths must grow (asked " + micrometres(depth) + " after " +
@@ -880,17 +929,23 @@ void Indentation3d::write_vtu(const std::string& path) const {
 namespace {
 
 // Every needle's crack, one after the other on the same mesh; returns the total area (one
-// face, of the meshed part) and each needle's share.
+// face, of the meshed part) and each needle's share; `original_node` maps every node of the
+// cracked mesh to its node in `mesh`.
 TetMesh cracked_copy(const TetMesh& mesh, const std::vector<Needle3d>& needles, double depth,
-                     std::vector<double>* areas) {
+                     std::vector<double>* areas, std::vector<int>* original_node) {
   TetMesh cracked = mesh;
+  original_node->resize(mesh.nodes.size());
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n) (*original_node)[n] = static_cast<int>(n);
   for (const Needle3d& needle : needles) {
     PlanarCrack crack;
     crack.origin_m = Eigen::Vector3d(needle.x, needle.y, 0.0);
     crack.normal = Eigen::Vector3d::UnitX();
     crack.depth_m = depth;
     double area = 0.0;
-    cracked = crack_mesh(cracked, crack, &area);
+    std::vector<int> previous;
+    cracked = crack_mesh(cracked, crack, &area, &previous);
+    for (int& node : previous) node = (*original_node)[static_cast<std::size_t>(node)];
+    *original_node = std::move(previous);
     areas->push_back(area);
   }
   cracked.mirror_y0 = mesh.mirror_y0;
@@ -938,8 +993,9 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   const TetMesh mesh = generate_tissue_mesh(block);
   std::vector<double> crack_areas;
   TetMesh cracked;
+  std::vector<int> original_node;
   if (options.crack_depth_m > 0.0)
-    cracked = cracked_copy(mesh, needles, options.crack_depth_m, &crack_areas);
+    cracked = cracked_copy(mesh, needles, options.crack_depth_m, &crack_areas, &original_node);
   const double meshing = seconds_since(start);
 
   Simulation3dResult result;
@@ -954,6 +1010,10 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   std::unique_ptr<Indentation3d> cracked_run;
   if (options.crack_depth_m > 0.0)
     cracked_run = std::make_unique<Indentation3d>(cracked, needles, options.depth, solver_options);
+  // With sticking contact the cracked twin holds the intact run's captured nodes: left to its
+  // own search it captures a different set and U_intact - U_cracked loses its sign.
+  if (cracked_run && options.contact == ContactMode::Sticking)
+    cracked_run->hold_contact_of(run, std::move(original_node));
   const double whole = mesh.mirror_y0 ? 2.0 : 1.0;
   double total_crack_area = 0.0;
   for (double a : crack_areas) total_crack_area += whole * a;

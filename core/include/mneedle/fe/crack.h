@@ -4,6 +4,7 @@
 // Griffith's criterion at fixed displacement; docs/model.md).
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "mneedle/fe/tissue_mesh.h"
 
@@ -20,7 +21,10 @@ struct PlanarCrack {
 
 /// The mesh with the faces inside the crack opened: nodes on the crack's interior are doubled,
 /// one copy per side (nodes on the crack front stay shared). `area_m2` receives the area of the
-/// faces opened (one side). Throws InputError when no mesh face lies on the crack's plane there.
-TetMesh crack_mesh(const TetMesh& mesh, const PlanarCrack& crack, double* area_m2);
+/// faces opened (one side). The copies are appended after the original nodes, whose indices do
+/// not change; `original_node`, when given, receives for every node of the result its node in
+/// `mesh`. Throws InputError when no mesh face lies on the crack's plane there.
+TetMesh crack_mesh(const TetMesh& mesh, const PlanarCrack& crack, double* area_m2,
+                   std::vector<int>* original_node = nullptr);
 
 }  // namespace mneedle::fe

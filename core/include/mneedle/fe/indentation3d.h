@@ -57,17 +57,18 @@ struct Timing3d {
   int factorizations = 0;
 };
 
-/// Repeated solves on one mesh: advance_to() a growing sequence of depths.
-/// Linear materials: the stiffness is factorised once; contact is solved on the captured
-/// surface nodes through their condensed compliance (columns of K⁻¹ added as nodes are
-/// captured). Nonlinear materials: Newton–Raphson with line search and adaptive depth steps, one
-/// symbolic analysis for the whole insertion. Errors: SolverError naming the depth and the cause.
 /// Solver choices of one Indentation3d.
 struct Indentation3dOptions {
   ContactMode contact = ContactMode::Sticking;
   double tolerance = 1e-8;  ///< Newton: free residual / reaction force
 };
 
+/// Repeated solves on one mesh: advance_to() a growing sequence of depths.
+/// Linear materials: the stiffness is factorised once; contact is solved on the captured
+/// surface nodes through their condensed compliance (columns of K⁻¹ added as nodes are
+/// captured). Nonlinear materials: Newton–Raphson with line search and adaptive depth steps, one
+/// symbolic analysis for the whole insertion. Errors: SolverError naming the depth and the cause.
+/// The run keeps its own copy of the mesh.
 class Indentation3d {
  public:
   /// max_depth bounds the needle travel (m): it fixes the candidate contact nodes.
@@ -81,6 +82,13 @@ class Indentation3d {
   Indentation3d& operator=(const Indentation3d&) = delete;
 
   Step3d advance_to(double depth);
+  /// Makes this run a cracked twin of `leader` for the energy release rate: this run's mesh is
+  /// the leader's with nodes added (crack_mesh), leader_node[n] the leader's node for node n.
+  /// From now on this run captures exactly the nodes the leader has captured (copies included)
+  /// instead of searching its own, so at one depth the two solutions differ by the crack alone
+  /// and U_cracked <= U_intact. Advance the leader to each depth first. Sticking contact only
+  /// (InputError otherwise); `leader` must outlive this run.
+  void hold_contact_of(const Indentation3d& leader, std::vector<int> leader_node);
   /// Nodal displacement (3 per node, m) at the last depth.
   Eigen::VectorXd displacement() const;
   const Timing3d& timing() const;
