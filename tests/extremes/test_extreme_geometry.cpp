@@ -39,8 +39,7 @@ double sneddon_cone(double E, double nu, double alpha, double d) {
 fe::InsertionResult axisymmetric(const fe::AxisymmetricNeedle& needle, double depth,
                                  double block_depth, double radius,
                                  fe::ContactMode contact = fe::ContactMode::Frictionless,
-                                 fe::Fidelity fidelity = fe::Fidelity::Fast) {
-  const double nu = 0.3;
+                                 fe::Fidelity fidelity = fe::Fidelity::Fast, double nu = 0.3) {
   fe::AxisymmetricProblem p;
   p.layers = {{block_depth, {fe::MaterialModel::Linear, 1e5, nu, 0.0, 0.0}}};
   p.radius_m = radius;
@@ -80,19 +79,41 @@ TEST(ExtremeGeometry, StickingFeConeFromOneToEightyNineDegreesIsFiniteAndBounded
   }
 }
 
-// DISABLED: frictionless axisymmetric contact under a sharp cone is too soft and gets softer
-// under refinement (10 deg: 0.22 / 0.16 / 0.13 of Sneddon at fast / standard / fine; 30 deg:
-// 0.67 / 0.66 / 0.65; 45 deg: 0.93 / 0.92 / 0.92) with a contact area 1.6-2.3x Sneddon's, as if
-// the contact set kept nodes that pull on the needle. core/src/fe/axisymmetric_insertion.cpp is
-// not ours; reported to the lead in the extremes report.
-TEST(ExtremeGeometry, DISABLED_FrictionlessFeConeMatchesSneddon) {
+// Cone on a bonded layer of depth h (Garcia 2018): Sneddon times this, y = d tan(alpha) / h.
+double garcia_layer(double y) {
+  return 1 + 0.721 * y + 0.650 * y * y + 0.491 * y * y * y + 0.225 * y * y * y * y;
+}
+
+// The linear model's frictionless contact is Sneddon's own small-strain condition (vertical gap
+// and force, radial sliding free), so it must reproduce Sneddon at any angle: measured FE /
+// (Sneddon x layer factor) 0.99-1.01 at 10-80 deg, nu 0.3 and 0.45, on fast, standard and fine
+// meshes, hence 3 %; refinement changes it by < 1 % (it used to soften the 10 deg cone to 0.81x
+// per level, 0.22 -> 0.13 of Sneddon). This says nothing about the real force under a sharp cone,
+// which Sneddon's small-slope theory underestimates (Hay, Bolshakov & Pharr: x1.06 at 45 deg,
+// 1.11 at 30 deg, 1.41 at 10 deg for nu = 0.45, x3.6 at 10 deg for nu = 0.3); no linear model
+// captures that, and tissue-like nu = 0.45 keeps it smallest.
+TEST(ExtremeGeometry, FrictionlessFeConeMatchesSneddon) {
+  const double nu = 0.45;
   for (double deg : {10.0, 30.0, 45.0}) {
     const double alpha = deg * kDeg, d = 20e-6;
     const double a = 2.0 / pi * d * std::tan(alpha);
     const double size = std::max(40 * a, 200e-6);
     const auto needle = fe::AxisymmetricNeedle::cone(alpha, std::max(3 * a, 1e-6));
-    const auto r = axisymmetric(needle, d, size, size);
-    EXPECT_NEAR(r.steps.back().force_N / sneddon_cone(1e5, 0.3, alpha, d), 1.05, 0.1) << deg;
+    const double reference =
+        sneddon_cone(1e5, nu, alpha, d) * garcia_layer(d * std::tan(alpha) / size);
+    const auto fast =
+        axisymmetric(needle, d, size, size, fe::ContactMode::Frictionless, fe::Fidelity::Fast, nu);
+    const auto standard = axisymmetric(needle, d, size, size, fe::ContactMode::Frictionless,
+                                       fe::Fidelity::Standard, nu);
+    const double f_fast = fast.steps.back().force_N, f_standard = standard.steps.back().force_N;
+    std::cout << "frictionless cone " << deg << " deg: F / (Sneddon x layer) fast "
+              << f_fast / reference << ", standard " << f_standard / reference << "; area / pi a^2 "
+              << standard.steps.back().contact_area_m2 / (pi * a * a) << "\n";
+    EXPECT_NEAR(f_fast / reference, 1.0, 0.03) << deg;
+    EXPECT_NEAR(f_standard / f_fast, 1.0, 0.02) << deg;
+    // Sneddon's contact radius a = (2/pi) d tan(alpha), known to half an element (measured
+    // 0.97-1.16 of pi a^2; it was 1.6-2.3 with the sloped constraint).
+    EXPECT_NEAR(standard.steps.back().contact_area_m2 / (pi * a * a), 1.0, 0.25) << deg;
   }
 }
 
@@ -113,7 +134,7 @@ TEST(ExtremeGeometry, BluntFlatFromZeroToFullDiameterGrowsTheForceMonotonically)
     EXPECT_TRUE(std::isfinite(sticking));
     EXPECT_GT(sticking, previous) << fraction;
     previous = sticking;
-    if (fraction == 0.0) continue;  // sharp: see DISABLED_FrictionlessFeConeMatchesSneddon
+    if (fraction == 0.0) continue;  // sharp: see FrictionlessFeConeMatchesSneddon
     const double frictionless = axisymmetric(n, d, 3e-3, 3e-3).steps.back().force_N;
     const double closed =
         analytic_indentation(homogeneous(1e5, 0.3, 6e-3, 3e-3), n, {d})[0].force_N;
@@ -142,10 +163,8 @@ TEST(ExtremeGeometry, TwoMillimetreDepthBeyondTheBlockStopsWithAnInputError) {
                InputError);
 }
 
-// DISABLED: simulate_axisymmetric accepts a depth beyond the layers' total thickness (2 mm into
-// 1.15 mm) and returns a force, the tip having passed through the rigid base. Not our file
-// (core/src/fe/axisymmetric*.cpp); reported to the lead.
-TEST(ExtremeGeometry, DISABLED_FeDepthBeyondTheBlockStopsWithAnInputError) {
+// 2 mm into a 1.15 mm block: the tip would pass through the rigid base.
+TEST(ExtremeGeometry, FeDepthBeyondTheBlockStopsWithAnInputError) {
   const auto cone = fe::AxisymmetricNeedle::cone(15 * kDeg, 115e-6);
   EXPECT_THROW(axisymmetric(cone, 2e-3, 1.15e-3, 1.7e-3), InputError);
 }
@@ -195,9 +214,9 @@ TEST(ExtremeGeometry, BlockTenTimesTheNeedleIsFineAndATenthIsRefused) {
                InputError);
 }
 
-// DISABLED: simulate_axisymmetric accepts a tissue cylinder (radius 0.1 R) narrower than the
-// needle and returns a force. Not our file; reported to the lead.
-TEST(ExtremeGeometry, DISABLED_FeBlockNarrowerThanTheNeedleStopsWithAnInputError) {
+// A tissue cylinder of radius 0.1 R under a punch of radius R: its clamped side is under the
+// needle.
+TEST(ExtremeGeometry, FeBlockNarrowerThanTheNeedleStopsWithAnInputError) {
   const double R = 115e-6;
   EXPECT_THROW(axisymmetric(fe::AxisymmetricNeedle::flat_punch(R), 1e-6, 0.2 * R, 0.1 * R),
                InputError);

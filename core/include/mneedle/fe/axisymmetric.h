@@ -174,7 +174,8 @@ struct InsertionStep {
 struct InsertionOptions {
   double depth_m = 0.0;  ///< final tip depth below the undeformed surface
   int output_steps = 20;
-  /// Frictionless: linear layers only (node-to-profile constraints on the condensed system).
+  /// Frictionless: linear layers only; the small-strain contact of Sneddon's theory (vertical
+  /// gap above each node's reference radius, vertical force, radial sliding free).
   ContactMode contact = ContactMode::Sticking;
   NewtonOptions newton;
   double stress_average_length_m = 0.0;  ///< tip_stress_Pa averaging length (0 = off)
