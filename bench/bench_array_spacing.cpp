@@ -4,7 +4,8 @@
 // tissue the mean contact pressure is proportional to the force, so the pressure-criterion
 // puncture depth scales with 1 / (force ratio). Olatunji et al. found the spacing to matter only
 // below ~150 um.
-// Figures in docs/_parts/puncture-performance.md. Run: bench_array_spacing [--benchmark_filter=]
+// Figures in docs/performance.md, "Array spacing (bed-of-nails) study". Run:
+// bench_array_spacing [--benchmark_filter=]
 #include <benchmark/benchmark.h>
 
 #include <cmath>

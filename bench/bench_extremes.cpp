@@ -4,7 +4,7 @@
 // memory growth with size (for the largest problem that fits in 24 GiB). Peak memory: the
 // process's getrusage maximum resident set, so run one size per process for clean figures:
 //   build/<dir>/bench/bench_extremes --benchmark_filter='LargeStl/5000000'
-// Figures: docs/_parts/extremes-performance.md.
+// Figures: docs/performance.md, "Hot paths, a 5-million-face STL and the largest 3-D problem".
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 

@@ -1,5 +1,5 @@
 // One sharp-bevel needle (230 um) pressed 200 um into paper A's 3000 x 3000 x 1150 um three-layer
-// skin, 3-D, at each fidelity; counters split the time (docs/_parts/fe3d-performance.md).
+// skin, 3-D, at each fidelity; counters split the time (docs/performance.md, "3-D performance").
 #include <benchmark/benchmark.h>
 
 #include <cstdio>

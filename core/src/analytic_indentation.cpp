@@ -1,5 +1,5 @@
 // Closed-form indentation of a layered block by a rigid punch of revolution.
-// Equations, units and sources: docs/_parts/extremes-model.md.
+// Equations, units and sources: docs/model.md, "The fast analytic path".
 //  - Sneddon (1965) general solution for a frictionless punch of profile h(r) on a half-space;
 //    for a piecewise-linear profile both of its integrals are closed-form (asin and sqrt terms).
 //  - Gao, Chiu & Lee (1992) two-layer weight function I0, applied layer by layer from the bottom
@@ -197,7 +197,8 @@ EffectiveModulus effective_modulus(const Tissue& tissue, double contact_radius_m
   if (layers.size() < 2 || !(contact_radius_m > 0.0)) return gao;
   // A top layer stiffer than what is beneath bends as a plate and spreads the load: Gao's
   // weight function, a first-order perturbation, misses that (100x too stiff for 1 GPa stratum
-  // corneum on 0.1 MPa). The smaller of the two is taken (docs/_parts/extremes-model.md).
+  // corneum on 0.1 MPa). The smaller of the two is taken (docs/model.md, "The fast analytic
+  // path", 3).
   Tissue below = tissue;
   below.layers.erase(below.layers.begin());
   const EffectiveModulus foundation = effective_modulus(below, contact_radius_m);

@@ -254,7 +254,8 @@ TEST(Toughness, PhantomRecordingGivesAFinitePositiveJFromBothConstructions) {
   const auto first = mneedle::prepare_pass(raw);
   mneedle::ForceDrop drop;
   const auto tail = mneedle::force_difference(first, mneedle::second_pass_from_tail(first, &drop));
-  // Puncture near 14.7 mm travel: 4.2 N -> 2.1 N (docs/_parts/toughness-validation.md).
+  // Puncture near 14.7 mm travel: 4.2 N -> 2.1 N (docs/validation.md, "Fracture toughness from
+  // two insertions", real recordings).
   EXPECT_NEAR(drop.peak_depth_m + first.cut.contact_travel_m, 14.7e-3, 0.3e-3);
   EXPECT_GT(drop.peak_force_N - drop.bottom_force_N, 1.5);
   EXPECT_GT(tail.difference_work_J, 0.0);

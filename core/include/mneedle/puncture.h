@@ -65,7 +65,7 @@ double interpolate_at(const std::vector<double>& depths_m, const std::vector<dou
                       double depth_m);
 
 /// Depth of the planar (3-D) or ring (axisymmetric) crack used for G: the needle's radius,
-/// at least two tip elements so the mesh resolves it (docs/_parts/puncture-model.md).
+/// at least two tip elements so the mesh resolves it (docs/model.md, "Criteria").
 double crack_depth_for(double needle_radius_m, double tip_element_size_m);
 
 }  // namespace mneedle

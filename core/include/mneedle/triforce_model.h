@@ -2,7 +2,8 @@
 // Paper B's tri-force model of the axial force on a needle entering soft tissue,
 //   F(z) = F_c(z) + F_s(z) + F_f(z)   (+ a Maxwell viscous branch for the speed dependence),
 // with layered (piecewise) parameters, a hold and a retraction, and a lateral perturbation of
-// the needle base. Every form, its units and its source are in docs/_parts/triforce_model.md.
+// the needle base. Every form, its units and its source are in docs/model.md, "Tri-force model
+// (paper B)".
 // z is the needle travel from contact along its axis (m); the angle is between the needle and
 // the tissue surface (rad, pi/2 = perpendicular), paper B's convention.
 

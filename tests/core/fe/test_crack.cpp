@@ -291,7 +291,8 @@ TEST(Crack, PullOpensTheCrackAndReleasesTheHalfPennyEnergy) {
     EXPECT_LT(opening, 1.6 * penny_opening);
   }
   // Linear tetrahedra at c / h = 4 are too stiff near the front: they release 63% of the
-  // estimate (the refinement study in docs/_parts/crack-validation.md converges from below).
+  // estimate (the refinement study, docs/validation.md "Convergence studies of the 3-D model",
+  // d, converges from below).
   const double released = a.energy - b.energy;
   EXPECT_GT(released, 0.55 * half_penny_energy(sigma, block.crack, block.E, block.nu, 1.1));
   EXPECT_LT(released, 1.2 * half_penny_energy(sigma, block.crack, block.E, block.nu, 1.2));

@@ -129,9 +129,10 @@ TEST(StressProbe, RejectsBadLengthAndLayer) {
                mneedle::InputError);
 }
 
-// Regression of the refinement study (docs/_parts/crack-validation.md, c): under a sharp cone the
-// stress at the tip point keeps growing as the mesh refines while its 50 um mean settles; from
-// 50 to 30 um tip elements (TET4) the local value moved 39%, the mean 15%.
+// Regression of the refinement study (docs/validation.md, "Convergence studies of the 3-D model",
+// c): under a sharp cone the stress at the tip point keeps growing as the mesh refines while its
+// 50 um mean settles; from 50 to 30 um tip elements (TET4) the local value moved 39%, the mean
+// 15%.
 double tip_stress(double tip_size, double length_or_zero) {
   TissueBlockSpec block;
   block.size_x = block.size_y = 3e-3;

@@ -205,7 +205,8 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
                               const InsertionOptions& options);
 
 /// The one-off case: mesh sized from the fidelity and the needle, then insert.
-/// Cylinder radius: the caller's choice (see docs/_parts/fe_model.md for the block equivalent).
+/// Cylinder radius: the caller's choice (see docs/model.md, "The tissue cylinder", for the block
+/// equivalent).
 struct AxisymmetricProblem {
   std::vector<AxisymmetricLayer> layers;
   double radius_m = 0.0;
