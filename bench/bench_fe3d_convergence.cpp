@@ -1,5 +1,6 @@
-// Convergence studies of the 3-D model through its public API (docs/_parts/crack-validation.md,
-// crack-performance.md). Run on demand, never from ctest:
+// Convergence studies of the 3-D model through its public API (docs/validation.md, "Convergence
+// studies of the 3-D model"; docs/performance.md, "Convergence-study cost"). Run on demand, never
+// from ctest:
 //   bench_fe3d_convergence [punch] [frictionless] [skin] [stress] [crack] [held]   (none: all)
 // Prints one table per study; each run's time is the process CPU time (the machine is shared).
 #include <Eigen/Core>

@@ -33,6 +33,7 @@ struct SimulateOptions {
   std::string model = "auto";
   std::string vtu;
   bool json = false;
+  bool no_reductions = false;
   bool csv = false;
 };
 
@@ -60,6 +61,7 @@ InsertionRunOptions run_options(const Scene& scene, const SimulateOptions& o) {
             : o.model == "3d"           ? PreModel::Full3d
                                         : PreModel::Auto;
   r.vtu_directory = o.vtu;
+  r.allow_reductions = !o.no_reductions;
   if (r.vtu_directory.empty() && scene.model.wants(Output::Fields)) {
     // The scene asks for fields: write them beside the working directory, named after it.
     r.vtu_directory = o.scene.stem().string() + "_fields";
@@ -242,6 +244,8 @@ void add_simulate_command(CLI::App& app) {
       "Examples:\n  mneedle simulate designs/scenes/silicone_phantom.toml --fidelity fast\n"
       "  mneedle simulate designs/scenes/human_skin.toml --criterion stress --json\n"
       "  mneedle simulate tests/assets/scenes/axisymmetric_punch.toml --csv");
+  cmd->add_flag("--no-reductions", options->no_reductions,
+                "solve the whole scene: no half model, layer merge or domain cut (to check them)");
   auto* json = cmd->add_flag("--json", options->json, "print the run as JSON");
   cmd->add_flag("--csv", options->csv, "print the curves as CSV")->excludes(json);
   cmd->callback([options]() { run(*options); });

@@ -110,7 +110,34 @@ void merge_deep_layers(RunPlan& plan, double influence) {
                              std::nullopt});
 }
 
+// The block beyond the needles' reach carries almost no strain: keep kDomainReach (a + d) around
+// them (the block stays centred on the scene's origin, so the needles keep their coordinates).
+// run_insertion measures the truncation error and undoes the cut when it is above tolerance.
+void cut_domain(RunPlan& plan, const std::vector<PreparedNeedle>& needles) {
+  const double reach = domain_reach(plan.needle_radius_m, plan.depth_m);
+  double half_x = 0.0, half_y = 0.0;
+  for (const PreparedNeedle& n : needles) {
+    half_x = std::max(half_x, std::abs(n.x));
+    half_y = std::max(half_y, std::abs(n.y));
+  }
+  const double cut_x = std::min(plan.block_x_m, 2.0 * (half_x + reach));
+  const double cut_y = std::min(plan.block_y_m, 2.0 * (half_y + reach));
+  if (cut_x >= plan.block_x_m && cut_y >= plan.block_y_m) return;
+  plan.block_x_m = cut_x;
+  plan.block_y_m = cut_y;
+  plan.reductions.push_back(
+      {"domain_cut",
+       "block " + um(plan.full_block_x_m) + " x " + um(plan.full_block_y_m) + " cut to " +
+           um(cut_x) + " x " + um(cut_y) + ": " + std::to_string(static_cast<int>(kDomainReach)) +
+           " x (needle radius + insertion depth) = " + um(reach) + " around the needles",
+       std::nullopt});
+}
+
 }  // namespace
+
+double domain_reach(double needle_radius_m, double insertion_depth_m) {
+  return kDomainReach * (needle_radius_m + insertion_depth_m);
+}
 
 double reduction_tolerance(fe::Fidelity fidelity) {
   switch (fidelity) {
@@ -157,6 +184,8 @@ RunPlan plan_insertion(const Scene& scene, const std::vector<PreparedNeedle>& ne
   plan.full_layers = plan.layers;
   plan.block_x_m = scene.tissue.size[0];
   plan.block_y_m = scene.tissue.size[1];
+  plan.full_block_x_m = plan.block_x_m;
+  plan.full_block_y_m = plan.block_y_m;
   plan.vtu_directory = options.vtu_directory;
   for (const PreparedNeedle& n : needles)
     plan.needle_radius_m = std::max(plan.needle_radius_m, max_radius_below(n.mesh, plan.depth_m));
@@ -190,6 +219,7 @@ RunPlan plan_insertion(const Scene& scene, const std::vector<PreparedNeedle>& ne
 
   if (options.allow_reductions) {
     merge_deep_layers(plan, influence_depth(plan.needle_radius_m, plan.depth_m));
+    cut_domain(plan, needles);
     if (plan.pre == PreKind::Full3d) {
       const bool mirror = std::all_of(needles.begin(), needles.end(), [](const auto& n) {
         return n.mirror_symmetric_y0 && std::abs(n.y) < 1e-12;

@@ -24,6 +24,8 @@ struct RunPlan {
   std::vector<fe::TissueLayer> full_layers;  ///< as the scene gives them
   double block_x_m = 0.0;
   double block_y_m = 0.0;
+  double full_block_x_m = 0.0;  ///< as the scene gives it (block_x_m after a domain cut)
+  double full_block_y_m = 0.0;
   double axisymmetric_radius_m = 0.0;
   double depth_m = 0.0;
   int steps = 0;
@@ -40,6 +42,11 @@ double reduction_tolerance(fe::Fidelity fidelity);
 double influence_depth(double needle_radius_m, double insertion_depth_m);
 
 inline constexpr double kInfluenceDepths = 10.0;
+
+/// Half-width of the block kept around the needles (m): kDomainReach times (radius + depth).
+double domain_reach(double needle_radius_m, double insertion_depth_m);
+
+inline constexpr double kDomainReach = 10.0;
 
 /// Scene layers as FE layers; InputError names file:line of a layer with invalid constants.
 std::vector<fe::TissueLayer> fe_layers(const Scene& scene);

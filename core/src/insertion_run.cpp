@@ -256,6 +256,48 @@ void check_layer_merge(const RunPlan& plan, const PreparedNeedle& needle,
   reduced = run_axisymmetric(unmerged, needle, options, crack_depth);
 }
 
+// The domain cut's truncation error, measured with the axisymmetric model (the needle itself, or
+// for the 3-D model the first needle's body of revolution): the force at the reduced run's last
+// step on the cut and on the full domain. Above the fidelity's tolerance the cut is undone and
+// the pre-puncture model runs again on the full block.
+void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
+                      const InsertionRunOptions& options, double crack_depth, PreResult& reduced,
+                      std::vector<Reduction>& reductions) {
+  auto cut = std::find_if(reductions.begin(), reductions.end(),
+                          [](const Reduction& r) { return r.name == "domain_cut"; });
+  if (cut == reductions.end() || reduced.needles[0].points.empty()) return;
+  PreparedNeedle proxy = needles[0];
+  if (!proxy.axisymmetric)
+    proxy.axisymmetric = equivalent_axisymmetric_needle(proxy.mesh, 1.05 * plan.depth_m);
+  auto reference_on = [&](double size_x, double size_y) {
+    RunPlan probe = plan;
+    probe.axisymmetric_radius_m = fe::equal_area_radius(std::sqrt(size_x * size_y));
+    probe.threshold.reset();  // same depth steps, no early stop
+    probe.vtu_directory.clear();
+    probe.depth_m = reduced.needles[0].points.back().depth_m;
+    probe.steps = static_cast<int>(reduced.needles[0].points.size());
+    return run_axisymmetric(probe, proxy, options, 0.0).needles[0].points.back().force_N;
+  };
+  const double f_full = reference_on(plan.full_block_x_m, plan.full_block_y_m);
+  const double f_cut = plan.pre == PreKind::Axisymmetric
+                           ? reduced.needles[0].points.back().force_N
+                           : reference_on(plan.block_x_m, plan.block_y_m);
+  if (!(f_full > 0.0)) return;
+  cut->measured_effect = std::abs(f_cut - f_full) / f_full;
+  const double tolerance =
+      options.reduction_tolerance.value_or(detail::reduction_tolerance(options.fidelity));
+  if (*cut->measured_effect <= tolerance) return;
+  cut->name = "domain_cut_rejected";
+  cut->detail += "; measured effect above the " + std::to_string(tolerance * 100.0).substr(0, 4) +
+                 " % tolerance: the full block was used";
+  plan.block_x_m = plan.full_block_x_m;
+  plan.block_y_m = plan.full_block_y_m;
+  plan.axisymmetric_radius_m = fe::equal_area_radius(std::sqrt(plan.block_x_m * plan.block_y_m));
+  reduced = plan.pre == PreKind::Axisymmetric
+                ? run_axisymmetric(plan, needles[0], options, crack_depth)
+                : run_3d(plan, needles, options, crack_depth);
+}
+
 double axisymmetric_tip_size(const RunPlan& plan, const PreparedNeedle& needle,
                              const InsertionRunOptions& options) {
   if (options.overrides.tip_size_m) return *options.overrides.tip_size_m;
@@ -468,6 +510,7 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
         if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
           run.crack_depth_m = crack_depth_for(plan.needle_radius_m, tip_size_3d(plan, options));
         pre = run_3d(plan, needles, options, run.crack_depth_m);
+        check_domain_cut(plan, needles, options, run.crack_depth_m, pre, run.reductions);
         if (plan.half_model)
           run.reductions.push_back(
               {"half_model",
@@ -482,6 +525,7 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
                                               axisymmetric_tip_size(plan, needles[0], options));
         pre = run_axisymmetric(plan, needles[0], options, run.crack_depth_m);
         check_layer_merge(plan, needles[0], options, run.crack_depth_m, pre, run.reductions);
+        check_domain_cut(plan, needles, options, run.crack_depth_m, pre, run.reductions);
         break;
       case PreKind::Analytic:
         pre = run_analytic(plan, scene, needles);

@@ -78,7 +78,9 @@ TEST(CmdSimulate, BevelRunsIn3dWithALateralForce) {
   EXPECT_NEAR(last["lateral_force_N"][1].get<double>(), 0.0, 1e-9);
 }
 
-TEST(CmdSimulate, FrictionlessIsRefusedUntilImplemented) {
+// The axisymmetric model's frictionless contact is linear-only: a neo-Hookean scene is refused
+// with a message that names the limit and the way out.
+TEST(CmdSimulate, FrictionlessOnANeoHookeanAxisymmetricSceneNamesTheLimit) {
   const CommandRun run =
       run_mneedle("simulate '" + scene("axisymmetric_punch.toml") + "' --contact frictionless");
   EXPECT_EQ(run.exit_code, 1);
@@ -159,6 +161,21 @@ TEST(CmdSimulate, BevelPuncturesOnAHalfModelAndReportsIt) {
     }
   EXPECT_TRUE(found);
   EXPECT_LT(p["depth_m"].get<double>(), 100e-6);
+}
+
+TEST(CmdSimulate, NoReductionsSolvesTheFullBevelModel) {
+  const CommandRun half = run_mneedle("simulate '" + scene("puncture_bevel.toml") + "' --json");
+  const CommandRun full =
+      run_mneedle("simulate '" + scene("puncture_bevel.toml") + "' --no-reductions --json");
+  ASSERT_EQ(half.exit_code, 0) << half.err;
+  ASSERT_EQ(full.exit_code, 0) << full.err;
+  const auto h = nlohmann::json::parse(half.out);
+  const auto f = nlohmann::json::parse(full.out);
+  EXPECT_TRUE(f["reductions"].empty()) << f["reductions"].dump();
+  EXPECT_GT(f["mesh"]["nodes"].get<int>(), h["mesh"]["nodes"].get<int>());
+  // The half model is exact for a mirror-symmetric bevel (tests/core/test_insertion_run.cpp).
+  EXPECT_NEAR(f["needles"][0]["puncture"]["depth_m"].get<double>(),
+              h["needles"][0]["puncture"]["depth_m"].get<double>(), 1e-9);
 }
 
 TEST(CmdSimulate, CsvHasAStageColumn) {

@@ -977,8 +977,11 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   std::vector<Eigen::Vector2d> first_contact;
   for (const Needle3d& needle : needles) {
     const NeedleShape shape(needle.mesh);
-    block.sites.push_back({needle.x, needle.y, shape.max_radius_up_to(options.depth)});
     first_contact.push_back(Eigen::Vector2d(needle.x, needle.y) + shape.first_contact_xy(1e-9));
+    fe::NeedleSite site{needle.x, needle.y, shape.max_radius_up_to(options.depth), std::nullopt};
+    if ((first_contact.back() - Eigen::Vector2d(needle.x, needle.y)).norm() > 1e-3 * site.radius)
+      site.tip = first_contact.back();
+    block.sites.push_back(site);
   }
   block.fidelity = options.fidelity;
   block.order = options.overrides.order.value_or(options.order);

@@ -74,17 +74,67 @@ std::vector<double> graded_coordinates(double lo, double hi, SizeAt size_at, int
   return coordinates;
 }
 
+// Nodes marched outward from `from` toward `to` (either direction), each interval the local
+// element size, so the cells near `from` do not depend on where the block ends: cutting the
+// block (the planner's domain cut) leaves the mesh at the needle unchanged. A remainder of at
+// least half a size is a cell of its own; a smaller one is spread over the last few cells (far
+// from `from`). A piece that is all one size is divided evenly.
+template <typename SizeAt>
+std::vector<double> marched_coordinates(double from, double to, SizeAt size_at) {
+  constexpr int kSpreadCells = 4;
+  const double direction = to > from ? 1.0 : -1.0;
+  const double length = std::abs(to - from);
+  std::vector<double> offsets{0.0};
+  bool uniform = true;
+  const double first_size = size_at(from);
+  while (true) {
+    const double size = size_at(from + direction * offsets.back());
+    uniform = uniform && std::abs(size - first_size) <= 1e-9 * first_size;
+    const double remainder = length - offsets.back();
+    if (remainder <= size) {
+      if (remainder < 0.5 * size && offsets.size() > 1) {
+        // Re-space the last cells evenly with the remainder as one more cell: all shrink a
+        // little, none grows (the lateral size cap keeps the aspect floor).
+        const std::size_t cells = offsets.size() - 1;
+        const std::size_t spread = std::min<std::size_t>(cells, kSpreadCells);
+        const double start = offsets[cells - spread];
+        for (std::size_t k = 1; k <= spread; ++k)
+          offsets[cells - spread + k] =
+              start + (length - start) * static_cast<double>(k) / static_cast<double>(spread + 1);
+      }
+      break;
+    }
+    offsets.push_back(offsets.back() + size);
+  }
+  offsets.push_back(length);
+  if (uniform) {
+    const auto cells =
+        static_cast<std::size_t>(std::max(1.0, std::ceil(length / first_size - 1e-9)));
+    offsets.resize(cells + 1);
+    for (std::size_t k = 0; k <= cells; ++k)
+      offsets[k] = length * static_cast<double>(k) / static_cast<double>(cells);
+  }
+  std::vector<double> coordinates;
+  for (double o : offsets) coordinates.push_back(from + direction * o);
+  if (direction < 0.0) std::reverse(coordinates.begin(), coordinates.end());
+  coordinates.front() = std::min(from, to);
+  coordinates.back() = std::max(from, to);
+  return coordinates;
+}
+
 std::vector<double> lateral_coordinates(double half, const std::vector<double>& centres,
-                                        const MeshSizing& sizing) {
+                                        const std::vector<double>& tips, const MeshSizing& sizing) {
   auto size_at = [&](double x) {
     double size = sizing.max_size;
     for (double c : centres)
       size = std::min(size, graded_size(std::abs(x - c) - sizing.fine_half_width, sizing));
     return size;
   };
-  // A grid line through every site, so a sharp tip meets a node the moment it touches.
+  // A grid line through every site and every off-axis tip (a bevel's), so a sharp tip meets a
+  // node the moment it touches.
   std::vector<double> breaks{-half};
   std::vector<double> sorted = centres;
+  sorted.insert(sorted.end(), tips.begin(), tips.end());
   std::sort(sorted.begin(), sorted.end());
   for (double c : sorted)
     if (c - breaks.back() > 0.25 * sizing.fine_size && half - c > 0.25 * sizing.fine_size)
@@ -92,7 +142,12 @@ std::vector<double> lateral_coordinates(double half, const std::vector<double>& 
   breaks.push_back(half);
   std::vector<double> coordinates{-half};
   for (std::size_t b = 0; b + 1 < breaks.size(); ++b) {
-    const std::vector<double> piece = graded_coordinates(breaks[b], breaks[b + 1], size_at, 1);
+    // The outer pieces march from the needle side; a piece between two needles is graded.
+    const bool first = b == 0, last = b + 2 == breaks.size();
+    const std::vector<double> piece =
+        first && !last   ? marched_coordinates(breaks[b + 1], breaks[b], size_at)
+        : last && !first ? marched_coordinates(breaks[b], breaks[b + 1], size_at)
+                         : graded_coordinates(breaks[b], breaks[b + 1], size_at, 1);
     coordinates.insert(coordinates.end(), piece.begin() + 1, piece.end());
   }
   return coordinates;
@@ -300,23 +355,26 @@ std::string to_string(Fidelity fidelity) {
 
 MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, double block_size,
                        const FidelityOverrides& overrides) {
-  // Elements per needle radius at the site, growth ratio and elements through the top layer;
-  // linear tetrahedra get twice the resolution of quadratic ones for a comparable answer.
+  // Node spacings per needle radius at the site (a TET10 element spans two, a TET4 one), growth
+  // ratio and elements through the top layer. Grid lines march out from the needle's axis, so
+  // a whole number of spacings per radius would put nodes exactly on a flat punch's rim or a
+  // bevel's tip, where rounding decides whether the needle holds them: the counts are
+  // half-integers, which puts the rim half-way between two nodes.
   struct Level {
-    double per_radius;
+    double spacings_per_radius;
     double growth;
     int through_top;
   };
-  const Level level = fidelity == Fidelity::Fast       ? Level{1.0, 2.0, 1}
-                      : fidelity == Fidelity::Standard ? Level{1.5, 1.6, 1}
-                                                       : Level{2.5, 1.35, 2};
-  const double refinement = order == 1 ? 2.0 : 1.0;
+  const Level level = fidelity == Fidelity::Fast       ? Level{2.5, 2.0, 1}
+                      : fidelity == Fidelity::Standard ? Level{3.5, 1.6, 1}
+                                                       : Level{5.5, 1.35, 2};
+  const int refinement = order == 1 ? 2 : 1;
   MeshSizing sizing;
-  sizing.fine_size = needle_radius / (level.per_radius * refinement);
+  sizing.fine_size = order * needle_radius / level.spacings_per_radius;
   sizing.fine_half_width = 1.25 * needle_radius;
   sizing.growth = level.growth;
   sizing.max_size = std::max(sizing.fine_size, block_size / 4.0);
-  sizing.elements_through_top = level.through_top * static_cast<int>(refinement);
+  sizing.elements_through_top = level.through_top * refinement;
   if (overrides.tip_size_m) {
     if (!(*overrides.tip_size_m > 0.0) || !std::isfinite(*overrides.tip_size_m))
       bad_spec("overrides.tip_size_m", "must be positive and finite");
@@ -346,10 +404,14 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   const MeshSizing sizing =
       mesh_sizing(spec.fidelity, spec.order, radius, std::max({spec.size_x, spec.size_y, total}),
                   spec.overrides);
-  std::vector<double> cx, cy;
+  std::vector<double> cx, cy, tip_x, tip_y;
   for (const NeedleSite& site : spec.sites) {
     cx.push_back(site.x);
     cy.push_back(site.y);
+    if (site.tip) {
+      tip_x.push_back(site.tip->x());
+      tip_y.push_back(site.tip->y());
+    }
   }
   if (spec.sites.empty()) cx = cy = {0.0};
   std::vector<double> z = vertical_coordinates(spec.layers, sizing, spec.insertion_depth);
@@ -360,7 +422,7 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   MeshSizing lateral = sizing;
   lateral.max_size =
       std::max(sizing.fine_size, std::min(sizing.max_size, kMaxCellAspect * thinnest));
-  std::vector<double> y_axis = lateral_coordinates(spec.size_y / 2, cy, lateral);
+  std::vector<double> y_axis = lateral_coordinates(spec.size_y / 2, cy, tip_y, lateral);
   // The full grid has a line through every site and is graded symmetrically about it, so its
   // y >= 0 part is exactly the half model's grid.
   std::vector<char> mirror_y = mirrored_cells(y_axis, cy);
@@ -372,7 +434,7 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
     mirror_y.erase(mirror_y.begin(), mirror_y.begin() + skip);
   }
   const std::array<std::vector<double>, 3> axes = {
-      lateral_coordinates(spec.size_x / 2, cx, lateral), std::move(y_axis), std::move(z)};
+      lateral_coordinates(spec.size_x / 2, cx, tip_x, lateral), std::move(y_axis), std::move(z)};
 
   TetMesh mesh;
   mesh.order = spec.order;

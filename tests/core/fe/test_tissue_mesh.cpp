@@ -146,6 +146,7 @@ TEST(TissueMesh, RegularKuhnCubeHasKnownQuality) {
   spec.insertion_depth = 1e-3;
   spec.fidelity = Fidelity::Fast;
   spec.order = 1;
+  spec.overrides.tip_size_m = 0.25e-3;  // divides the block's half-width and depth evenly
   const MeshQuality q = mesh_quality(generate_tissue_mesh(spec));
   // Cubic cells: the Kuhn tetrahedron's dihedral angles are 45, 60 and 90 degrees.
   EXPECT_NEAR(q.min_dihedral_deg, 45.0, 1e-9);

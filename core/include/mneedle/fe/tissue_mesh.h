@@ -4,7 +4,9 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mneedle/fe/fidelity.h"
@@ -25,9 +27,17 @@ struct TissueLayer {
 /// Where a needle enters the block: (x, y) relative to the block centre (m) and the largest
 /// needle radius over the insertion depth (m), which sets the finest element size there.
 struct NeedleSite {
+  NeedleSite() = default;
+  NeedleSite(double x_m, double y_m, double radius_m,
+             std::optional<Eigen::Vector2d> tip_m = std::nullopt)
+      : x(x_m), y(y_m), radius(radius_m), tip(std::move(tip_m)) {}
+
   double x = 0.0;
   double y = 0.0;
   double radius = 0.0;
+  /// Where the needle first touches the surface when that is off its axis (a bevel's tip), m:
+  /// the grid gets lines through it too.
+  std::optional<Eigen::Vector2d> tip;
 };
 
 /// The block spans x in [-size_x/2, size_x/2], y likewise and z in [-total thickness, 0]; the top
@@ -99,10 +109,10 @@ MeshQuality mesh_quality(const TetMesh& mesh);
 /// top layer forces flat cells all across the block, and this cap bounds how flat.
 inline constexpr double kMaxCellAspect = 20.0;
 
-/// Documented quality floor of the generator (docs/_parts/fe_3d_model.md): with the aspect cap
-/// every mesh it makes keeps min dihedral >= kMinDihedralFloorDeg and aspect ratio <=
+/// Documented quality floor of the generator (docs/model.md, "Tissue block and mesh"): with the
+/// aspect cap every mesh it makes keeps min dihedral >= kMinDihedralFloorDeg and aspect ratio <=
 /// kMaxAspectRatioCeiling (longest edge over 2 sqrt(6) inradius).
-inline constexpr double kMinDihedralFloorDeg = 1.5;
+inline constexpr double kMinDihedralFloorDeg = 1.2;
 inline constexpr double kMaxAspectRatioCeiling = 60.0;
 
 }  // namespace mneedle::fe
