@@ -134,12 +134,18 @@ std::vector<double> lateral_coordinates(double half, const std::vector<double>& 
   // node the moment it touches.
   std::vector<double> breaks{-half};
   std::vector<double> sorted = centres;
-  sorted.insert(sorted.end(), tips.begin(), tips.end());
   std::sort(sorted.begin(), sorted.end());
   for (double c : sorted)
     if (c - breaks.back() > 0.25 * sizing.fine_size && half - c > 0.25 * sizing.fine_size)
       breaks.push_back(c);
   breaks.push_back(half);
+  // Tips yield to the sites (the half model needs its line on y = 0) and to each other.
+  for (double t : tips) {
+    const bool clear = std::all_of(breaks.begin(), breaks.end(), [&](double b) {
+      return std::abs(t - b) > 0.25 * sizing.fine_size;
+    });
+    if (clear) breaks.insert(std::upper_bound(breaks.begin(), breaks.end(), t), t);
+  }
   std::vector<double> coordinates{-half};
   for (std::size_t b = 0; b + 1 < breaks.size(); ++b) {
     // The outer pieces march from the needle side; a piece between two needles is graded.

@@ -138,6 +138,22 @@ TEST(TissueMesh, QualityStaysAboveTheDocumentedFloorAtEveryFidelity) {
   }
 }
 
+TEST(TissueMesh, OffAxisTipGetsAGridLineButTheHalfModelKeepsItsMirrorLine) {
+  // A bevel's tip 100 um off the axis, and (round-off of a mean of vertices) 1e-9 m below y = 0.
+  TissueBlockSpec spec = paper_a_skin(Fidelity::Fast, 2);
+  spec.sites = {{0.0, 0.0, 115e-6, Eigen::Vector2d(-100e-6, -1e-9)}};
+  spec.half_y = true;
+  const TetMesh mesh = generate_tissue_mesh(spec);
+  bool on_mirror = false, through_tip = false;
+  for (const Eigen::Vector3d& p : mesh.nodes) {
+    on_mirror = on_mirror || p.y() == 0.0;
+    through_tip = through_tip || (p.x() == -100e-6 && p.z() == 0.0);
+  }
+  EXPECT_TRUE(on_mirror);
+  EXPECT_TRUE(through_tip);
+  for (const Eigen::Vector3d& p : mesh.nodes) EXPECT_GE(p.y(), 0.0);
+}
+
 TEST(TissueMesh, RegularKuhnCubeHasKnownQuality) {
   TissueBlockSpec spec;
   spec.size_x = spec.size_y = 1e-3;
