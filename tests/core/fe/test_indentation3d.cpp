@@ -44,9 +44,9 @@ constexpr double kHayesNu045Ratio04 = 1.599;
 // the punch rim, falling to 1.13 at 30 um elements (same section).
 constexpr double kFrictionlessPunchTolerance = 0.30;
 
-// a = 90 um on a mesh graded for 100 um: no surface node lies within 0.5 um of the rim, so the
-// captured footprint does not hinge on round-off (docs/validation.md, "Rigid flat punch, bonded
-// (sticking), vs Hayes et al. (1972)").
+// a = 90 um on a mesh graded for the punch: its half-integer node spacing keeps the grid lines'
+// nodes off the rim, so the captured footprint does not hinge on round-off (docs/validation.md,
+// "Rigid flat punch, bonded (sticking), vs Hayes et al. (1972)").
 void check_bonded_punch(int order, double tolerance) {
   const double E = 1e5, nu = 0.45, a = 90e-6, h = 225e-6, d = 2e-6;
   const TissueBlockSpec block = homogeneous_block(MaterialModel::Linear, E, nu, 675e-6, h);
@@ -68,7 +68,7 @@ void check_bonded_punch(int order, double tolerance) {
 }
 
 TEST(Indentation3d, BondedFlatPunchOnQuadraticTetsMatchesHayesLayerSolution) {
-  check_bonded_punch(2, 0.15);
+  check_bonded_punch(2, 0.05);  // measured 0.983 (docs/validation.md)
 }
 
 TEST(Indentation3d, BondedFlatPunchOnLinearTetsMatchesHayesLayerSolution) {
