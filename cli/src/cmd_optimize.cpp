@@ -86,6 +86,23 @@ std::vector<DesignVariable> variables(const PluginShapeInfo& shape, const Optimi
   return out;
 }
 
+// Where the search starts: a --set value of a varied parameter, else the plugin's default,
+// inside the bounds (the middle of the bounds can be no valid shape at all, e.g. a bevel longer
+// than the needle).
+std::vector<double> start_values(const PluginShapeInfo& shape,
+                                 const std::vector<DesignVariable>& vars,
+                                 const std::map<std::string, double>& settings) {
+  std::vector<double> start;
+  for (const DesignVariable& v : vars) {
+    const auto it = std::find_if(shape.parameters.begin(), shape.parameters.end(),
+                                 [&](const PluginParameter& p) { return p.name == v.name; });
+    const auto set = settings.find(v.name);
+    const double value = set != settings.end() ? set->second : it->default_value;
+    start.push_back(std::clamp(value, v.lower, v.upper));
+  }
+  return start;
+}
+
 struct Problem {
   const Scene& scene;
   const PluginRegistry& registry;
@@ -176,14 +193,15 @@ nlohmann::json number_or_null(double v) {
 
 // One element size at the tip for every design of the run (from the start design's radius), so
 // the tissue mesh does not jump between designs and the objective stays smooth.
-double fixed_tip_size(const Problem& p, const std::vector<DesignVariable>& vars) {
-  std::map<std::string, double> middle;
-  for (const auto& v : vars) middle[v.name] = 0.5 * (v.lower + v.upper);
+double fixed_tip_size(const Problem& p, const std::vector<DesignVariable>& vars,
+                      const std::vector<double>& start) {
+  std::map<std::string, double> at_start;
+  for (std::size_t i = 0; i < vars.size(); ++i) at_start[vars[i].name] = start[i];
   NeedleSource n;
   try {
-    n = p.needle(middle);
+    n = p.needle(at_start);
   } catch (const std::exception&) {
-    n = p.needle({});  // the middle is not a valid shape: the plugin's defaults are
+    n = p.needle({});  // the start is not a valid shape: the plugin's defaults are
   }
   const double depth = p.scene.requirements.target_depth.value_or(p.scene.insertion.depth);
   const double block = std::max(p.scene.tissue.size[0], p.scene.tissue.size[1]);
@@ -208,9 +226,11 @@ void run_optimize(const OptimizeArgs& a) {
   if (problem.material.empty()) problem.material = "silicon";
   problem.evaluation.fidelity = parse_fidelity(a.fidelity);
   problem.evaluation.model = parse_pre_model(a.model);
-  problem.evaluation.overrides.tip_size_m = fixed_tip_size(problem, vars);
+  const std::vector<double> start = start_values(shape, vars, problem.fixed);
+  problem.evaluation.overrides.tip_size_m = fixed_tip_size(problem, vars, start);
 
   OptimizerOptions o;
+  o.start = start;
   o.algorithm = a.algorithm;
   o.local_algorithm = a.local;
   o.starts = a.starts;
@@ -228,8 +248,16 @@ void run_optimize(const OptimizeArgs& a) {
   };
   const OptimizerResult r = optimize_design(
       vars, [&](const auto& values) { return problem.score(values); }, kConstraints, o);
-  if (r.best.empty())
-    throw SolverError("optimize: every evaluation failed (" + r.stop_reason + ")");
+  if (r.best.empty()) {
+    // Name the first failure: the same cause usually sinks them all.
+    std::string first;
+    for (const EvaluationRecord& e : r.history)
+      if (e.failed && !e.error.empty()) {
+        first = "; the first: " + e.error;
+        break;
+      }
+    throw SolverError("optimize: every evaluation failed (" + r.stop_reason + ")" + first);
+  }
 
   const NeedleSource best = problem.needle(r.best);
   const DesignEvaluation e = problem.evaluate(best);

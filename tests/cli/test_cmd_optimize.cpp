@@ -29,6 +29,18 @@ fs::path temp_dir(const std::string& name) {
   return dir;
 }
 
+// The README's search: no --bound, so the plugin's whole ranges. Their middle is no valid bevel
+// (longer than the needle); the search starts from the plugin's defaults instead.
+TEST(OptimizeCommand, SearchOverThePluginsWholeRangesStartsFromItsDefaults) {
+  const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSkin +
+                               "' --vary bevel_angle,diameter --model analytic --material silicon"
+                               " --max-evals 3 --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_TRUE(j["best"]["params"].contains("diameter")) << j.dump(2);
+  EXPECT_TRUE(j["best"]["puncture_depth_m"].is_number()) << j.dump(2);
+}
+
 TEST(OptimizeCommand, PunctureDepthIsTheDefaultObjectiveAndTheSummaryHasItsKeys) {
   const fs::path dir = temp_dir("optimize_depth");
   const auto run =
