@@ -303,7 +303,8 @@ std::string markdown(const std::vector<RunOutcome>& runs, const Options& o, doub
        "process CPU time over the same call (all threads).\n\n";
   s << "Regenerate (about " << static_cast<int>(total / 60.0 + 0.5) << " min):\n\n"
     << "```sh\ncmake --build --preset release --target bench_speed_accuracy\n"
-    << "build/release/bench/bench_speed_accuracy" << (o.quick ? " --quick" : "") << "   # --out DIR\n"
+    << "build/release/bench/bench_speed_accuracy" << (o.quick ? " --quick" : "")
+    << "   # --out DIR\n"
     << "```\n\n";
   s << "Machine: " << machine() << "; run " << today() << ", total " << static_cast<int>(total)
     << " s; load average (1/5/15 min) " << load_before << " before, " << load_after

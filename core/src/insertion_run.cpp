@@ -225,6 +225,21 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
   return out;
 }
 
+// Records a reduction's measured effect (relative force change); above the fidelity's
+// tolerance renames it "<name>_rejected", says what was used instead and returns false.
+bool keep_reduction(Reduction& reduction, double f_reduced, double f_full,
+                    const InsertionRunOptions& options, const std::string& instead) {
+  if (!(f_full > 0.0)) return true;
+  reduction.measured_effect = std::abs(f_reduced - f_full) / f_full;
+  const double tolerance =
+      options.reduction_tolerance.value_or(detail::reduction_tolerance(options.fidelity));
+  if (*reduction.measured_effect <= tolerance) return true;
+  reduction.name += "_rejected";
+  reduction.detail += "; measured effect above the " +
+                      std::to_string(tolerance * 100.0).substr(0, 4) + " % tolerance: " + instead;
+  return false;
+}
+
 // The axisymmetric model is cheap: where layers were merged, run it once more on the scene's own
 // layers and measure the relative change of the force at the last common step. A merge that
 // changes it by more than the fidelity's tolerance is undone (the full-layer run is used).
@@ -241,16 +256,10 @@ void check_layer_merge(const RunPlan& plan, const PreparedNeedle& needle,
   full.depth_m = reduced.needles[0].points.back().depth_m;
   full.steps = static_cast<int>(reduced.needles[0].points.size());
   const PreResult reference = run_axisymmetric(full, needle, options, 0.0);
-  const double f_reduced = reduced.needles[0].points.back().force_N;
-  const double f_full = reference.needles[0].points.back().force_N;
-  if (!(f_full > 0.0)) return;
-  merge->measured_effect = std::abs(f_reduced - f_full) / f_full;
-  const double tolerance =
-      options.reduction_tolerance.value_or(detail::reduction_tolerance(options.fidelity));
-  if (*merge->measured_effect <= tolerance) return;
-  merge->name = "layer_merge_rejected";
-  merge->detail += "; measured effect above the " + std::to_string(tolerance * 100.0).substr(0, 4) +
-                   " % tolerance: the scene's own layers were used";
+  if (keep_reduction(*merge, reduced.needles[0].points.back().force_N,
+                     reference.needles[0].points.back().force_N, options,
+                     "the scene's own layers were used"))
+    return;
   RunPlan unmerged = plan;
   unmerged.layers = plan.full_layers;
   reduced = run_axisymmetric(unmerged, needle, options, crack_depth);
@@ -282,14 +291,7 @@ void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
   const double f_cut = plan.pre == PreKind::Axisymmetric
                            ? reduced.needles[0].points.back().force_N
                            : reference_on(plan.block_x_m, plan.block_y_m);
-  if (!(f_full > 0.0)) return;
-  cut->measured_effect = std::abs(f_cut - f_full) / f_full;
-  const double tolerance =
-      options.reduction_tolerance.value_or(detail::reduction_tolerance(options.fidelity));
-  if (*cut->measured_effect <= tolerance) return;
-  cut->name = "domain_cut_rejected";
-  cut->detail += "; measured effect above the " + std::to_string(tolerance * 100.0).substr(0, 4) +
-                 " % tolerance: the full block was used";
+  if (keep_reduction(*cut, f_cut, f_full, options, "the full block was used")) return;
   plan.block_x_m = plan.full_block_x_m;
   plan.block_y_m = plan.full_block_y_m;
   plan.axisymmetric_radius_m = fe::equal_area_radius(std::sqrt(plan.block_x_m * plan.block_y_m));

@@ -560,7 +560,8 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
   const bool frictionless = options.contact == ContactMode::Frictionless;
   if (frictionless && !model.is_linear())
     throw InputError(
-        "axisymmetric solver: frictionless contact needs linear layers; use sticking, or --model 3d");
+        "axisymmetric solver: frictionless contact needs linear layers; use sticking, or --model "
+        "3d");
   const auto start = std::chrono::steady_clock::now();
   const int before = model.factorization_count();
   const bool keep_field = options.stress_average_length_m > 0.0 || !options.vtu_directory.empty();
