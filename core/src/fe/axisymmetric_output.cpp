@@ -11,6 +11,7 @@
 #include "axisymmetric_internal.h"
 #include "mneedle/error.h"
 #include "mneedle/fe/axisymmetric.h"
+#include "vtu_writer.h"
 
 namespace mneedle::fe {
 
@@ -121,41 +122,20 @@ double AxisymmetricModel::averaged_max_principal_stress(const Eigen::VectorXd& u
 
 void AxisymmetricModel::write_vtu(const std::string& path, const Eigen::VectorXd& u) const {
   const AxisymmetricMesh& mesh = impl_->mesh;
-  const std::vector<double> stress = von_mises(u);
-  const std::vector<double> energy = energy_density(u);
-  std::ofstream out(path);
-  if (!out) throw InputError(path + ": cannot open for writing");
-  out.precision(9);
-  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
-      << "<UnstructuredGrid><Piece NumberOfPoints=\"" << mesh.nodes.size() << "\" NumberOfCells=\""
-      << mesh.elements.size() << "\">\n<Points>\n"
-      << "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const auto& p : mesh.nodes) out << p.x() << " 0 " << p.y() << '\n';
-  out << "</DataArray>\n</Points>\n<Cells>\n"
-      << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+  VtuFields f;
+  // The (r, z) plane drawn as the x-z plane of a 3-D file.
+  for (const auto& p : mesh.nodes) f.points_m.emplace_back(p.x(), 0.0, p.y());
   // VTK_QUADRATIC_TRIANGLE: corners, then mid-edges 0-1, 1-2, 2-0 (our order).
-  for (const auto& e : mesh.elements) {
-    for (std::uint32_t node : e) out << node << ' ';
-    out << '\n';
-  }
-  out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (std::size_t e = 1; e <= mesh.elements.size(); ++e) out << 6 * e << '\n';
-  out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  for (std::size_t e = 0; e < mesh.elements.size(); ++e) out << "22\n";
-  out << "</DataArray>\n</Cells>\n<PointData Vectors=\"displacement_m\">\n"
-      << "<DataArray type=\"Float64\" Name=\"displacement_m\" NumberOfComponents=\"3\" "
-         "format=\"ascii\">\n";
-  for (Eigen::Index i = 0; i + 1 < u.size(); i += 2) out << u(i) << " 0 " << u(i + 1) << '\n';
-  out << "</DataArray>\n</PointData>\n<CellData>\n"
-      << "<DataArray type=\"Float64\" Name=\"von_mises_Pa\" format=\"ascii\">\n";
-  for (double s : stress) out << s << '\n';
-  out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"energy_density_J_per_m3\" "
-         "format=\"ascii\">\n";
-  for (double w : energy) out << w << '\n';
-  out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"layer\" format=\"ascii\">\n";
-  for (int layer : mesh.element_layer) out << layer << '\n';
-  out << "</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-  if (!out) throw InputError(path + ": write failed");
+  for (const auto& e : mesh.elements)
+    for (std::uint32_t node : e) f.connectivity.push_back(node);
+  f.nodes_per_cell = 6;
+  f.cell_type = 22;
+  for (Eigen::Index i = 0; i + 1 < u.size(); i += 2)
+    f.displacement_m.emplace_back(u(i), 0.0, u(i + 1));
+  f.von_mises_Pa = von_mises(u);
+  f.energy_density_J_per_m3 = energy_density(u);
+  f.layer = mesh.element_layer;
+  fe::write_vtu(path, f);
 }
 
 AxisymmetricMesh crack_axisymmetric_mesh(const AxisymmetricMesh& mesh, double radius_m,

@@ -12,6 +12,7 @@
 
 #include "fe/contact3d.h"
 #include "fe/needle_shape.h"
+#include "fe/vtu_writer.h"
 #include "mneedle/error.h"
 #include "mneedle/fe/crack.h"
 #include "mneedle/fe/solid3d.h"
@@ -886,44 +887,18 @@ std::string Indentation3d::solver_backend() const {
 void Indentation3d::write_vtu(const std::string& path) const {
   const TetMesh& mesh = impl_->mesh;
   const Eigen::VectorXd u = displacement();
-  const std::vector<double> stress = impl_->model.von_mises(u);
-  const std::vector<double> energy = impl_->model.energy_density(u);
-  std::ofstream out(path);
-  if (!out) throw InputError(path + ": cannot open for writing");
-  out.precision(9);
-  const int per_element = mesh.nodes_per_element();
-  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
-      << "<UnstructuredGrid><Piece NumberOfPoints=\"" << mesh.nodes.size() << "\" NumberOfCells=\""
-      << mesh.elements.size() << "\">\n<Points>\n"
-      << "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const auto& p : mesh.nodes) out << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
-  out << "</DataArray>\n</Points>\n<Cells>\n"
-      << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const auto& e : mesh.elements) {
-    for (int a = 0; a < per_element; ++a) out << e[static_cast<std::size_t>(a)] << ' ';
-    out << '\n';
-  }
-  out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (std::size_t e = 1; e <= mesh.elements.size(); ++e)
-    out << e * static_cast<std::size_t>(per_element) << '\n';
-  out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  for (std::size_t e = 0; e < mesh.elements.size(); ++e)
-    out << (per_element == 4 ? 10 : 24) << '\n';
-  out << "</DataArray>\n</Cells>\n<PointData Vectors=\"displacement_m\">\n"
-      << "<DataArray type=\"Float64\" Name=\"displacement_m\" NumberOfComponents=\"3\" "
-         "format=\"ascii\">\n";
-  for (Eigen::Index i = 0; i < u.size(); i += 3)
-    out << u(i) << ' ' << u(i + 1) << ' ' << u(i + 2) << '\n';
-  out << "</DataArray>\n</PointData>\n<CellData>\n"
-      << "<DataArray type=\"Float64\" Name=\"von_mises_Pa\" format=\"ascii\">\n";
-  for (double s : stress) out << s << '\n';
-  out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"energy_density_J_per_m3\" "
-         "format=\"ascii\">\n";
-  for (double w : energy) out << w << '\n';
-  out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"layer\" format=\"ascii\">\n";
-  for (int layer : mesh.element_layer) out << layer << '\n';
-  out << "</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-  if (!out) throw InputError(path + ": write failed");
+  VtuFields f;
+  f.points_m = mesh.nodes;
+  f.nodes_per_cell = mesh.nodes_per_element();
+  f.cell_type = f.nodes_per_cell == 4 ? 10 : 24;
+  for (const auto& e : mesh.elements)
+    for (int a = 0; a < f.nodes_per_cell; ++a)
+      f.connectivity.push_back(e[static_cast<std::size_t>(a)]);
+  for (Eigen::Index i = 0; i < u.size(); i += 3) f.displacement_m.emplace_back(u.segment<3>(i));
+  f.von_mises_Pa = impl_->model.von_mises(u);
+  f.energy_density_J_per_m3 = impl_->model.energy_density(u);
+  f.layer = mesh.element_layer;
+  fe::write_vtu(path, f);
 }
 
 namespace {
