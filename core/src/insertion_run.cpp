@@ -61,21 +61,15 @@ class CrossingWatch {
   std::optional<PunctureThreshold> threshold_;
 };
 
-CriterionSample sample_of(double depth, const fe::NeedleStep3d& n) {
+// The criterion's view of one needle at one depth: a 3-D NeedleStep3d or an axisymmetric
+// InsertionStep, which carry the same fields.
+template <class NeedleState>
+CriterionSample sample_of(double depth, const NeedleState& n) {
   CriterionSample s;
   s.depth_m = depth;
   s.contact_pressure_Pa = n.contact_pressure_Pa;
   s.tip_stress_Pa = n.tip_stress_Pa;
   s.energy_release_rate_J_per_m2 = n.energy_release_rate_J_per_m2;
-  return s;
-}
-
-CriterionSample sample_of(const fe::InsertionStep& st) {
-  CriterionSample s;
-  s.depth_m = st.depth_m;
-  s.contact_pressure_Pa = st.contact_pressure_Pa;
-  s.tip_stress_Pa = st.tip_stress_Pa;
-  s.energy_release_rate_J_per_m2 = st.energy_release_rate_J_per_m2;
   return s;
 }
 
@@ -159,7 +153,9 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
   if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
     p.crack_depth_m = crack_depth;
   CrossingWatch watch(1, plan.threshold);
-  p.on_step = [&](const fe::InsertionStep& step) { return watch.keep_going(0, sample_of(step)); };
+  p.on_step = [&](const fe::InsertionStep& step) {
+    return watch.keep_going(0, sample_of(step.depth_m, step));
+  };
   const fe::InsertionResult r = fe::simulate_axisymmetric(p);
   PreResult out;
   out.needles.resize(1);
@@ -173,7 +169,7 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
     pt.tip_stress_Pa = st.tip_stress_Pa;
     pt.energy_release_rate_J_per_m2 = st.energy_release_rate_J_per_m2;
     out.needles[0].points.push_back(pt);
-    out.needles[0].samples.push_back(sample_of(st));
+    out.needles[0].samples.push_back(sample_of(st.depth_m, st));
   }
   out.nodes = static_cast<int>(r.nodes);
   out.elements = static_cast<int>(r.elements);
