@@ -36,6 +36,31 @@ double max_radius_below(const TriangleMesh& mesh, double height) {
   return fe::NeedleShape(mesh).max_radius_up_to(height);
 }
 
+// A mirror plane x = 0 (y = 0) holds when every needle is symmetric about its own plane in that
+// direction and has a twin of the same mesh at its mirror image (itself when on the plane).
+bool mirror_holds(const std::vector<PreparedNeedle>& needles, bool across_x) {
+  return std::all_of(needles.begin(), needles.end(), [&](const PreparedNeedle& n) {
+    if (!(across_x ? n.mirror_symmetric_x0 : n.mirror_symmetric_y0)) return false;
+    const double x = across_x ? -n.x : n.x, y = across_x ? n.y : -n.y;
+    return std::any_of(needles.begin(), needles.end(), [&](const PreparedNeedle& m) {
+      return m.x == x && m.y == y && m.mesh.vertices == n.mesh.vertices &&
+             m.mesh.triangles == n.mesh.triangles;
+    });
+  });
+}
+
+// The energy criterion cracks each needle on the plane x = needle x: not on a mirror plane.
+bool crack_on_x_mirror(const RunPlan& plan, const std::vector<PreparedNeedle>& needles) {
+  return plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy &&
+         std::any_of(needles.begin(), needles.end(),
+                     [](const PreparedNeedle& n) { return n.x == 0.0; });
+}
+
+void choose_mirror_planes(RunPlan& plan, const std::vector<PreparedNeedle>& needles) {
+  plan.half_model = mirror_holds(needles, false);
+  plan.mirror_x = mirror_holds(needles, true) && !crack_on_x_mirror(plan, needles);
+}
+
 bool on_axis(const PreparedNeedle& n) {
   return std::hypot(n.x, n.y) < 1e-12;
 }
@@ -220,12 +245,7 @@ RunPlan plan_insertion(const Scene& scene, const std::vector<PreparedNeedle>& ne
   if (options.allow_reductions) {
     merge_deep_layers(plan, influence_depth(plan.needle_radius_m, plan.depth_m));
     cut_domain(plan, needles);
-    if (plan.pre == PreKind::Full3d) {
-      const bool mirror = std::all_of(needles.begin(), needles.end(), [](const auto& n) {
-        return n.mirror_symmetric_y0 && std::abs(n.y) < 1e-12;
-      });
-      plan.half_model = mirror;
-    }
+    if (plan.pre == PreKind::Full3d) choose_mirror_planes(plan, needles);
   }
   plan.axisymmetric_radius_m = fe::equal_area_radius(std::sqrt(plan.block_x_m * plan.block_y_m));
   return plan;

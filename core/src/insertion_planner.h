@@ -19,7 +19,8 @@ struct RunPlan {
   PreKind pre = PreKind::Full3d;
   std::optional<PunctureThreshold> threshold;  ///< none: the scene has no puncture data
   bool post_stage = true;                      ///< continue after puncture with surface loads
-  bool half_model = false;
+  bool half_model = false;                     ///< 3-D: mirror plane y = 0
+  bool mirror_x = false;  ///< 3-D: mirror plane x = 0 (with half_model, a quarter model)
   std::vector<fe::TissueLayer> layers;       ///< after merging deep layers
   std::vector<fe::TissueLayer> full_layers;  ///< as the scene gives them
   double block_x_m = 0.0;

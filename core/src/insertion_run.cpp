@@ -97,6 +97,7 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
   o.contact = to_fe(options.contact);
   o.overrides = options.overrides;
   o.half_model = plan.half_model;
+  o.mirror_x = plan.mirror_x;
   if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Stress)
     o.stress_average_length_m = plan.threshold->average_length_m;
   if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
@@ -134,6 +135,21 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
   out.max_aspect_ratio = r.quality.max_aspect_ratio;
   out.model = "fe_3d";
   return out;
+}
+
+Reduction mirror_reduction(const RunPlan& plan) {
+  const bool quarter = plan.half_model && plan.mirror_x;
+  const std::string planes = quarter ? "x = 0 and y = 0" : plan.half_model ? "y = 0" : "x = 0";
+  const std::string part = quarter           ? "x, y >= 0 quarter"
+                           : plan.half_model ? "y >= 0 half"
+                                             : "x >= 0 half";
+  return {quarter ? "quarter_model" : "half_model",
+          "the needles are symmetric about " + planes +
+              " (each needle about its own axis, the array as a whole): the 3-D model solves the " +
+              part +
+              " (results reported for every needle; tested against the full model in "
+              "tests/core/test_insertion_run.cpp)",
+          std::nullopt};
 }
 
 PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
@@ -509,13 +525,7 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
           run.crack_depth_m = crack_depth_for(plan.needle_radius_m, tip_size_3d(plan, options));
         pre = run_3d(plan, needles, options, run.crack_depth_m);
         check_domain_cut(plan, needles, options, run.crack_depth_m, pre, run.reductions);
-        if (plan.half_model)
-          run.reductions.push_back(
-              {"half_model",
-               "every needle is symmetric about y = 0 and lies on it: the 3-D model solves the "
-               "y >= 0 half (forces reported for the whole needle; tested against the full "
-               "model in tests/core/test_insertion_run.cpp)",
-               std::nullopt});
+        if (plan.half_model || plan.mirror_x) run.reductions.push_back(mirror_reduction(plan));
         break;
       case PreKind::Axisymmetric:
         if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)

@@ -122,7 +122,10 @@ std::optional<fe::AxisymmetricNeedle> axisymmetric_profile(const PluginRegistry&
   return profile;
 }
 
-bool mirror_symmetric_y0(const TriangleMesh& mesh) {
+namespace {
+
+// True when the image of every vertex under `mirror` (componentwise sign) is a vertex.
+bool maps_onto_itself(const TriangleMesh& mesh, const Vec3& mirror) {
   if (mesh.vertices.empty()) return false;
   const BoundingBox box = bounding_box(mesh);
   const double size =
@@ -131,7 +134,7 @@ bool mirror_symmetric_y0(const TriangleMesh& mesh) {
   std::vector<Vec3> sorted = mesh.vertices;
   std::sort(sorted.begin(), sorted.end());
   for (const Vec3& v : mesh.vertices) {
-    const Vec3 m{v[0], -v[1], v[2]};
+    const Vec3 m{mirror[0] * v[0], mirror[1] * v[1], mirror[2] * v[2]};
     // Candidates share x within the tolerance: scan that slice of the sorted list.
     auto it = std::lower_bound(sorted.begin(), sorted.end(), Vec3{m[0] - tol, -1e300, -1e300});
     bool found = false;
@@ -140,6 +143,16 @@ bool mirror_symmetric_y0(const TriangleMesh& mesh) {
     if (!found) return false;
   }
   return true;
+}
+
+}  // namespace
+
+bool mirror_symmetric_y0(const TriangleMesh& mesh) {
+  return maps_onto_itself(mesh, {1.0, -1.0, 1.0});
+}
+
+bool mirror_symmetric_x0(const TriangleMesh& mesh) {
+  return maps_onto_itself(mesh, {-1.0, 1.0, 1.0});
 }
 
 std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, const Scene& scene) {
@@ -154,6 +167,7 @@ std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, cons
     n.y = spec.at[1];
     n.axisymmetric = axisymmetric_profile(registry, source, where);
     n.mirror_symmetric_y0 = n.axisymmetric.has_value() || mirror_symmetric_y0(source.mesh);
+    n.mirror_symmetric_x0 = mirror_symmetric_x0(source.mesh);
     n.mesh = std::move(source.mesh);
     prepared.push_back(std::move(n));
   }

@@ -142,6 +142,29 @@ TEST(CmdSimulate, CriterionWithoutItsDataNamesTheLayerAndKey) {
   EXPECT_NE(run.err.find("strength: missing"), std::string::npos) << run.err;
 }
 
+// Paper A's four-needle array: symmetric about x = 0 and y = 0, so one needle is solved and
+// reported four times; the total is their sum.
+TEST(CmdSimulate, PaperAArrayRunsAsAQuarterModelAndReportsEveryNeedle) {
+  const std::string file =
+      std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/paper_a_skin_array.toml";
+  const CommandRun run = run_mneedle("simulate '" + file + "' --fidelity fast --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  ASSERT_EQ(j["reductions"].size(), 1U) << j["reductions"].dump();
+  EXPECT_EQ(j["reductions"][0]["name"], "quarter_model");
+  ASSERT_EQ(j["needles"].size(), 4U);
+  const double force = j["needles"][0]["max_force_N"].get<double>();
+  EXPECT_GT(force, 1e-3);  // tens of mN for a 230 um punch 200 um into skin
+  for (const auto& needle : j["needles"]) {
+    EXPECT_EQ(needle["max_force_N"].get<double>(), force) << needle["name"];
+    const auto& lateral = needle["curve"].back()["lateral_force_N"];
+    EXPECT_NEAR(std::abs(lateral[0].get<double>()),
+                std::abs(j["needles"][0]["curve"].back()["lateral_force_N"][0].get<double>()),
+                1e-12);
+  }
+  EXPECT_NEAR(j["total_curve"].back()["force_N"].get<double>(), 4.0 * force, 1e-9 * force);
+}
+
 TEST(CmdSimulate, BevelPuncturesOnAHalfModelAndReportsIt) {
   const CommandRun run = run_mneedle("simulate '" + scene("puncture_bevel.toml") + "' --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;

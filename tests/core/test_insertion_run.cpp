@@ -26,6 +26,7 @@ PreparedNeedle punch(const std::string& name, double r, double x = 0.0, double y
   n.y = y;
   n.axisymmetric = fe::AxisymmetricNeedle::flat_punch(r);
   n.mirror_symmetric_y0 = true;
+  n.mirror_symmetric_x0 = true;
   return n;
 }
 
@@ -305,6 +306,59 @@ TEST(ScenePlanner, HalfModelOfABevelMatchesTheFullModel) {
   EXPECT_NEAR(a.force_N, b.force_N, 1e-9 * b.force_N);
   EXPECT_NEAR(a.lateral_force_N[0], b.lateral_force_N[0], 1e-9 * b.force_N);
   EXPECT_NEAR(a.contact_area_m2, b.contact_area_m2, 1e-9 * b.contact_area_m2);
+}
+
+std::string two_by_two_punches() {
+  std::string text;
+  const char* names[] = {"a", "b", "c", "d"};
+  const char* at[] = {"[\"-250 um\", \"-250 um\"]", "[\"250 um\", \"-250 um\"]",
+                      "[\"-250 um\", \"250 um\"]", "[\"250 um\", \"250 um\"]"};
+  for (int k = 0; k < 4; ++k)
+    text += std::string("[[needles]]\nname = \"") + names[k] +
+            "\"\ngeometry = { plugin = \"cylinder\", diameter = \"150 um\" }\nat = " + at[k] + "\n";
+  return text;
+}
+
+std::vector<PreparedNeedle> two_by_two(double x0 = 0.0) {
+  return {punch("a", 75e-6, x0 - 250e-6, -250e-6), punch("b", 75e-6, x0 + 250e-6, -250e-6),
+          punch("c", 75e-6, x0 - 250e-6, 250e-6), punch("d", 75e-6, x0 + 250e-6, 250e-6)};
+}
+
+TEST(ScenePlanner, QuarterModelOfATwoByTwoArrayMatchesTheFullModel) {
+  const Scene scene = parse_scene(scene_text("", kFracture, two_by_two_punches(), "[\"puncture\"]",
+                                             "[\"1500 um\", \"1500 um\", \"600 um\"]", "60 um"),
+                                  "array.toml");
+  InsertionRunOptions full = fast();
+  full.allow_reductions = false;
+  const InsertionRun quarter = run_insertion(scene, two_by_two(), fast());
+  const InsertionRun whole = run_insertion(scene, two_by_two(), full);
+  ASSERT_NE(find_reduction(quarter, "quarter_model"), nullptr);
+  EXPECT_LT(4 * quarter.elements, whole.elements + whole.elements / 10);
+  ASSERT_EQ(quarter.needles.size(), 4U);
+  for (std::size_t n = 0; n < 4; ++n) {
+    const RunPoint& a = quarter.needles[n].curve.back();
+    const RunPoint& b = whole.needles[n].curve.back();
+    ASSERT_GT(b.force_N, 0.0);
+    EXPECT_NEAR(a.force_N, b.force_N, 1e-6 * b.force_N) << n;
+    EXPECT_NEAR(a.lateral_force_N[0], b.lateral_force_N[0], 1e-6 * b.force_N) << n;
+    EXPECT_NEAR(a.lateral_force_N[1], b.lateral_force_N[1], 1e-6 * b.force_N) << n;
+  }
+  EXPECT_NEAR(quarter.total_curve.back().force_N, whole.total_curve.back().force_N,
+              1e-6 * whole.total_curve.back().force_N);
+}
+
+TEST(ScenePlanner, ArrayOffTheCentreOrWithOddNeedlesKeepsTheFullModel) {
+  const Scene scene = parse_scene(scene_text("", kFracture, two_by_two_punches(), "[\"puncture\"]",
+                                             "[\"1500 um\", \"1500 um\", \"600 um\"]", "20 um"),
+                                  "array.toml");
+  const InsertionRun shifted = run_insertion(scene, two_by_two(10e-6), fast());
+  EXPECT_NE(find_reduction(shifted, "half_model"), nullptr);  // still symmetric about y = 0
+  EXPECT_EQ(find_reduction(shifted, "quarter_model"), nullptr);
+  std::vector<PreparedNeedle> odd = two_by_two();
+  odd[0] = punch("a", 60e-6, -250e-6, -250e-6);  // a differs from its images
+  const InsertionRun mixed = run_insertion(scene, odd, fast());
+  EXPECT_EQ(find_reduction(mixed, "half_model"), nullptr);
+  EXPECT_EQ(find_reduction(mixed, "quarter_model"), nullptr);
 }
 
 TEST(ScenePlanner, AxisymmetricModelAgreesWithThe3dBlockWithinTheFastTolerance) {

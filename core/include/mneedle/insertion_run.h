@@ -25,6 +25,7 @@ struct PreparedNeedle {
   double y = 0.0;
   std::optional<fe::AxisymmetricNeedle> axisymmetric;  ///< set for cylinder/cone shapes
   bool mirror_symmetric_y0 = false;  ///< mesh symmetric about its y = 0 plane (bevels)
+  bool mirror_symmetric_x0 = false;  ///< mesh symmetric about its x = 0 plane (cones)
 };
 
 /// Which model computes the pre-puncture stage.

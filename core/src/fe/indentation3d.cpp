@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "fe/contact3d.h"
+#include "fe/mirror_planes.h"
 #include "fe/needle_shape.h"
 #include "fe/vtu_writer.h"
 #include "mneedle/error.h"
@@ -701,8 +702,23 @@ struct Indentation3d::Impl {
     return area;
   }
 
-  // A half model reports the whole problem: its mirror image carries the same share.
-  double whole() const { return mesh.mirror_y0 ? 2.0 : 1.0; }
+  // A reduced model reports the whole problem: each mirror image carries the same share.
+  double whole() const { return (mesh.mirror_x0 ? 2.0 : 1.0) * (mesh.mirror_y0 ? 2.0 : 1.0); }
+  bool on_mirror_x(std::size_t n) const { return mesh.mirror_x0 && needles[n].x == 0.0; }
+  bool on_mirror_y(std::size_t n) const { return mesh.mirror_y0 && needles[n].y == 0.0; }
+  // A needle on a mirror plane is cut by it: its image there is its other half. A needle off
+  // the planes is whole in the model (its images are other needles).
+  double share(std::size_t n) const {
+    return (on_mirror_x(n) ? 2.0 : 1.0) * (on_mirror_y(n) ? 2.0 : 1.0);
+  }
+  // Tissue-on-needle force of needle n for the whole needle: the mirror halves' forces
+  // across a plane cancel.
+  Eigen::Vector3d whole_needle_force(std::size_t n, const Eigen::Vector3d& meshed) const {
+    Eigen::Vector3d total = share(n) * meshed;
+    if (on_mirror_x(n)) total.x() = 0.0;
+    if (on_mirror_y(n)) total.y() = 0.0;
+    return total;
+  }
 
   Eigen::VectorXd field() const {
     if (!model.is_linear()) return u;
@@ -739,11 +755,10 @@ struct Indentation3d::Impl {
     for (std::size_t n = 0; n < needles.size(); ++n) {
       NeedleStep3d needle;
       needle.name = needles[n].name;
-      Eigen::Vector3d total = whole() * force[n];
-      if (mesh.mirror_y0) total.y() = 0.0;
+      const Eigen::Vector3d total = whole_needle_force(n, force[n]);
       needle.force_N = total.z();
       needle.lateral_force_N = {total.x(), total.y()};
-      needle.contact_area_m2 = whole() * area[n];
+      needle.contact_area_m2 = share(n) * area[n];
       needle.contact_pressure_Pa =
           needle.contact_area_m2 > 0.0 ? needle.force_N / needle.contact_area_m2 : 0.0;
       needle.captured_nodes =
@@ -772,11 +787,10 @@ struct Indentation3d::Impl {
         total -= forces.segment<3>(3 * static_cast<Eigen::Index>(i));  // tissue on needle
         ++needle.captured_nodes;
       }
-      total *= whole();
-      if (mesh.mirror_y0) total.y() = 0.0;  // the mirror halves' y forces cancel
+      total = whole_needle_force(n, total);
       needle.force_N = total.z();
       needle.lateral_force_N = {total.x(), total.y()};
-      needle.contact_area_m2 = whole() * contact_area(static_cast<int>(n), moved);
+      needle.contact_area_m2 = share(n) * contact_area(static_cast<int>(n), moved);
       needle.contact_pressure_Pa =
           needle.contact_area_m2 > 0.0 ? needle.force_N / needle.contact_area_m2 : 0.0;
       result.needles.push_back(needle);
@@ -796,17 +810,23 @@ double mesh_extent(const TetMesh& mesh) {
   return (hi - lo).norm();
 }
 
-// A half model is exact only for needles that the mirror plane y = 0 maps onto themselves.
-void check_half_model(const std::vector<Needle3d>& needles, const std::vector<NeedleShape>& shapes,
-                      double extent) {
-  const double tolerance = 1e-9 * extent;
+// A reduced model holds the needles of its own part: each needle lies on the kept side of every
+// mirror plane, and one that a plane cuts must be symmetric about it. Planes are exact
+// coordinates (x = 0, y = 0), as the planner and the mesh generator place them.
+void check_mirror_planes(const TetMesh& mesh, const std::vector<Needle3d>& needles,
+                         const std::vector<NeedleShape>& shapes, double extent) {
+  const double tolerance = 1e-6 * extent + 1e-12;
   for (std::size_t n = 0; n < needles.size(); ++n) {
-    if (std::abs(needles[n].y) > tolerance)
-      throw InputError("3-D half model: needle '" + needles[n].name +
-                       "' at y = " + micrometres(needles[n].y) + " is off the mirror plane y = 0");
-    if (!shapes[n].mirror_symmetric_y(1e-6 * extent + 1e-12))
-      throw InputError("3-D half model: needle '" + needles[n].name +
-                       "' is not mirror-symmetric about y = 0 (use the full model)");
+    const std::string where = "3-D reduced model: needle '" + needles[n].name + "'";
+    if ((mesh.mirror_x0 && needles[n].x < 0.0) || (mesh.mirror_y0 && needles[n].y < 0.0))
+      throw InputError(where + " at (" + micrometres(needles[n].x) + ", " +
+                       micrometres(needles[n].y) +
+                       ") lies in the mirrored part: give only the needles with x, y >= 0 on "
+                       "a mirror plane");
+    if (mesh.mirror_y0 && needles[n].y == 0.0 && !shapes[n].mirror_symmetric_y(tolerance))
+      throw InputError(where + " is not mirror-symmetric about y = 0 (use the full model)");
+    if (mesh.mirror_x0 && needles[n].x == 0.0 && !shapes[n].mirror_symmetric_x(tolerance))
+      throw InputError(where + " is not mirror-symmetric about x = 0 (use the full model)");
   }
 }
 
@@ -824,13 +844,16 @@ Indentation3d::Indentation3d(const TetMesh& mesh, std::vector<Needle3d> needles,
   impl_->select_candidates(max_depth);
   if (impl_->frictionless()) impl_->setup_frictionless();
   const double extent = mesh_extent(mesh);
-  if (mesh.mirror_y0) check_half_model(impl_->needles, impl_->shapes, extent);
+  check_mirror_planes(mesh, impl_->needles, impl_->shapes, extent);
   impl_->fixed_dof.assign(static_cast<std::size_t>(impl_->model.dof_count()), 0);
   for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
     if (mesh.fixed[n])
       for (int j = 0; j < 3; ++j) impl_->fixed_dof[3 * n + static_cast<std::size_t>(j)] = 1;
+    // symmetry: no displacement across a mirror plane
+    if (mesh.mirror_x0 && std::abs(mesh.nodes[n].x()) <= 1e-12 * extent)
+      impl_->fixed_dof[3 * n] = 1;
     if (mesh.mirror_y0 && std::abs(mesh.nodes[n].y()) <= 1e-12 * extent)
-      impl_->fixed_dof[3 * n + 1] = 1;  // symmetry: u_y = 0 on the mirror plane
+      impl_->fixed_dof[3 * n + 1] = 1;
   }
 }
 
@@ -923,6 +946,7 @@ TetMesh cracked_copy(const TetMesh& mesh, const std::vector<Needle3d>& needles, 
     *original_node = std::move(previous);
     areas->push_back(area);
   }
+  cracked.mirror_x0 = mesh.mirror_x0;
   cracked.mirror_y0 = mesh.mirror_y0;
   return cracked;
 }
@@ -944,24 +968,38 @@ void check_options(const Simulation3dOptions& options) {
 
 }  // namespace
 
-Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d>& needles,
+Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d>& all_needles,
                                const Simulation3dOptions& options) {
   check_options(options);
   const auto start = Clock::now();
+  const MirrorSelection selection =
+      select_mirrored_part(all_needles, options.mirror_x, options.half_model);
+  const std::vector<Needle3d>& needles = selection.kept;
+  if (options.mirror_x && options.crack_depth_m > 0.0)
+    for (const Needle3d& needle : needles)
+      if (needle.x == 0.0)
+        throw InputError("simulate_3d: needle '" + needle.name +
+                         "': its crack (normal x) would lie on the mirror plane x = 0 (use the "
+                         "model without the x mirror)");
+  // The grid is the whole scene's, so a reduced model meshes exactly its share of it.
   block.sites.clear();
   std::vector<Eigen::Vector2d> first_contact;
-  for (const Needle3d& needle : needles) {
+  for (const Needle3d& needle : all_needles) {
     const NeedleShape shape(needle.mesh);
-    first_contact.push_back(Eigen::Vector2d(needle.x, needle.y) + shape.first_contact_xy(1e-9));
+    const Eigen::Vector2d axis(needle.x, needle.y);
+    const Eigen::Vector2d tip = axis + shape.first_contact_xy(1e-9);
     fe::NeedleSite site{needle.x, needle.y, shape.max_radius_up_to(options.depth), std::nullopt};
-    if ((first_contact.back() - Eigen::Vector2d(needle.x, needle.y)).norm() > 1e-3 * site.radius)
-      site.tip = first_contact.back();
+    if ((tip - axis).norm() > 1e-3 * site.radius) site.tip = tip;
     block.sites.push_back(site);
+    const bool kept =
+        (!options.mirror_x || needle.x >= 0.0) && (!options.half_model || needle.y >= 0.0);
+    if (kept) first_contact.push_back(tip);
   }
   block.fidelity = options.fidelity;
   block.order = options.overrides.order.value_or(options.order);
   block.insertion_depth = options.depth;
   block.overrides = options.overrides;
+  block.half_x = options.mirror_x;
   block.half_y = options.half_model;
   if (options.overrides.domain_scale) {
     block.size_x *= *options.overrides.domain_scale;
@@ -992,7 +1030,8 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   // own search it captures a different set and U_intact - U_cracked loses its sign.
   if (cracked_run && options.contact == ContactMode::Sticking)
     cracked_run->hold_contact_of(run, std::move(original_node));
-  const double whole = mesh.mirror_y0 ? 2.0 : 1.0;
+  // Every mirror image of the meshed part holds the same cracks.
+  const double whole = (mesh.mirror_x0 ? 2.0 : 1.0) * (mesh.mirror_y0 ? 2.0 : 1.0);
   double total_crack_area = 0.0;
   for (double a : crack_areas) total_crack_area += whole * a;
   if (cracked_run && !(total_crack_area > 0.0))
@@ -1013,14 +1052,15 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
       const double release = (step.strain_energy_J - opened.strain_energy_J) / total_crack_area;
       for (std::size_t n = 0; n < needles.size(); ++n) {
         step.needles[n].energy_release_rate_J_per_m2 = release;
-        step.needles[n].crack_area_m2 = whole * crack_areas[n];
+        step.needles[n].crack_area_m2 =
+            (needles[n].y == 0.0 && mesh.mirror_y0 ? 2.0 : 1.0) * crack_areas[n];
       }
     }
     if (!options.vtu_directory.empty())
       run.write_vtu(
           (std::filesystem::path(options.vtu_directory) / ("step_" + std::to_string(k) + ".vtu"))
               .string());
-    result.steps.push_back(step);
+    result.steps.push_back(whole_scene_step(step, selection, all_needles));
     if (options.on_step && !options.on_step(result.steps.back())) break;
   }
   result.timing = run.timing();

@@ -107,12 +107,25 @@ double NeedleShape::max_radius_up_to(double height) const {
   return radius;
 }
 
-bool NeedleShape::mirror_symmetric_y(double tolerance) const {
-  for (const Eigen::Vector3d& v : impl_->vertices) {
-    const Eigen::Vector3d mirrored(v.x(), -v.y(), v.z());
-    if ((closest_point(mirrored) - mirrored).norm() > tolerance) return false;
+namespace {
+
+bool maps_onto_itself(const NeedleShape& shape, const std::vector<Eigen::Vector3d>& vertices,
+                      const Eigen::Vector3d& mirror, double tolerance) {
+  for (const Eigen::Vector3d& v : vertices) {
+    const Eigen::Vector3d image = v.cwiseProduct(mirror);
+    if ((shape.closest_point(image) - image).norm() > tolerance) return false;
   }
   return true;
+}
+
+}  // namespace
+
+bool NeedleShape::mirror_symmetric_y(double tolerance) const {
+  return maps_onto_itself(*this, impl_->vertices, {1.0, -1.0, 1.0}, tolerance);
+}
+
+bool NeedleShape::mirror_symmetric_x(double tolerance) const {
+  return maps_onto_itself(*this, impl_->vertices, {-1.0, 1.0, 1.0}, tolerance);
 }
 
 Eigen::Vector2d NeedleShape::first_contact_xy(double tolerance) const {

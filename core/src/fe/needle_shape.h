@@ -36,6 +36,8 @@ class NeedleShape {
   /// True when the mirror image (x, -y, z) of every vertex lies on the surface within
   /// `tolerance` (m): the needle is symmetric about its y = 0 plane.
   bool mirror_symmetric_y(double tolerance) const;
+  /// The same for the image (-x, y, z): symmetric about its x = 0 plane.
+  bool mirror_symmetric_x(double tolerance) const;
   /// Mean (x, y) of the lowest vertices (within `tolerance` of the lowest z): where the needle
   /// first touches a flat surface, needle frame.
   Eigen::Vector2d first_contact_xy(double tolerance) const;

@@ -30,9 +30,6 @@ void validate(const TissueBlockSpec& spec) {
     if (!(layer.thickness > 0.0) || !std::isfinite(layer.thickness))
       bad_spec("layers." + layer.name + ".thickness", "must be positive and finite");
   if (spec.order != 1 && spec.order != 2) bad_spec("order", "must be 1 or 2");
-  if (spec.half_y)
-    for (const NeedleSite& site : spec.sites)
-      if (site.y != 0.0) bad_spec("needle position", "a half model needs every site on y = 0");
   if (!(spec.insertion_depth >= 0.0)) bad_spec("insertion_depth", "must be >= 0");
   for (const NeedleSite& site : spec.sites) {
     if (!(site.radius > 0.0)) bad_spec("needle radius", "must be positive");
@@ -122,40 +119,83 @@ std::vector<double> marched_coordinates(double from, double to, SizeAt size_at) 
   return coordinates;
 }
 
+// Grid pieces between consecutive breaks: a piece between two needles is graded; an outer piece
+// marches out from its needle side, so the cells at a needle do not depend on where the block
+// ends. With march_from_lo false the axis starts on a mirror plane: its first piece is an inner
+// one, and the last piece marches out even when it is also the first.
+template <typename SizeAt>
+std::vector<double> axis_through(const std::vector<double>& breaks, bool march_from_lo,
+                                 SizeAt size_at) {
+  std::vector<double> coordinates{breaks.front()};
+  for (std::size_t b = 0; b + 1 < breaks.size(); ++b) {
+    const bool first = b == 0, last = b + 2 == breaks.size();
+    const std::vector<double> piece =
+        first && !last && march_from_lo ? marched_coordinates(breaks[b + 1], breaks[b], size_at)
+        : last && (!first || !march_from_lo)
+            ? marched_coordinates(breaks[b], breaks[b + 1], size_at)
+            : graded_coordinates(breaks[b], breaks[b + 1], size_at, 1);
+    coordinates.insert(coordinates.end(), piece.begin() + 1, piece.end());
+  }
+  return coordinates;
+}
+
+// True when the set of points maps onto itself under p -> -p.
+bool symmetric_about_zero(std::vector<double> points, double tolerance) {
+  std::sort(points.begin(), points.end());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (std::abs(points[i] + points[points.size() - 1 - i]) > tolerance) return false;
+  return true;
+}
+
+// Off-axis tips (a bevel's) that get a grid line of their own: tips yield to the sites (a half
+// model needs its line on the mirror plane), to the block's sides and to each other.
+std::vector<double> tips_clear_of(const std::vector<double>& sites, const std::vector<double>& tips,
+                                  double half, double clearance) {
+  std::vector<double> taken = sites;
+  taken.push_back(-half);
+  taken.push_back(half);
+  std::vector<double> clear;
+  for (double t : tips) {
+    const bool free = std::all_of(taken.begin(), taken.end(),
+                                  [&](double b) { return std::abs(t - b) > clearance; });
+    if (!free) continue;
+    clear.push_back(t);
+    taken.push_back(t);
+  }
+  return clear;
+}
+
+// Grid lines along one axis of [-half, half], through every site and every clear tip. When sites
+// and tips are symmetric about 0 the axis is built on [0, half] and reflected, with a line on 0:
+// the half >= 0 is then exactly a half model's axis.
 std::vector<double> lateral_coordinates(double half, const std::vector<double>& centres,
-                                        const std::vector<double>& tips, const MeshSizing& sizing) {
+                                        const std::vector<double>& tips, const MeshSizing& sizing,
+                                        bool* symmetric) {
   auto size_at = [&](double x) {
     double size = sizing.max_size;
     for (double c : centres)
       size = std::min(size, graded_size(std::abs(x - c) - sizing.fine_half_width, sizing));
     return size;
   };
-  // A grid line through every site and every off-axis tip (a bevel's), so a sharp tip meets a
-  // node the moment it touches.
-  std::vector<double> breaks{-half};
+  const double clearance = 0.25 * sizing.fine_size;
   std::vector<double> sorted = centres;
   std::sort(sorted.begin(), sorted.end());
+  const std::vector<double> clear = tips_clear_of(sorted, tips, half, clearance);
+  std::vector<double> lines = sorted;
+  lines.insert(lines.end(), clear.begin(), clear.end());
+  *symmetric = symmetric_about_zero(lines, 1e-12 * half);
+  std::vector<double> breaks{*symmetric ? 0.0 : -half};
   for (double c : sorted)
-    if (c - breaks.back() > 0.25 * sizing.fine_size && half - c > 0.25 * sizing.fine_size)
-      breaks.push_back(c);
+    if (c - breaks.back() > clearance && half - c > clearance) breaks.push_back(c);
   breaks.push_back(half);
-  // Tips yield to the sites (the half model needs its line on y = 0) and to each other.
-  for (double t : tips) {
-    const bool clear = std::all_of(breaks.begin(), breaks.end(), [&](double b) {
-      return std::abs(t - b) > 0.25 * sizing.fine_size;
-    });
-    if (clear) breaks.insert(std::upper_bound(breaks.begin(), breaks.end(), t), t);
-  }
-  std::vector<double> coordinates{-half};
-  for (std::size_t b = 0; b + 1 < breaks.size(); ++b) {
-    // The outer pieces march from the needle side; a piece between two needles is graded.
-    const bool first = b == 0, last = b + 2 == breaks.size();
-    const std::vector<double> piece =
-        first && !last   ? marched_coordinates(breaks[b + 1], breaks[b], size_at)
-        : last && !first ? marched_coordinates(breaks[b], breaks[b + 1], size_at)
-                         : graded_coordinates(breaks[b], breaks[b + 1], size_at, 1);
-    coordinates.insert(coordinates.end(), piece.begin() + 1, piece.end());
-  }
+  for (double t : clear)
+    if (!*symmetric || t > clearance)
+      breaks.insert(std::upper_bound(breaks.begin(), breaks.end(), t), t);
+  if (!*symmetric) return axis_through(breaks, true, size_at);
+  const std::vector<double> upper = axis_through(breaks, false, size_at);
+  std::vector<double> coordinates;
+  for (auto it = upper.rbegin(); it + 1 != upper.rend(); ++it) coordinates.push_back(-*it);
+  coordinates.insert(coordinates.end(), upper.begin(), upper.end());
   return coordinates;
 }
 
@@ -322,20 +362,41 @@ void link_neighbours_and_top(TetMesh& mesh) {
     }
 }
 
-// The mirror plane of a half model (y = lo.y = 0) is not a clamped side.
+// A mirror plane (x = lo.x = 0 or y = lo.y = 0 of a reduced model) is not a clamped side.
 void mark_fixed_nodes(TetMesh& mesh, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
-                      bool mirror_lo_y) {
+                      bool mirror_lo_x, bool mirror_lo_y) {
   const double tolerance = 1e-9 * (hi - lo).norm();
   mesh.fixed.assign(mesh.nodes.size(), 0);
   for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
     const Eigen::Vector3d& p = mesh.nodes[n];
-    const bool side = std::abs(p.x() - lo.x()) < tolerance ||
+    const bool side = (!mirror_lo_x && std::abs(p.x() - lo.x()) < tolerance) ||
                       std::abs(p.x() - hi.x()) < tolerance ||
                       (!mirror_lo_y && std::abs(p.y() - lo.y()) < tolerance) ||
                       std::abs(p.y() - hi.y()) < tolerance;
     const bool bottom = std::abs(p.z() - lo.z()) < tolerance;
     mesh.fixed[n] = side || bottom ? 1 : 0;
   }
+}
+
+// One lateral axis and its cells' split flags; with `half` only the part >= 0 of the full axis
+// (which is symmetric about 0 by construction when its sites and tips are), so a reduced model
+// meshes exactly its share of the full mesh.
+std::vector<double> half_axis(double half_size, const std::vector<double>& sites,
+                              const std::vector<double>& tips, const MeshSizing& sizing, bool half,
+                              const std::string& name, std::vector<char>* mirrored) {
+  bool symmetric = false;
+  std::vector<double> axis = lateral_coordinates(half_size, sites, tips, sizing, &symmetric);
+  *mirrored = mirrored_cells(axis, sites);
+  if (!half) return axis;
+  if (!symmetric)
+    bad_spec("mirror plane " + name + " = 0",
+             "the needle sites and tips are not symmetric about it (use the full model)");
+  const auto zero = std::find(axis.begin(), axis.end(), 0.0);
+  if (zero == axis.end()) bad_spec("mirror plane " + name + " = 0", "no grid line on it");
+  const auto skip = zero - axis.begin();
+  axis.erase(axis.begin(), zero);
+  mirrored->erase(mirrored->begin(), mirrored->begin() + skip);
+  return axis;
 }
 
 }  // namespace
@@ -428,20 +489,10 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   MeshSizing lateral = sizing;
   lateral.max_size =
       std::max(sizing.fine_size, std::min(sizing.max_size, kMaxCellAspect * thinnest));
-  std::vector<double> y_axis = lateral_coordinates(spec.size_y / 2, cy, tip_y, lateral);
-  // The full grid has a line through every site and is graded symmetrically about it, so its
-  // y >= 0 part is exactly the half model's grid.
-  std::vector<char> mirror_y = mirrored_cells(y_axis, cy);
-  if (spec.half_y) {
-    const auto first = std::find(y_axis.begin(), y_axis.end(), 0.0);
-    if (first == y_axis.end()) bad_spec("half model", "no grid line on y = 0");
-    const auto skip = first - y_axis.begin();
-    y_axis.erase(y_axis.begin(), first);
-    mirror_y.erase(mirror_y.begin(), mirror_y.begin() + skip);
-  }
-  const std::array<std::vector<double>, 3> axes = {
-      lateral_coordinates(spec.size_x / 2, cx, tip_x, lateral), std::move(y_axis), std::move(z)};
-
+  std::array<std::vector<char>, 2> mirrored;
+  std::array<std::vector<double>, 3> axes = {
+      half_axis(spec.size_x / 2, cx, tip_x, lateral, spec.half_x, "x", &mirrored[0]),
+      half_axis(spec.size_y / 2, cy, tip_y, lateral, spec.half_y, "y", &mirrored[1]), std::move(z)};
   TetMesh mesh;
   mesh.order = spec.order;
   mesh.layers = spec.layers;
@@ -464,11 +515,12 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
     }
     cell_layer.push_back(layer);
   }
-  split_cells(mesh, axes, cell_layer, mirrored_cells(axes[0], cx), mirror_y);
+  split_cells(mesh, axes, cell_layer, mirrored[0], mirrored[1]);
   if (mesh.order == 2) add_midside_nodes(mesh);
   link_neighbours_and_top(mesh);
   mark_fixed_nodes(mesh, {axes[0].front(), axes[1].front(), axes[2].front()},
-                   {axes[0].back(), axes[1].back(), 0.0}, spec.half_y);
+                   {axes[0].back(), axes[1].back(), 0.0}, spec.half_x, spec.half_y);
+  mesh.mirror_x0 = spec.half_x;
   mesh.mirror_y0 = spec.half_y;
   return mesh;
 }

@@ -52,6 +52,8 @@ std::optional<fe::AxisymmetricNeedle> axisymmetric_profile(const PluginRegistry&
 /// True when the mirror image (x, -y, z) of every vertex is a vertex (within 1e-6 of the mesh
 /// size): the needle is symmetric about its y = 0 plane (bevels, bodies of revolution).
 bool mirror_symmetric_y0(const TriangleMesh& mesh);
+/// The same for the image (-x, y, z): symmetric about its x = 0 plane (bodies of revolution).
+bool mirror_symmetric_x0(const TriangleMesh& mesh);
 
 /// Every needle of the scene ready for run_insertion, in the scene's order.
 std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, const Scene& scene);

@@ -229,6 +229,63 @@ TEST(Indentation3d, HalfModelMatchesFullModelOnSymmetricBevel) {
   }
 }
 
+// Compares every needle of the reduced run with the same needle of the full run: exact by
+// symmetry up to round-off (and a capture decision flipped by it).
+void expect_same_needles(const Simulation3dResult& reduced, const Simulation3dResult& full) {
+  ASSERT_EQ(reduced.steps.size(), full.steps.size());
+  for (std::size_t k = 0; k < full.steps.size(); ++k) {
+    ASSERT_EQ(reduced.steps[k].needles.size(), full.steps[k].needles.size());
+    for (std::size_t n = 0; n < full.steps[k].needles.size(); ++n) {
+      const NeedleStep3d& f = full.steps[k].needles[n];
+      const NeedleStep3d& r = reduced.steps[k].needles[n];
+      EXPECT_EQ(r.name, f.name);
+      const double scale = std::max(f.force_N, 1e-12);
+      EXPECT_NEAR(r.force_N, f.force_N, 1e-6 * scale) << f.name << " step " << k;
+      EXPECT_NEAR(r.lateral_force_N[0], f.lateral_force_N[0], 1e-6 * scale) << f.name;
+      EXPECT_NEAR(r.lateral_force_N[1], f.lateral_force_N[1], 1e-6 * scale) << f.name;
+      EXPECT_NEAR(r.contact_area_m2, f.contact_area_m2, 1e-6 * f.contact_area_m2) << f.name;
+    }
+    EXPECT_NEAR(reduced.steps[k].strain_energy_J, full.steps[k].strain_energy_J,
+                1e-6 * full.steps[k].strain_energy_J);
+  }
+}
+
+TEST(Indentation3d, QuarterModelOfATwoByTwoConeArrayMatchesTheFullModel) {
+  const auto cone = cone_needle(std::numbers::pi / 6, 40e-6, 1e-3);
+  const std::vector<Needle3d> needles{{"a", cone, -120e-6, -120e-6},
+                                      {"b", cone, 120e-6, -120e-6},
+                                      {"c", cone, -120e-6, 120e-6},
+                                      {"d", cone, 120e-6, 120e-6}};
+  Simulation3dOptions options = small_options();
+  options.steps = 2;
+  options.overrides.tip_size_m = 20e-6;  // coarse: four fine zones in the full model
+  const Simulation3dResult full = simulate_3d(small_skin(), needles, options);
+  ASSERT_GT(full.steps.back().needles[0].force_N, 0.0);
+  // The full mesh is itself symmetric: opposite corners feel opposite lateral forces.
+  const auto& last = full.steps.back().needles;
+  ASSERT_GT(std::abs(last[3].lateral_force_N[0]), 1e-3 * last[3].force_N);
+  EXPECT_NEAR(last[0].lateral_force_N[0], -last[3].lateral_force_N[0], 1e-6 * last[3].force_N);
+  EXPECT_NEAR(last[0].lateral_force_N[1], -last[3].lateral_force_N[1], 1e-6 * last[3].force_N);
+  options.half_model = options.mirror_x = true;
+  const Simulation3dResult quarter = simulate_3d(small_skin(), needles, options);
+  EXPECT_LT(quarter.nodes, 0.35 * full.nodes);
+  expect_same_needles(quarter, full);
+}
+
+TEST(Indentation3d, HalfModelOfBevelsOffTheMirrorPlaneMatchesTheFullModel) {
+  const auto bevel = bevel_needle(40e-6, std::numbers::pi / 6, 1e-3);
+  const std::vector<Needle3d> needles{{"lower", bevel, 0.0, -150e-6},
+                                      {"upper", bevel, 0.0, 150e-6}};
+  Simulation3dOptions options = small_options();
+  options.steps = 2;
+  const Simulation3dResult full = simulate_3d(small_skin(), needles, options);
+  ASSERT_GT(full.steps.back().needles[0].force_N, 0.0);
+  options.half_model = true;
+  const Simulation3dResult half = simulate_3d(small_skin(), needles, options);
+  EXPECT_LT(half.nodes, 0.6 * full.nodes);
+  expect_same_needles(half, full);
+}
+
 TEST(Indentation3d, HalfModelRejectsNeedlesOffTheMirrorPlaneOrAsymmetric) {
   Simulation3dOptions options = small_options();
   options.half_model = true;
@@ -239,6 +296,13 @@ TEST(Indentation3d, HalfModelRejectsNeedlesOffTheMirrorPlaneOrAsymmetric) {
   for (auto& v : turned.vertices) v = {-v[1], v[0], v[2]};
   EXPECT_THROW(simulate_3d(small_skin(), {{"turned", turned, 0.0, 0.0}}, options),
                mneedle::InputError);
+  options.half_model = false;
+  options.mirror_x = true;  // a bevel is not symmetric about x = 0
+  EXPECT_THROW(simulate_3d(small_skin(), {{"bevel", bevel, 0.0, 0.0}}, options),
+               mneedle::InputError);
+  const auto cone = cone_needle(std::numbers::pi / 6, 40e-6, 1e-3);
+  options.crack_depth_m = 10e-6;  // the crack under a needle on x = 0 would lie on the plane
+  EXPECT_THROW(simulate_3d(small_skin(), {{"cone", cone, 0.0, 0.0}}, options), mneedle::InputError);
 }
 
 TEST(Indentation3d, OnStepReturningFalseStopsTheInsertion) {

@@ -154,6 +154,62 @@ TEST(TissueMesh, OffAxisTipGetsAGridLineButTheHalfModelKeepsItsMirrorLine) {
   for (const Eigen::Vector3d& p : mesh.nodes) EXPECT_GE(p.y(), 0.0);
 }
 
+// A 2 x 2 array: the grid is built symmetric about x = 0 and y = 0 with lines on both, so the
+// quarter model meshes exactly the x, y >= 0 part of the full block, split the same way.
+TEST(TissueMesh, QuarterMeshOfASymmetricArrayIsThePositivePartOfTheFullMesh) {
+  TissueBlockSpec spec = paper_a_skin(Fidelity::Fast, 1);
+  spec.sites = {{-400e-6, -300e-6, 115e-6},
+                {400e-6, -300e-6, 115e-6},
+                {-400e-6, 300e-6, 115e-6},
+                {400e-6, 300e-6, 115e-6}};
+  const TetMesh full = generate_tissue_mesh(spec);
+  spec.half_x = spec.half_y = true;
+  const TetMesh quarter = generate_tissue_mesh(spec);
+  EXPECT_TRUE(quarter.mirror_x0 && quarter.mirror_y0);
+  auto key = [](const Eigen::Vector3d& p) { return std::array<double, 3>{p.x(), p.y(), p.z()}; };
+  std::set<std::array<double, 3>> kept;
+  for (const Eigen::Vector3d& p : full.nodes)
+    if (p.x() >= 0.0 && p.y() >= 0.0) kept.insert(key(p));
+  std::set<std::array<double, 3>> meshed;
+  for (const Eigen::Vector3d& p : quarter.nodes) meshed.insert(key(p));
+  EXPECT_EQ(meshed, kept);
+  EXPECT_EQ(4 * quarter.grid_cells[0] * quarter.grid_cells[1],
+            full.grid_cells[0] * full.grid_cells[1]);
+  // Tetrahedra: each quarter element is a full-mesh element (same corner coordinates).
+  std::set<std::array<double, 12>> full_tets;
+  auto tet_key = [](const TetMesh& m, const std::array<int, 10>& t) {
+    std::array<std::array<double, 3>, 4> c;
+    for (int i = 0; i < 4; ++i) {
+      const auto& p = m.nodes[static_cast<std::size_t>(t[static_cast<std::size_t>(i)])];
+      c[static_cast<std::size_t>(i)] = {p.x(), p.y(), p.z()};
+    }
+    std::sort(c.begin(), c.end());
+    std::array<double, 12> k{};
+    for (int i = 0; i < 12; ++i) k[static_cast<std::size_t>(i)] = c[i / 3][i % 3];
+    return k;
+  };
+  for (const auto& t : full.elements) full_tets.insert(tet_key(full, t));
+  for (const auto& t : quarter.elements) EXPECT_EQ(full_tets.count(tet_key(quarter, t)), 1U);
+  // The mirror planes are not clamped; the far sides are.
+  for (std::size_t n = 0; n < quarter.nodes.size(); ++n) {
+    const Eigen::Vector3d& p = quarter.nodes[n];
+    if ((p.x() == 0.0 || p.y() == 0.0) && p.z() > quarter.nodes.front().z() && p.x() < 1.4e-3 &&
+        p.y() < 1.4e-3) {
+      EXPECT_EQ(quarter.fixed[n], 0) << p.transpose();
+    }
+  }
+}
+
+TEST(TissueMesh, MirrorPlaneNeedsSitesSymmetricAboutIt) {
+  TissueBlockSpec spec = paper_a_skin(Fidelity::Fast, 1);
+  spec.sites = {{-400e-6, 0.0, 115e-6}, {300e-6, 0.0, 115e-6}};
+  spec.half_x = true;
+  EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
+  spec.half_x = false;
+  spec.half_y = true;  // both sites on y = 0: fine
+  EXPECT_NO_THROW(generate_tissue_mesh(spec));
+}
+
 TEST(TissueMesh, RegularKuhnCubeHasKnownQuality) {
   TissueBlockSpec spec;
   spec.size_x = spec.size_y = 1e-3;

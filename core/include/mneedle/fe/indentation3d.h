@@ -72,9 +72,10 @@ struct Indentation3dOptions {
 class Indentation3d {
  public:
   /// max_depth bounds the needle travel (m): it fixes the candidate contact nodes.
-  /// A mesh with mirror_y0 set is the y >= 0 half of a symmetric problem: nodes on y = 0 get
-  /// u_y = 0, every needle must sit on y = 0 with a mirror-symmetric surface (InputError
-  /// otherwise), and forces, energy and contact area are reported for the whole problem.
+  /// A mesh with mirror_y0 (mirror_x0) set is the y >= 0 (x >= 0) part of a symmetric problem:
+  /// nodes on the plane get no normal displacement; the needles are those of the modelled part
+  /// (InputError for one at y < 0, or one on y = 0 that is not symmetric about it). Energy is
+  /// reported for the whole problem, forces and contact area for each whole needle.
   Indentation3d(const TetMesh& mesh, std::vector<Needle3d> needles, double max_depth,
                 const Indentation3dOptions& options = {});
   ~Indentation3d();
@@ -111,9 +112,12 @@ struct Simulation3dOptions {
   /// Honoured: order, tip_size_m, growth, domain_scale (block size x and y), tolerance, steps,
   /// elements_through_top.
   FidelityOverrides overrides;
-  /// Mesh only y >= 0 with the mirror plane y = 0 through every needle (InputError when a
-  /// needle is off the plane or not mirror-symmetric); results are for the whole problem.
+  /// Mesh only y >= 0, with the mirror plane y = 0: every needle must be symmetric about its
+  /// own y = 0 plane and a needle at y != 0 needs one of the same mesh at -y (InputError
+  /// otherwise). Results are for the whole scene, one entry per needle as given.
   bool half_model = false;
+  /// The same across x = 0 (with half_model: a quarter model). Not with a crack on x = 0.
+  bool mirror_x = false;
   double stress_average_length_m = 0.0;  ///< tip_stress_Pa averaging length (0 = off)
   /// Depth of the planar crack (normal x) through each needle's axis for G (0 = off); a second,
   /// cracked model runs in lock-step with the intact one.

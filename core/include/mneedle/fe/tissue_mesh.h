@@ -53,9 +53,11 @@ struct TissueBlockSpec {
   /// Each set field replaces the fidelity's choice (domain_scale, tolerance and steps are
   /// applied by simulate_3d, not here).
   FidelityOverrides overrides;
-  /// Mesh only the y >= 0 half (mirror plane y = 0, which must hold every site): the result
-  /// is exactly the y >= 0 half of the full mesh, with mirror_y0 set.
+  /// Mesh only y >= 0 (mirror plane y = 0; the sites and off-axis tips must be symmetric about
+  /// it as a set): the result is exactly the y >= 0 part of the full mesh, with mirror_y0 set.
   bool half_y = false;
+  /// The same for x >= 0 and the plane x = 0 (mirror_x0); with half_y, a quarter model.
+  bool half_x = false;
 };
 
 /// Element sizes chosen for a fidelity and needle radius (m, growth ratios dimensionless).
@@ -85,6 +87,8 @@ struct TetMesh {
   /// The y >= 0 half of a mirror-symmetric block: nodes on y = 0 lie on the symmetry plane
   /// (not in `fixed`; the solver sets u_y = 0 there).
   bool mirror_y0 = false;
+  /// Likewise x >= 0 and the plane x = 0 (u_x = 0 there).
+  bool mirror_x0 = false;
 
   int nodes_per_element() const { return order == 1 ? 4 : 10; }
   const MaterialParameters& material_of(int element) const {
