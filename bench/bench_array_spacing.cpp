@@ -64,7 +64,7 @@ material = { model = "linear", E = "0.2 MPa", nu = 0.49 }
   return parse_scene(text, "bench_array_spacing");
 }
 
-InsertionRun run(int needles, double pitch) {
+InsertionRun run(int needles, double pitch, fe::Fidelity fidelity) {
   const Scene s = scene(needles, pitch);
   std::vector<PreparedNeedle> prepared;
   for (const NeedleSpec& spec : s.needles) {
@@ -73,11 +73,11 @@ InsertionRun run(int needles, double pitch) {
     n.mesh = cylinder(kRadius, 1e-3);
     n.x = spec.at[0];
     n.y = spec.at[1];
-    n.mirror_symmetric_y0 = true;
+    n.mirror_symmetric_y0 = n.mirror_symmetric_x0 = true;  // the arrays run as quarter models
     prepared.push_back(n);
   }
   InsertionRunOptions o;
-  o.fidelity = fe::Fidelity::Fast;
+  o.fidelity = fidelity;
   o.model = PreModel::Full3d;  // the single needle on the same 3-D model as the arrays
   o.steps = 10;
   return run_insertion(s, prepared, o);
@@ -93,10 +93,12 @@ double pre_force(const NeedleRun& n) {
 
 void BM_ArraySpacing(benchmark::State& state) {
   const double gap = static_cast<double>(state.range(0)) * 1e-6;  // edge to edge
+  const auto fidelity = state.range(1) == 0 ? fe::Fidelity::Fast : fe::Fidelity::Standard;
   const double pitch = gap + 2.0 * kRadius;
-  static const InsertionRun single = run(1, 0.0);
+  const InsertionRun single = run(1, 0.0, fidelity);
   InsertionRun array;
-  for (auto _ : state) array = run(4, pitch);
+  for (auto _ : state) array = run(4, pitch, fidelity);
+  state.counters["standard"] = static_cast<double>(state.range(1));
   state.counters["gap_um"] = gap * 1e6;
   state.counters["pitch_um"] = pitch * 1e6;
   double per_needle = 0.0;
@@ -108,14 +110,10 @@ void BM_ArraySpacing(benchmark::State& state) {
   state.counters["single_elements"] = single.elements;
 }
 
+// Gap (um) x fidelity (0 fast, 1 standard).
 BENCHMARK(BM_ArraySpacing)
-    ->Arg(20)
-    ->Arg(50)
-    ->Arg(100)
-    ->Arg(150)
-    ->Arg(250)
-    ->Arg(500)
-    ->Arg(1370)  // paper A: 1600 um centre to centre
+    ->ArgsProduct({{20, 50, 100, 150, 250, 500, 1370},  // 1370: paper A, 1600 um centre to centre
+                   {0, 1}})
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
 
