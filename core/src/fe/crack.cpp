@@ -250,4 +250,11 @@ TetMesh crack_mesh(const TetMesh& mesh, const PlanarCrack& crack, double* area_m
   return cracked;
 }
 
+Eigen::Vector3d crack_origin_under(const TetMesh& mesh, const Eigen::Vector2d& axis_m,
+                                   const Eigen::Vector2d& tip_m) {
+  const bool grid_plane = std::any_of(mesh.nodes.begin(), mesh.nodes.end(),
+                                      [&](const Eigen::Vector3d& p) { return p.x() == tip_m.x(); });
+  return {grid_plane ? tip_m.x() : axis_m.x(), axis_m.y(), 0.0};
+}
+
 }  // namespace mneedle::fe

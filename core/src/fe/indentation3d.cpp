@@ -929,14 +929,15 @@ namespace {
 // Every needle's crack, one after the other on the same mesh; returns the total area (one
 // face, of the meshed part) and each needle's share; `original_node` maps every node of the
 // cracked mesh to its node in `mesh`.
-TetMesh cracked_copy(const TetMesh& mesh, const std::vector<Needle3d>& needles, double depth,
+TetMesh cracked_copy(const TetMesh& mesh, const std::vector<Needle3d>& needles,
+                     const std::vector<Eigen::Vector2d>& tips, double depth,
                      std::vector<double>* areas, std::vector<int>* original_node) {
   TetMesh cracked = mesh;
   original_node->resize(mesh.nodes.size());
   for (std::size_t n = 0; n < mesh.nodes.size(); ++n) (*original_node)[n] = static_cast<int>(n);
-  for (const Needle3d& needle : needles) {
+  for (std::size_t n = 0; n < needles.size(); ++n) {
     PlanarCrack crack;
-    crack.origin_m = Eigen::Vector3d(needle.x, needle.y, 0.0);
+    crack.origin_m = crack_origin_under(mesh, Eigen::Vector2d(needles[n].x, needles[n].y), tips[n]);
     crack.normal = Eigen::Vector3d::UnitX();
     crack.depth_m = depth;
     double area = 0.0;
@@ -975,6 +976,7 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   const MirrorSelection selection =
       select_mirrored_part(all_needles, options.mirror_x, options.half_model);
   const std::vector<Needle3d>& needles = selection.kept;
+  // (A needle symmetric about x = 0 touches first on its axis, so its crack is there too.)
   if (options.mirror_x && options.crack_depth_m > 0.0)
     for (const Needle3d& needle : needles)
       if (needle.x == 0.0)
@@ -1011,7 +1013,8 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   TetMesh cracked;
   std::vector<int> original_node;
   if (options.crack_depth_m > 0.0)
-    cracked = cracked_copy(mesh, needles, options.crack_depth_m, &crack_areas, &original_node);
+    cracked = cracked_copy(mesh, needles, first_contact, options.crack_depth_m, &crack_areas,
+                           &original_node);
   const double meshing = seconds_since(start);
 
   Simulation3dResult result;

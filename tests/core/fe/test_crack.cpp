@@ -245,6 +245,26 @@ TEST(Crack, TissueMeshTopFacesSurviveTheCrack) {
   EXPECT_EQ(opened % 2, 0);
 }
 
+// A bevel's tip gets a grid line of its own, so its crack opens under the tip; a tip that gave
+// its line up (too close to another) falls back to the axis.
+TEST(Crack, OriginIsUnderTheTipWhenTheGridHasItsPlane) {
+  TissueBlockSpec spec;
+  spec.size_x = spec.size_y = 2e-3;
+  spec.layers = {{"block", 1e-3, {MaterialModel::Linear, 1e5, 0.45, 0, 0}}};
+  spec.sites = {{0.0, 0.0, 0.1e-3, Eigen::Vector2d(-0.1e-3, 0.0)}};
+  spec.fidelity = Fidelity::Fast;
+  spec.insertion_depth = 0.2e-3;
+  const TetMesh mesh = generate_tissue_mesh(spec);
+  const Eigen::Vector3d under_tip =
+      crack_origin_under(mesh, Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(-0.1e-3, 0.0));
+  EXPECT_EQ(under_tip, Eigen::Vector3d(-0.1e-3, 0.0, 0.0));
+  double area = 0.0;
+  EXPECT_NO_THROW(crack_mesh(mesh, {under_tip, {1, 0, 0}, 0.15e-3}, &area));
+  const Eigen::Vector3d off_grid =
+      crack_origin_under(mesh, Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(-0.1e-3 + 1e-9, 0.0));
+  EXPECT_EQ(off_grid, Eigen::Vector3d(0.0, 0.0, 0.0));
+}
+
 TEST(Crack, PlaneBetweenGridLinesIsRejected) {
   Block block;
   const TetMesh mesh = block.mesh();

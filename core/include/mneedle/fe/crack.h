@@ -27,4 +27,11 @@ struct PlanarCrack {
 TetMesh crack_mesh(const TetMesh& mesh, const PlanarCrack& crack, double* area_m2,
                    std::vector<int>* original_node = nullptr);
 
+/// Where the energy criterion opens a needle's crack (normal x): under its first contact point
+/// `tip_m` (x, y on the surface; a bevel's tip) when the mesh has the grid plane x = tip x,
+/// otherwise through its axis `axis_m`. A crack through a bevel's axis lies a radius away from
+/// the load and releases almost nothing.
+Eigen::Vector3d crack_origin_under(const TetMesh& mesh, const Eigen::Vector2d& axis_m,
+                                   const Eigen::Vector2d& tip_m);
+
 }  // namespace mneedle::fe
