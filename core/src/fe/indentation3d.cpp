@@ -142,7 +142,7 @@ struct Indentation3d::Impl {
       const Eigen::Vector3d x = mesh.nodes[static_cast<std::size_t>(node)] + displacement_of(node);
       for (std::size_t n = 0; n < needles.size(); ++n) {
         const Eigen::Vector3d local = x - tip(static_cast<int>(n), at_depth);
-        if (local.head<2>().norm() > reach[n] || !shapes[n].contains(local)) continue;
+        if (local.head<2>().norm() > reach[n] || !shapes[n].touches(local)) continue;
         found.push_back({node, static_cast<int>(n), shapes[n].lower_surface_below(local)});
         break;
       }

@@ -59,12 +59,41 @@ bool NeedleShape::contains(const Eigen::Vector3d& point) const {
   return (*impl_->inside)(to_cgal(point)) != CGAL::ON_UNBOUNDED_SIDE;
 }
 
+namespace {
+
+std::optional<Eigen::Vector3d> point_below(const auto& tree, const Eigen::Vector3d& point) {
+  const CgalKernel::Ray_3 down(to_cgal(point), CgalKernel::Direction_3(0, 0, -1));
+  const auto hit = tree.first_intersection(down);
+  if (hit)
+    if (const CgalPoint* p = boost::get<CgalPoint>(&hit->first))
+      return Eigen::Vector3d(p->x(), p->y(), p->z());
+  return std::nullopt;
+}
+
+}  // namespace
+
+namespace {
+
+// The point moved a relative hair toward the needle axis.
+Eigen::Vector3d toward_axis(Eigen::Vector3d point) {
+  point.head<2>() *= 1.0 - 1e-6;
+  return point;
+}
+
+}  // namespace
+
+bool NeedleShape::touches(const Eigen::Vector3d& point) const {
+  return contains(point) || contains(toward_axis(point));
+}
+
 Eigen::Vector3d NeedleShape::lower_surface_below(const Eigen::Vector3d& point) const {
   // The needle travels along -z, so a tissue point it reaches enters through the face below it.
-  const CgalKernel::Ray_3 down(to_cgal(point), CgalKernel::Direction_3(0, 0, -1));
-  const auto hit = impl_->tree->first_intersection(down);
-  if (hit)
-    if (const CgalPoint* p = boost::get<CgalPoint>(&hit->first)) return {p->x(), p->y(), p->z()};
+  if (const auto hit = point_below(*impl_->tree, point)) return *hit;
+  // A point on a vertical face (the grid node on the wall at a bevel's tip) sends the ray along
+  // that face. A hair toward the axis the ray meets the face that swept the point: the tip.
+  // Falling back to the point itself would hold the node where it was touched, a whole depth
+  // step late, with no force.
+  if (const auto hit = point_below(*impl_->tree, toward_axis(point))) return *hit;
   return closest_point(point);
 }
 

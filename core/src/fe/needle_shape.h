@@ -19,6 +19,9 @@ class NeedleShape {
 
   /// Inside or on the needle surface (point in the needle frame).
   bool contains(const Eigen::Vector3d& point) const;
+  /// contains(), or the point a relative 10⁻⁶ of its radius outside the surface: a grid node put
+  /// on the wall at a bevel's tip, where rounding alone would decide the side.
+  bool touches(const Eigen::Vector3d& point) const;
   /// Nearest point of the needle surface (needle frame), found through an AABB tree of the faces.
   Eigen::Vector3d closest_point(const Eigen::Vector3d& point) const;
   /// The same, and the outward unit normal of the face that holds it.

@@ -286,6 +286,23 @@ TEST(Indentation3d, HalfModelOfBevelsOffTheMirrorPlaneMatchesTheFullModel) {
   expect_same_needles(half, full);
 }
 
+// The grid has a line through a bevel's tip, so a node sits on the needle's wall right at the
+// tip. It must be anchored at the tip (the face that swept it), not held where it was touched:
+// held there it carried no force for a whole step.
+TEST(Indentation3d, BevelTipNodeCarriesForceFromTheStepThatCapturesIt) {
+  const auto bevel = bevel_needle(60e-6, std::numbers::pi / 6, 1e-3);
+  Simulation3dOptions options = small_options();
+  options.steps = 3;
+  const Simulation3dResult r = simulate_3d(small_skin(), {{"bevel", bevel, 0.0, 0.0}}, options);
+  ASSERT_GE(r.steps.front().needles[0].captured_nodes, 1);
+  EXPECT_GT(r.steps.front().needles[0].force_N, 0.0);
+  // Linear tissue, contact on the same node: the force grows about linearly from zero.
+  const double f1 = r.steps[0].needles[0].force_N, f2 = r.steps[1].needles[0].force_N;
+  if (r.steps[1].needles[0].captured_nodes == r.steps[0].needles[0].captured_nodes) {
+    EXPECT_NEAR(f2 / f1, 2.0, 0.05);
+  }
+}
+
 TEST(Indentation3d, HalfModelRejectsNeedlesOffTheMirrorPlaneOrAsymmetric) {
   Simulation3dOptions options = small_options();
   options.half_model = true;
