@@ -8,6 +8,7 @@
 
 #include "fe/needle_shape.h"
 #include "mneedle/error.h"
+#include "mneedle/mesh.h"
 
 namespace mneedle::fe {
 
@@ -34,13 +35,8 @@ std::size_t needle_at(const std::vector<Needle3d>& needles, const Needle3d& need
 }
 
 double mesh_size(const TriangleMesh& mesh) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
-  for (const Vec3& v : mesh.vertices) {
-    const Eigen::Vector3d p(v[0], v[1], v[2]);
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  return (hi - lo).norm();
+  const BoundingBox box = bounding_box(mesh);
+  return std::hypot(box.max[0] - box.min[0], box.max[1] - box.min[1], box.max[2] - box.min[2]);
 }
 
 void check_plane(const std::vector<Needle3d>& needles, bool across_x) {
