@@ -985,18 +985,17 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
                          "model without the x mirror)");
   // The grid is the whole scene's, so a reduced model meshes exactly its share of it.
   block.sites.clear();
-  std::vector<Eigen::Vector2d> first_contact;
+  std::vector<Eigen::Vector2d> tips;  // first contact points of the whole scene's needles
   for (const Needle3d& needle : all_needles) {
     const NeedleShape shape(needle.mesh);
     const Eigen::Vector2d axis(needle.x, needle.y);
-    const Eigen::Vector2d tip = axis + shape.first_contact_xy(1e-9);
+    tips.push_back(axis + shape.first_contact_xy(1e-9));
     fe::NeedleSite site{needle.x, needle.y, shape.max_radius_up_to(options.depth), std::nullopt};
-    if ((tip - axis).norm() > 1e-3 * site.radius) site.tip = tip;
+    if ((tips.back() - axis).norm() > 1e-3 * site.radius) site.tip = tips.back();
     block.sites.push_back(site);
-    const bool kept =
-        (!options.mirror_x || needle.x >= 0.0) && (!options.half_model || needle.y >= 0.0);
-    if (kept) first_contact.push_back(tip);
   }
+  std::vector<Eigen::Vector2d> first_contact;  // of the kept needles
+  for (std::size_t i : selection.kept_from) first_contact.push_back(tips[i]);
   block.fidelity = options.fidelity;
   block.order = options.overrides.order.value_or(options.order);
   block.insertion_depth = options.depth;

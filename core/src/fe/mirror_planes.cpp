@@ -71,6 +71,7 @@ MirrorSelection select_mirrored_part(const std::vector<Needle3d>& needles, bool 
     if ((!mirror_x || needles[i].x >= 0.0) && (!mirror_y || needles[i].y >= 0.0)) {
       kept_index[i] = selection.kept.size();
       selection.kept.push_back(needles[i]);
+      selection.kept_from.push_back(i);
     }
   for (const Needle3d& n : needles) {
     const bool flip_x = mirror_x && n.x < 0.0, flip_y = mirror_y && n.y < 0.0;

@@ -11,7 +11,8 @@
 namespace mneedle::fe {
 
 struct MirrorSelection {
-  std::vector<Needle3d> kept;  ///< needles of the modelled part, in the scene's order
+  std::vector<Needle3d> kept;          ///< needles of the modelled part, in the scene's order
+  std::vector<std::size_t> kept_from;  ///< for every kept needle: its index in the scene
   /// For every needle of the scene: index into `kept` of the needle whose results it takes.
   std::vector<std::size_t> source;
   /// For every needle of the scene: +1 or -1 per lateral force component (an image across x = 0

@@ -40,6 +40,7 @@ TEST(MirrorPlanes, HalfOfTheArrayKeepsTheNeedlesOnTheKeptSideInSceneOrder) {
   ASSERT_EQ(s.kept.size(), 2U);
   EXPECT_EQ(s.kept[0].name, "c");
   EXPECT_EQ(s.kept[1].name, "d");
+  EXPECT_EQ(s.kept_from, (std::vector<std::size_t>{2, 3}));
   EXPECT_EQ(s.source, (std::vector<std::size_t>{0, 1, 0, 1}));
 }
 
