@@ -1,19 +1,18 @@
-// Bed-of-nails study (issue #5 §5): force per needle of a 2 x 2 array of paper A's flat-ended
-// 230 um needles pressed 100 um into its silicone (E 0.2 MPa, nu 0.49, linear), against the
-// same needle alone, as the gap between neighbouring needles shrinks. For a flat punch in linear
-// tissue the mean contact pressure is proportional to the force, so the pressure-criterion
-// puncture depth scales with 1 / (force ratio). Olatunji et al. found the spacing to matter only
-// below ~150 um.
-// Figures in docs/performance.md, "Array spacing (bed-of-nails) study". Run:
-// bench_array_spacing [--benchmark_filter=]
+// Bed-of-nails study (docs/performance.md, "Array spacing"): force per needle of a 2 x 2 array of
+// paper A's flat-ended 230 um needles pressed 100 um into its silicone (E 0.2 MPa, nu 0.49,
+// linear), against the same needle alone, as the gap between neighbouring needles shrinks. For a
+// flat punch in linear tissue the mean contact pressure is proportional to the force, so the
+// pressure-criterion puncture depth scales with 1 / (force ratio). Olatunji et al. found the
+// spacing to matter only below ~150 um. Figures in docs/performance.md, "Array spacing
+// (bed-of-nails) study". Run: bench_array_spacing [--benchmark_filter=]
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "mneedle/insertion_run.h"
-#include "mneedle/scene.h"
+#include "mneedle/insertion/insertion_run.h"
+#include "mneedle/scene/scene.h"
 
 namespace {
 

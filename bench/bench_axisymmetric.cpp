@@ -14,6 +14,7 @@
 namespace {
 
 using namespace mneedle::fe;
+using mneedle::MaterialModel;
 
 AxisymmetricProblem skin_problem(MaterialModel model, Fidelity fidelity) {
   auto layer = [model](double thickness, double E) {

@@ -1,8 +1,9 @@
-// Hot paths and limits (issue 7 §3): the closed-form indentation, slicing and classification of
-// needle meshes up to 5 million faces (generated here, written to a temporary binary STL and read
-// back through load + validate, the path of `mneedle inspect`), and the 3-D tissue problem's
-// memory growth with size (for the largest problem that fits in 24 GiB). Peak memory: the
-// process's getrusage maximum resident set, so run one size per process for clean figures:
+// Hot paths and limits (docs/performance.md, "Hot paths"): the closed-form indentation, slicing and
+// classification of needle meshes up to 5 million faces (generated here, written to a temporary
+// binary STL and read back through load + validate, the path of `mneedle inspect`), and the 3-D
+// tissue problem's memory growth with size (for the largest problem that fits in 24 GiB). Peak
+// memory: the process's getrusage maximum resident set, so run one size per process for clean
+// figures:
 //   build/<dir>/bench/bench_extremes --benchmark_filter='LargeStl/5000000'
 // Figures: docs/performance.md, "Hot paths, a 5-million-face STL and the largest 3-D problem".
 #include <benchmark/benchmark.h>
@@ -12,12 +13,12 @@
 #include <filesystem>
 #include <numbers>
 
-#include "mneedle/analytic_indentation.h"
 #include "mneedle/fe/indentation3d.h"
-#include "mneedle/mesh_io.h"
-#include "mneedle/mesh_validation.h"
-#include "mneedle/section_table.h"
-#include "mneedle/surface_groups.h"
+#include "mneedle/geometry/surface_groups.h"
+#include "mneedle/insertion/analytic_indentation.h"
+#include "mneedle/needle/mesh_io.h"
+#include "mneedle/needle/mesh_validation.h"
+#include "mneedle/strength/section_table.h"
 
 namespace {
 
@@ -137,6 +138,7 @@ BENCHMARK(BM_LargeStl)
 // in um (smaller: larger problem).
 void BM_Tissue3dMemory(benchmark::State& state) {
   using namespace mneedle::fe;
+  using mneedle::MaterialModel;
   TissueBlockSpec block;
   block.size_x = block.size_y = 2e-3;
   block.layers = {{"block", 1e-3, {MaterialModel::Linear, 1e5, 0.45, 0.0, 0.0}}};

@@ -12,6 +12,7 @@
 namespace {
 
 using namespace mneedle::fe;
+using mneedle::MaterialModel;
 
 mneedle::TriangleMesh sharp_bevel() {
   try {

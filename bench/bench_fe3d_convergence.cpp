@@ -23,6 +23,7 @@
 namespace {
 
 using namespace mneedle::fe;
+using mneedle::MaterialModel;
 constexpr double kPi = std::numbers::pi;
 constexpr double kDepth = 200e-6;  // needle travel of every study (m)
 

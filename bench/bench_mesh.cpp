@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "mneedle/mesh.h"
+#include "mneedle/needle/mesh.h"
 
 namespace {
 

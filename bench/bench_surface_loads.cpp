@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "../tests/core/needle_shapes.h"
-#include "mneedle/surface_loads.h"
+#include "mneedle/insertion/surface_loads.h"
 
 namespace {
 

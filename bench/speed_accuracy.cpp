@@ -1,7 +1,7 @@
-// Speed against accuracy of the two-stage insertion (issue 7 §1): paper A's three needles in
-// human skin and in the silicone phantom, at each fidelity, on the analytic path, with each
-// reduction of the scene planner switched on and off and with two explicit overrides, every run
-// compared with a reference run of its scene. Writes speed-accuracy.md and speed-accuracy.svg.
+// Speed against accuracy of the two-stage insertion (docs/speed-accuracy.md): paper A's three
+// needles in human skin and in the silicone phantom, at each fidelity, on the analytic path, with
+// each reduction of the scene planner switched on and off and with two explicit overrides, every
+// run compared with a reference run of its scene. Writes speed-accuracy.md and speed-accuracy.svg.
 // Run on demand, never from ctest:
 //   bench_speed_accuracy [--quick] [--out DIR]
 // --quick: human skin only and no fine level (the reference drops to standard, named so).
@@ -22,9 +22,9 @@
 #include <vector>
 
 #include "mneedle/design_source.h"
-#include "mneedle/insertion_run.h"
+#include "mneedle/insertion/insertion_run.h"
 #include "mneedle/plugin_host.h"
-#include "mneedle/scene.h"
+#include "mneedle/scene/scene.h"
 #include "speed_accuracy_report.h"
 
 namespace {

@@ -1,7 +1,8 @@
 #pragma once
-// The pure half of bench/speed_accuracy.cpp (issue 7 §1): relative errors of a run against its
-// scene's reference, the Markdown table and the hand-written log-log SVG of error against time.
-// No solver here, so tests/bench/test_speed_accuracy_report.cpp can check it with made-up runs.
+// The pure half of bench/speed_accuracy.cpp (docs/speed-accuracy.md): relative errors of a run
+// against its scene's reference, the Markdown table and the hand-written log-log SVG of error
+// against time. No solver here, so tests/bench/test_speed_accuracy_report.cpp can check it with
+// made-up runs.
 
 #include <optional>
 #include <string>

@@ -13,12 +13,12 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
-#include "mneedle/error.h"
+#include "mneedle/insertion/surface_loads.h"
 #include "mneedle/plugin_host.h"
-#include "mneedle/scene.h"
-#include "mneedle/surface_loads.h"
-#include "mneedle/units.h"
+#include "mneedle/scene/scene.h"
 
 namespace mneedle::cli {
 namespace {

@@ -11,11 +11,11 @@
 
 #include "commands.h"
 #include "json_output.h"
-#include "mneedle/error.h"
-#include "mneedle/mesh.h"
-#include "mneedle/mesh_io.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
+#include "mneedle/needle/mesh.h"
+#include "mneedle/needle/mesh_io.h"
 #include "mneedle/plugin_host.h"
-#include "mneedle/units.h"
 
 namespace mneedle::cli {
 namespace {

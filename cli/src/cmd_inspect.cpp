@@ -12,12 +12,12 @@
 #include <string>
 
 #include "commands.h"
-#include "mneedle/error.h"
-#include "mneedle/mesh.h"
-#include "mneedle/mesh_io.h"
-#include "mneedle/mesh_validation.h"
-#include "mneedle/needle_frame.h"
-#include "mneedle/units.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
+#include "mneedle/needle/mesh.h"
+#include "mneedle/needle/mesh_io.h"
+#include "mneedle/needle/mesh_validation.h"
+#include "mneedle/needle/needle_frame.h"
 
 #include "json_output.h"
 #include "surface_report_json.h"

@@ -1,6 +1,6 @@
-// mneedle optimize: search a plugin's tip parameters (issue 6 §2). Default objective: the
-// puncture depth of the two-stage model at one fixed mesh setting for the whole run; or the peak
-// force up to the target depth.
+// mneedle optimize: search a plugin's tip parameters (docs/model.md, "Optimisation"). Default
+// objective: the puncture depth of the two-stage model at one fixed mesh setting for the whole run;
+// or the peak force up to the target depth.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -14,13 +14,13 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
 #include "mneedle/design_evaluation.h"
 #include "mneedle/design_source.h"
-#include "mneedle/error.h"
 #include "mneedle/fe/tissue_mesh.h"
-#include "mneedle/mesh_io.h"
+#include "mneedle/needle/mesh_io.h"
 #include "mneedle/tip_optimizer.h"
-#include "mneedle/units.h"
 
 namespace mneedle::cli {
 namespace {

@@ -12,8 +12,8 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "mneedle/base/units.h"
 #include "mneedle/plugin_host.h"
-#include "mneedle/units.h"
 
 namespace mneedle::cli {
 namespace {

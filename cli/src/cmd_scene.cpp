@@ -10,8 +10,8 @@
 
 #include "commands.h"
 #include "json_output.h"
-#include "mneedle/scene.h"
-#include "mneedle/units.h"
+#include "mneedle/base/units.h"
+#include "mneedle/scene/scene.h"
 
 namespace mneedle::cli {
 namespace {

@@ -1,4 +1,4 @@
-// mneedle screen: rank a folder of needle designs on one scene (issue 6 §3).
+// mneedle screen: rank a folder of needle designs on one scene (docs/cli.md).
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -7,9 +7,9 @@
 
 #include "commands.h"
 #include "json_output.h"
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
 #include "mneedle/screening.h"
-#include "mneedle/units.h"
 
 namespace mneedle::cli {
 namespace {

@@ -15,12 +15,12 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "mneedle/base/error.h"
 #include "mneedle/design_source.h"
-#include "mneedle/error.h"
 #include "mneedle/fe/tissue_mesh.h"
-#include "mneedle/insertion_run.h"
+#include "mneedle/insertion/insertion_run.h"
 #include "mneedle/plugin_host.h"
-#include "mneedle/scene.h"
+#include "mneedle/scene/scene.h"
 
 namespace mneedle::cli {
 namespace {

@@ -1,4 +1,5 @@
-// mneedle strength: buckling and material capacity of one needle (issue 6 §1).
+// mneedle strength: buckling and material capacity of one needle (docs/model.md, "Needle
+// strength").
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -7,11 +8,11 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
-#include "mneedle/error.h"
-#include "mneedle/needle_strength.h"
-#include "mneedle/section_table.h"
-#include "mneedle/units.h"
+#include "mneedle/strength/needle_strength.h"
+#include "mneedle/strength/section_table.h"
 
 namespace mneedle::cli {
 namespace {

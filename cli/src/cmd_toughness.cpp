@@ -1,5 +1,5 @@
 // mneedle toughness: fracture toughness J from two insertions into the same spot (paper A eqs.
-// 13-14; issue 5 §3).
+// 13-14).
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -14,11 +14,11 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
-#include "mneedle/error.h"
-#include "mneedle/force_curve.h"
-#include "mneedle/toughness.h"
-#include "mneedle/units.h"
+#include "mneedle/measurement/force_curve.h"
+#include "mneedle/measurement/toughness.h"
 
 namespace mneedle::cli {
 namespace {

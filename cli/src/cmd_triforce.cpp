@@ -1,5 +1,6 @@
 // mneedle fit / predict / stats: paper B's tri-force model fitted to a user's recordings,
-// predictions at other speeds and angles, and ANOVA/Tukey between groups (issue 8).
+// predictions at other speeds and angles, and ANOVA/Tukey between groups (docs/model.md, "Tri-force
+// model").
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -16,14 +17,14 @@
 
 #include "commands.h"
 #include "json_output.h"
-#include "mneedle/anova.h"
-#include "mneedle/curve_metrics.h"
-#include "mneedle/error.h"
-#include "mneedle/force_curve.h"
-#include "mneedle/layer_boundaries.h"
-#include "mneedle/triforce_fit.h"
-#include "mneedle/triforce_model.h"
-#include "mneedle/units.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
+#include "mneedle/measurement/anova.h"
+#include "mneedle/measurement/curve_metrics.h"
+#include "mneedle/measurement/force_curve.h"
+#include "mneedle/measurement/layer_boundaries.h"
+#include "mneedle/measurement/triforce_fit.h"
+#include "mneedle/measurement/triforce_model.h"
 
 namespace mneedle::cli {
 namespace {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <optional>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 namespace mneedle::cli {
 namespace {

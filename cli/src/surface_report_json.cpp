@@ -3,7 +3,7 @@
 #include <string>
 
 #include "json_output.h"
-#include "mneedle/surface_report.h"
+#include "mneedle/geometry/surface_report.h"
 
 namespace mneedle::cli {
 

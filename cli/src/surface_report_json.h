@@ -4,7 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "mneedle/mesh.h"
+#include "mneedle/needle/mesh.h"
 
 namespace mneedle::cli {
 

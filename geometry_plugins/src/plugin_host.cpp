@@ -10,10 +10,10 @@
 #include <sstream>
 #include <system_error>
 
-#include "mneedle/error.h"
-#include "mneedle/mesh_validation.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
+#include "mneedle/needle/mesh_validation.h"
 #include "mneedle/plugin.h"
-#include "mneedle/units.h"
 
 #ifndef MNEEDLE_BUILTIN_PLUGIN_DIR
 #error "MNEEDLE_BUILTIN_PLUGIN_DIR must name the build tree's plugin folder"

@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "mneedle/error.h"
-#include "mneedle/section_table.h"
-#include "mneedle/surface_groups.h"
-#include "mneedle/units.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
+#include "mneedle/geometry/surface_groups.h"
+#include "mneedle/strength/section_table.h"
 
 namespace mneedle {
 namespace {

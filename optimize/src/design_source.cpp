@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "mneedle/error.h"
-#include "mneedle/mesh_io.h"
-#include "mneedle/mesh_validation.h"
-#include "mneedle/needle_frame.h"
-#include "mneedle/units.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
+#include "mneedle/needle/mesh_io.h"
+#include "mneedle/needle/mesh_validation.h"
+#include "mneedle/needle/needle_frame.h"
 
 namespace mneedle {
 namespace {

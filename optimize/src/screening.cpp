@@ -15,9 +15,9 @@
 #include <sstream>
 #include <thread>
 
+#include "mneedle/base/error.h"
 #include "mneedle/blas_threads.h"
 #include "mneedle/design_source.h"
-#include "mneedle/error.h"
 
 namespace mneedle {
 namespace fs = std::filesystem;

@@ -9,7 +9,7 @@
 #include <numeric>
 #include <random>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "mneedle/nlopt_status.h"
 
 namespace mneedle {

@@ -1,5 +1,5 @@
 // Runs the built `mneedle simulate` on small scenes and checks exit status and output: the FE
-// keys of issue #4 and the two-stage keys of issue #5 (stage, puncture, total curve, planner).
+// keys of the pre-puncture model and the two-stage keys (stage, puncture, total curve, planner).
 
 #include <gtest/gtest.h>
 

@@ -15,7 +15,7 @@
 #include <sstream>
 #include <string>
 
-#include "mneedle/triforce_model.h"
+#include "mneedle/measurement/triforce_model.h"
 
 namespace {
 

@@ -8,7 +8,7 @@
 #include <sstream>
 #include <string>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 namespace mneedle::cli {
 namespace {

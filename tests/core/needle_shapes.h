@@ -9,7 +9,7 @@
 #include <numbers>
 #include <vector>
 
-#include "mneedle/mesh.h"
+#include "mneedle/needle/mesh.h"
 
 namespace mneedle::test {
 

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <iostream>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "mneedle/fe/axisymmetric.h"
 
 namespace mneedle::fe {

@@ -10,9 +10,9 @@
 #include <string>
 
 #include "../core/needle_shapes.h"
-#include "mneedle/analytic_indentation.h"
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "mneedle/fe/axisymmetric.h"
+#include "mneedle/insertion/analytic_indentation.h"
 
 namespace mneedle {
 namespace {
@@ -41,7 +41,7 @@ fe::InsertionResult axisymmetric(const fe::AxisymmetricNeedle& needle, double de
                                  fe::ContactMode contact = fe::ContactMode::Frictionless,
                                  fe::Fidelity fidelity = fe::Fidelity::Fast, double nu = 0.3) {
   fe::AxisymmetricProblem p;
-  p.layers = {{block_depth, {fe::MaterialModel::Linear, 1e5, nu, 0.0, 0.0}}};
+  p.layers = {{block_depth, {MaterialModel::Linear, 1e5, nu, 0.0, 0.0}}};
   p.radius_m = radius;
   p.needle = needle;
   p.depth_m = depth;

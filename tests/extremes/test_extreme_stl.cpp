@@ -7,13 +7,13 @@
 #include <numbers>
 #include <string>
 
-#include "mneedle/analytic_indentation.h"
-#include "mneedle/error.h"
-#include "mneedle/mesh_io.h"
-#include "mneedle/mesh_validation.h"
-#include "mneedle/needle_frame.h"
-#include "mneedle/section_table.h"
-#include "mneedle/surface_report.h"
+#include "mneedle/base/error.h"
+#include "mneedle/geometry/surface_report.h"
+#include "mneedle/insertion/analytic_indentation.h"
+#include "mneedle/needle/mesh_io.h"
+#include "mneedle/needle/mesh_validation.h"
+#include "mneedle/needle/needle_frame.h"
+#include "mneedle/strength/section_table.h"
 
 namespace mneedle {
 namespace {

@@ -8,8 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "mneedle/base/error.h"
 #include "mneedle/blas_threads.h"
-#include "mneedle/error.h"
 
 namespace {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <thread>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 namespace {
 

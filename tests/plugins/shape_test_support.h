@@ -6,8 +6,8 @@
 #include <map>
 #include <string>
 
-#include "mneedle/mesh.h"
-#include "mneedle/mesh_validation.h"
+#include "mneedle/needle/mesh.h"
+#include "mneedle/needle/mesh_validation.h"
 #include "mneedle/plugin_host.h"
 
 namespace mneedle::test {

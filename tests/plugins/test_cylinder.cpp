@@ -3,7 +3,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "shape_test_support.h"
 
 namespace mneedle::test {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 namespace mneedle {
 namespace {

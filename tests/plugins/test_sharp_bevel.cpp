@@ -3,8 +3,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "mneedle/cross_section.h"
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
+#include "mneedle/geometry/cross_section.h"
 #include "shape_test_support.h"
 
 namespace mneedle::test {

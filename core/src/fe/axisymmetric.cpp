@@ -10,7 +10,7 @@
 #include <string>
 
 #include "axisymmetric_internal.h"
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 namespace mneedle::fe {
 

@@ -14,7 +14,7 @@
 #include <string>
 
 #include "axisymmetric_internal.h"
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "mneedle/fe/axisymmetric.h"
 
 namespace mneedle::fe {

@@ -5,7 +5,7 @@
 #include <limits>
 #include <string>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "mneedle/fe/axisymmetric.h"
 
 namespace mneedle::fe {

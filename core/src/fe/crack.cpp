@@ -10,7 +10,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 namespace mneedle::fe {
 

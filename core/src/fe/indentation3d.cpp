@@ -14,7 +14,7 @@
 #include "fe/mirror_planes.h"
 #include "fe/needle_shape.h"
 #include "fe/vtu_writer.h"
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "mneedle/fe/crack.h"
 #include "mneedle/fe/solid3d.h"
 #include "mneedle/fe/sparse_solver.h"

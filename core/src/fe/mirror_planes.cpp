@@ -7,8 +7,8 @@
 #include <string>
 
 #include "fe/needle_shape.h"
-#include "mneedle/error.h"
-#include "mneedle/mesh.h"
+#include "mneedle/base/error.h"
+#include "mneedle/needle/mesh.h"
 
 namespace mneedle::fe {
 

@@ -13,8 +13,8 @@
 #include <limits>
 #include <optional>
 
-#include "cgal_mesh.h"
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
+#include "needle/cgal_mesh.h"
 
 namespace mneedle::fe {
 

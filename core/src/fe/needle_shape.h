@@ -4,7 +4,7 @@
 #include <Eigen/Core>
 #include <memory>
 
-#include "mneedle/mesh.h"
+#include "mneedle/needle/mesh.h"
 
 namespace mneedle::fe {
 

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 namespace mneedle::fe {
 

@@ -2,7 +2,7 @@
 
 #include <Eigen/SparseCholesky>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 #ifdef MNEEDLE_HAVE_CHOLMOD
 #include <Eigen/CholmodSupport>

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "mneedle/fe/material.h"
 
 namespace mneedle::fe {

@@ -9,7 +9,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 namespace mneedle::fe {
 

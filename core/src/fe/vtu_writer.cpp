@@ -2,7 +2,7 @@
 
 #include <fstream>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 namespace mneedle::fe {
 

@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-#include "mneedle/mesh.h"
+#include "mneedle/needle/mesh.h"
 
 namespace mneedle {
 

@@ -10,12 +10,12 @@
 
 #include "mneedle/fe/axisymmetric.h"
 #include "mneedle/fe/fidelity.h"
-#include "mneedle/insertion_run.h"
-#include "mneedle/mesh.h"
-#include "mneedle/needle_material.h"
-#include "mneedle/needle_strength.h"
-#include "mneedle/scene.h"
-#include "mneedle/surface_loads.h"
+#include "mneedle/insertion/insertion_run.h"
+#include "mneedle/insertion/surface_loads.h"
+#include "mneedle/needle/mesh.h"
+#include "mneedle/scene/scene.h"
+#include "mneedle/strength/needle_material.h"
+#include "mneedle/strength/needle_strength.h"
 
 namespace mneedle {
 

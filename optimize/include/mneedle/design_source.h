@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "mneedle/fe/axisymmetric.h"
-#include "mneedle/insertion_run.h"
-#include "mneedle/mesh.h"
+#include "mneedle/insertion/insertion_run.h"
+#include "mneedle/needle/mesh.h"
 #include "mneedle/plugin_host.h"
-#include "mneedle/scene.h"
+#include "mneedle/scene/scene.h"
 
 namespace mneedle {
 

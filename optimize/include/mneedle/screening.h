@@ -11,7 +11,7 @@
 
 #include "mneedle/design_evaluation.h"
 #include "mneedle/plugin_host.h"
-#include "mneedle/scene.h"
+#include "mneedle/scene/scene.h"
 
 namespace mneedle {
 

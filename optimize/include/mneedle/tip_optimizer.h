@@ -1,7 +1,7 @@
 #pragma once
-// NLopt searches over named design parameters (issue 6 §2): scaled bounds, an evaluation cache,
-// failed evaluations as penalised points, infeasible problems reported as such, multi-start and
-// MLSL for problems with more than one minimum, evaluation and wall-time budgets.
+// NLopt searches over named design parameters (docs/model.md, "Optimisation"): scaled bounds, an
+// evaluation cache, failed evaluations as penalised points, infeasible problems reported as such,
+// multi-start and MLSL for problems with more than one minimum, evaluation and wall-time budgets.
 
 #include <functional>
 #include <map>

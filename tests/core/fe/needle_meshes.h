@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <numbers>
 
-#include "mneedle/mesh.h"
+#include "mneedle/needle/mesh.h"
 
 namespace mneedle::test {
 

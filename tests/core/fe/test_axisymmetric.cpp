@@ -6,7 +6,7 @@
 #include <iostream>
 #include <string>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 namespace mneedle::fe {
 namespace {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "mneedle/fe/axisymmetric.h"
 
 namespace mneedle::fe {

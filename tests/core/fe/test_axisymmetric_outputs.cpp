@@ -10,7 +10,7 @@
 #include <sstream>
 #include <string>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "mneedle/fe/axisymmetric.h"
 #include "mneedle/fe/indentation3d.h"
 #include "needle_meshes.h"

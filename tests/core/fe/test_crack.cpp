@@ -10,7 +10,7 @@
 #include <set>
 #include <vector>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "mneedle/fe/solid3d.h"
 #include "mneedle/fe/sparse_solver.h"
 #include "mneedle/fe/tissue_mesh.h"
@@ -18,6 +18,7 @@
 namespace {
 
 using namespace mneedle::fe;
+using mneedle::MaterialModel;
 constexpr double kPi = std::numbers::pi;
 
 // Grid coordinates on [-half, half]: spacing h within |x| <= fine, then growing by `growth`.

@@ -7,12 +7,13 @@
 #include <fstream>
 #include <numbers>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "needle_meshes.h"
 
 namespace {
 
 using namespace mneedle::fe;
+using mneedle::MaterialModel;
 using mneedle::test::bevel_needle;
 using mneedle::test::cone_needle;
 using mneedle::test::cylinder_needle;

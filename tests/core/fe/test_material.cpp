@@ -5,7 +5,7 @@
 #include <Eigen/Eigenvalues>
 #include <array>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 namespace mneedle::fe {
 namespace {

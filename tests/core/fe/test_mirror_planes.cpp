@@ -7,7 +7,7 @@
 
 #include <numbers>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "needle_meshes.h"
 
 namespace {

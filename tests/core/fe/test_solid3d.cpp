@@ -5,12 +5,13 @@
 #include <Eigen/Dense>
 #include <cmath>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "mneedle/fe/sparse_solver.h"
 
 namespace {
 
 using namespace mneedle::fe;
+using mneedle::MaterialModel;
 
 std::vector<Eigen::Vector3d> unit_tet() {
   return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 namespace {
 

@@ -5,7 +5,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 #include "mneedle/fe/indentation3d.h"
 #include "mneedle/fe/material.h"
 #include "mneedle/fe/tissue_mesh.h"
@@ -14,6 +14,7 @@
 namespace {
 
 using namespace mneedle::fe;
+using mneedle::MaterialModel;
 
 // 1 x 1 mm block: a 0.2 mm top layer on a 0.8 mm substrate, graded toward the centre.
 TetMesh two_layer_block(int order, double nu, MaterialModel model = MaterialModel::Linear) {

@@ -8,11 +8,12 @@
 #include <cmath>
 #include <set>
 
-#include "mneedle/error.h"
+#include "mneedle/base/error.h"
 
 namespace {
 
 using namespace mneedle::fe;
+using mneedle::MaterialModel;
 
 MaterialParameters linear(double E, double nu) {
   return {MaterialModel::Linear, E, nu, 0.0, 0.0};

@@ -12,7 +12,7 @@
 
 #include "mneedle/fe/fidelity.h"
 #include "mneedle/fe/tissue_mesh.h"
-#include "mneedle/mesh.h"
+#include "mneedle/needle/mesh.h"
 
 namespace mneedle::fe {
 

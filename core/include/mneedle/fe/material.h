@@ -4,9 +4,9 @@
 
 #include <Eigen/Core>
 
-namespace mneedle::fe {
+#include "mneedle/base/material_model.h"
 
-enum class MaterialModel { Linear, StVenantKirchhoff, NeoHookean, MooneyRivlin };
+namespace mneedle::fe {
 
 /// Constants of one tissue layer. E (Pa) and nu set the small-strain response of every model.
 /// Mooney-Rivlin: W = c10 (I1bar - 3) + c01 (I2bar - 3) + kappa/2 (ln J)^2 with

@@ -1,0 +1,116 @@
+#pragma once
+// The full two-stage insertion of paper A (§2.2, §4): the pre-puncture finite element stage until
+// the scene's puncture criterion fires, then the post-puncture distributed-load model for the rest
+// of the depth. A scene planner decides which models run (no FE when only post-puncture forces are
+// asked for, axisymmetric or half models where the geometry allows, FE only up to puncture when
+// only the puncture is asked for) and reports what it decided. SI units throughout.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mneedle/fe/axisymmetric.h"
+#include "mneedle/fe/fidelity.h"
+#include "mneedle/needle/mesh.h"
+#include "mneedle/scene/scene.h"
+
+namespace mneedle {
+
+/// A needle ready to simulate: its validated mesh in the needle frame (tip at the origin, body
+/// along +z, metres) and, when it is a body of revolution, its axisymmetric profile.
+struct PreparedNeedle {
+  std::string name;
+  TriangleMesh mesh;
+  double x = 0.0;  ///< m, tip position on the surface (scene frame)
+  double y = 0.0;
+  std::optional<fe::AxisymmetricNeedle> axisymmetric;  ///< set for cylinder/cone shapes
+  bool mirror_symmetric_y0 = false;  ///< mesh symmetric about its y = 0 plane (bevels)
+  bool mirror_symmetric_x0 = false;  ///< mesh symmetric about its x = 0 plane (cones)
+};
+
+/// Which model computes the pre-puncture stage.
+enum class PreModel { Auto, Analytic, Axisymmetric, Full3d };
+
+struct InsertionRunOptions {
+  fe::Fidelity fidelity = fe::Fidelity::Standard;
+  fe::FidelityOverrides overrides;
+  Contact contact = Contact::Sticking;
+  PunctureCriterion criterion = PunctureCriterion::Pressure;
+  PreModel model = PreModel::Auto;
+  bool allow_reductions = true;  ///< half models, layer merging
+  /// Largest relative force change a measured reduction may cause; empty: from the fidelity
+  /// (fast 5 %, standard 2 %, fine 1 %).
+  std::optional<double> reduction_tolerance;
+  int steps = 0;              ///< output depth steps; 0: from the fidelity
+  std::string vtu_directory;  ///< fields per step when set (or when the scene asks for them)
+};
+
+enum class Stage { Pre, Post };
+
+struct RunPoint {
+  double depth_m = 0.0;
+  double force_N = 0.0;
+  Stage stage = Stage::Pre;
+  // Pre-puncture (FE or analytic) quantities; zero after puncture.
+  double lateral_force_N[2] = {0.0, 0.0};
+  double contact_area_m2 = 0.0;
+  double contact_pressure_Pa = 0.0;
+  double strain_energy_J = 0.0;
+  /// Criterion quantities, computed only for the criterion in use (else 0).
+  double tip_stress_Pa = 0.0;                 ///< stress: averaged max principal stress
+  double energy_release_rate_J_per_m2 = 0.0;  ///< energy: G of the crack under the tip
+  // Post-puncture split (paper A eqs. 18-20, friction); zero before puncture.
+  double alpha_N = 0.0;
+  double beta_N = 0.0;
+  double friction_N = 0.0;
+};
+
+struct Puncture {
+  double depth_m = 0.0;       ///< located between steps (interpolated or bisected)
+  double force_N = 0.0;       ///< pre-puncture force at that depth
+  double post_force_N = 0.0;  ///< post-puncture model's force at that depth
+  PunctureCriterion criterion = PunctureCriterion::Pressure;
+};
+
+struct NeedleRun {
+  std::string name;
+  std::vector<RunPoint> curve;
+  std::optional<Puncture> puncture;  ///< empty: it never punctures within the insertion depth
+  double max_force_N = 0.0;
+};
+
+/// One decision of the planner and, where it was measured, what it changes.
+struct Reduction {
+  std::string name;    ///< "axisymmetric", "half_model", "domain_cut", "layer_merge", ...
+  std::string detail;  ///< human-readable: what was cut and why
+  std::optional<double> measured_effect;  ///< relative change of the force it was checked on
+};
+
+struct InsertionRun {
+  std::vector<NeedleRun> needles;
+  std::vector<RunPoint> total_curve;    ///< sum over the needles (stage of the first needle)
+  std::vector<std::string> models_run;  ///< "analytic", "axisymmetric_fe", "fe_3d", "surface_loads"
+  std::vector<Reduction> reductions;
+  fe::Fidelity fidelity = fe::Fidelity::Standard;
+  /// The criterion evaluated; empty when the scene has no puncture data (pre-puncture stage only)
+  /// or no pre-puncture model ran.
+  std::optional<PunctureCriterion> criterion;
+  std::optional<double> threshold;  ///< the criterion's threshold (Pa or J/m^2)
+  double crack_depth_m = 0.0;       ///< energy criterion: depth of the crack G is computed with
+  // Mesh summary of the FE stage (zeros when none ran).
+  int nodes = 0;
+  int elements = 0;
+  int order = 0;
+  bool axisymmetric = false;
+  double min_dihedral_deg = 0.0;  ///< 3-D mesh quality (0 for the axisymmetric model)
+  double max_aspect_ratio = 0.0;
+  double seconds = 0.0;
+};
+
+/// Runs the scene's insertion for the prepared needles (one per scene needle, same order).
+/// Throws InputError for a scene that cannot be run as asked and SolverError (naming the depth)
+/// when the FE stage fails.
+InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>& needles,
+                           const InsertionRunOptions& options = {});
+
+}  // namespace mneedle

@@ -1,0 +1,42 @@
+#pragma once
+// The needle frame used by everything downstream: tip at the origin, the needle's body along
+// +z, insertion toward -z into tissue whose undeformed surface is the plane z = 0.
+
+#include <optional>
+#include <string>
+
+#include "mneedle/needle/mesh.h"
+
+namespace mneedle {
+
+struct FrameInfo {
+  Vec3 axis{};             ///< unit direction the tip points, in the input coordinates
+  Vec3 tip{};              ///< tip point in the input coordinates (metres)
+  bool auto_axis = false;  ///< axis found by principal-component analysis
+  std::string note;        ///< how the tip was found, e.g. which end `auto` chose
+};
+
+/// How the caller names the tip direction.
+struct AxisChoice {
+  enum class Kind { input_z, given, automatic };
+  Kind kind = Kind::input_z;
+  Vec3 tip_direction{0.0, 0.0, -1.0};  ///< used when kind == given (need not be unit length)
+};
+
+/// Moves `mesh` into the needle frame. Without a direction the input z is the axis and the
+/// tip is at the lowest z; a direction names where the tip points. The tip is the single
+/// extreme vertex along the direction; a flat or hollow tip (several extreme vertices apart)
+/// has no tip point, and the tip is then the point of the centroid's axis line in the lowest
+/// cross-section. The axis passes through the volume centroid (area centroid when the mesh
+/// encloses no volume). Throws mneedle::InputError for an empty mesh or a zero or
+/// non-finite direction.
+FrameInfo place_in_needle_frame(TriangleMesh& mesh, std::optional<Vec3> tip_direction);
+
+/// As above with the automatic choice available: the principal axis of the surface
+/// (area-weighted), with the tip at the end whose cross-section near the end is smaller.
+FrameInfo place_in_needle_frame(TriangleMesh& mesh, const AxisChoice& choice);
+
+/// Finds the frame without moving the mesh.
+FrameInfo find_needle_frame(const TriangleMesh& mesh, const AxisChoice& choice);
+
+}  // namespace mneedle

@@ -1,0 +1,58 @@
+#pragma once
+// PRIVATE to mneedle::core: the scene planner of run_insertion (docs/model.md, "Scene planner").
+// From the scene's outputs, its needles' geometry and the run options it decides which pre-puncture
+// model runs, on which (possibly reduced) domain, and records every decision as a Reduction.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mneedle/fe/tissue_mesh.h"
+#include "mneedle/insertion/insertion_run.h"
+#include "mneedle/insertion/puncture.h"
+
+namespace mneedle::detail {
+
+enum class PreKind { None, Analytic, Axisymmetric, Full3d };
+
+struct RunPlan {
+  PreKind pre = PreKind::Full3d;
+  std::optional<PunctureThreshold> threshold;  ///< none: the scene has no puncture data
+  bool post_stage = true;                      ///< continue after puncture with surface loads
+  bool half_model = false;                     ///< 3-D: mirror plane y = 0
+  bool mirror_x = false;  ///< 3-D: mirror plane x = 0 (with half_model, a quarter model)
+  std::vector<fe::TissueLayer> layers;       ///< after merging deep layers
+  std::vector<fe::TissueLayer> full_layers;  ///< as the scene gives them
+  double block_x_m = 0.0;
+  double block_y_m = 0.0;
+  double full_block_x_m = 0.0;  ///< as the scene gives it (block_x_m after a domain cut)
+  double full_block_y_m = 0.0;
+  double axisymmetric_radius_m = 0.0;
+  double depth_m = 0.0;
+  int steps = 0;
+  double needle_radius_m = 0.0;  ///< largest needle radius reaching the insertion depth
+  std::string vtu_directory;
+  std::vector<Reduction> reductions;
+};
+
+/// Accuracy the reductions must keep, relative force change, per fidelity (fast 5 %, standard
+/// 2 %, fine 1 %): the tests check each reduction against the full model at this level.
+double reduction_tolerance(fe::Fidelity fidelity);
+
+/// Depth below which layers no longer matter (m): kInfluenceDepths times (radius + depth).
+double influence_depth(double needle_radius_m, double insertion_depth_m);
+
+inline constexpr double kInfluenceDepths = 10.0;
+
+/// Half-width of the block kept around the needles (m): kDomainReach times (radius + depth).
+double domain_reach(double needle_radius_m, double insertion_depth_m);
+
+inline constexpr double kDomainReach = 10.0;
+
+/// Scene layers as FE layers; InputError names file:line of a layer with invalid constants.
+std::vector<fe::TissueLayer> fe_layers(const Scene& scene);
+
+RunPlan plan_insertion(const Scene& scene, const std::vector<PreparedNeedle>& needles,
+                       const InsertionRunOptions& options);
+
+}  // namespace mneedle::detail

@@ -1,0 +1,564 @@
+#include "mneedle/insertion/insertion_run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <memory>
+
+#include "insertion/insertion_planner.h"
+#include "mneedle/base/error.h"
+#include "mneedle/fe/indentation3d.h"
+#include "mneedle/fe/tissue_mesh.h"
+#include "mneedle/insertion/analytic_indentation.h"
+#include "mneedle/insertion/puncture.h"
+#include "mneedle/insertion/surface_loads.h"
+
+namespace mneedle {
+namespace {
+
+using detail::PreKind;
+using detail::RunPlan;
+
+// Pre-puncture history of one needle: the curve points and what the criteria read.
+struct PreSeries {
+  std::vector<RunPoint> points;
+  std::vector<CriterionSample> samples;
+  std::function<double(double)> resolve;  ///< criterion at any depth, when cheap (analytic)
+};
+
+struct PreResult {
+  std::vector<PreSeries> needles;
+  int nodes = 0;
+  int elements = 0;
+  int order = 0;
+  bool axisymmetric = false;
+  double min_dihedral_deg = 0.0;
+  double max_aspect_ratio = 0.0;
+  std::string model;
+};
+
+fe::ContactMode to_fe(Contact c) {
+  return c == Contact::Frictionless ? fe::ContactMode::Frictionless : fe::ContactMode::Sticking;
+}
+
+// Tracks the criterion during the FE run so it can stop once every needle has crossed.
+class CrossingWatch {
+ public:
+  CrossingWatch(std::size_t needles, const std::optional<PunctureThreshold>& threshold)
+      : crossed_(needles, false), threshold_(threshold) {}
+  // False once every needle's criterion has reached the threshold.
+  bool keep_going(std::size_t needle, const CriterionSample& s) {
+    if (!threshold_) return true;
+    if (criterion_value(threshold_->criterion, s) >= threshold_->threshold) crossed_[needle] = true;
+    return !std::all_of(crossed_.begin(), crossed_.end(), [](bool c) { return c; });
+  }
+
+ private:
+  std::vector<bool> crossed_;
+  std::optional<PunctureThreshold> threshold_;
+};
+
+// The criterion's view of one needle at one depth: a 3-D NeedleStep3d or an axisymmetric
+// InsertionStep, which carry the same fields.
+template <class NeedleState>
+CriterionSample sample_of(double depth, const NeedleState& n) {
+  CriterionSample s;
+  s.depth_m = depth;
+  s.contact_pressure_Pa = n.contact_pressure_Pa;
+  s.tip_stress_Pa = n.tip_stress_Pa;
+  s.energy_release_rate_J_per_m2 = n.energy_release_rate_J_per_m2;
+  return s;
+}
+
+double tip_size_3d(const RunPlan& plan, const InsertionRunOptions& options) {
+  if (options.overrides.tip_size_m) return *options.overrides.tip_size_m;
+  return fe::mesh_sizing(options.fidelity, options.overrides.order.value_or(2),
+                         plan.needle_radius_m, std::max(plan.block_x_m, plan.block_y_m))
+      .fine_size;
+}
+
+PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles,
+                 const InsertionRunOptions& options, double crack_depth) {
+  fe::TissueBlockSpec block;
+  block.size_x = plan.block_x_m;
+  block.size_y = plan.block_y_m;
+  block.layers = plan.layers;
+  std::vector<fe::Needle3d> fe_needles;
+  for (const PreparedNeedle& n : needles) fe_needles.push_back({n.name, n.mesh, n.x, n.y});
+  fe::Simulation3dOptions o;
+  o.fidelity = options.fidelity;
+  o.order = options.overrides.order.value_or(2);
+  o.depth = plan.depth_m;
+  o.steps = plan.steps;
+  o.vtu_directory = plan.vtu_directory;
+  o.contact = to_fe(options.contact);
+  o.overrides = options.overrides;
+  o.half_model = plan.half_model;
+  o.mirror_x = plan.mirror_x;
+  if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Stress)
+    o.stress_average_length_m = plan.threshold->average_length_m;
+  if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
+    o.crack_depth_m = crack_depth;
+  CrossingWatch watch(needles.size(), plan.threshold);
+  o.on_step = [&](const fe::Step3d& step) {
+    bool more = true;
+    for (std::size_t i = 0; i < step.needles.size(); ++i)
+      more = watch.keep_going(i, sample_of(step.depth_m, step.needles[i])) && more;
+    return more;
+  };
+  const fe::Simulation3dResult r = fe::simulate_3d(block, fe_needles, o);
+  PreResult out;
+  out.needles.resize(needles.size());
+  for (const fe::Step3d& step : r.steps)
+    for (std::size_t i = 0; i < step.needles.size() && i < needles.size(); ++i) {
+      const fe::NeedleStep3d& n = step.needles[i];
+      RunPoint p;
+      p.depth_m = step.depth_m;
+      p.force_N = n.force_N;
+      p.lateral_force_N[0] = n.lateral_force_N[0];
+      p.lateral_force_N[1] = n.lateral_force_N[1];
+      p.contact_area_m2 = n.contact_area_m2;
+      p.contact_pressure_Pa = n.contact_pressure_Pa;
+      p.strain_energy_J = step.strain_energy_J;
+      p.tip_stress_Pa = n.tip_stress_Pa;
+      p.energy_release_rate_J_per_m2 = n.energy_release_rate_J_per_m2;
+      out.needles[i].points.push_back(p);
+      out.needles[i].samples.push_back(sample_of(step.depth_m, n));
+    }
+  out.nodes = r.nodes;
+  out.elements = r.elements;
+  out.order = r.order;
+  out.min_dihedral_deg = r.quality.min_dihedral_deg;
+  out.max_aspect_ratio = r.quality.max_aspect_ratio;
+  out.model = "fe_3d";
+  return out;
+}
+
+Reduction mirror_reduction(const RunPlan& plan) {
+  const bool quarter = plan.half_model && plan.mirror_x;
+  const std::string planes = quarter ? "x = 0 and y = 0" : plan.half_model ? "y = 0" : "x = 0";
+  const std::string part = quarter           ? "x, y >= 0 quarter"
+                           : plan.half_model ? "y >= 0 half"
+                                             : "x >= 0 half";
+  return {quarter ? "quarter_model" : "half_model",
+          "the needles are symmetric about " + planes +
+              " (each needle about its own axis, the array as a whole): the 3-D model solves the " +
+              part +
+              " (results reported for every needle; tested against the full model in "
+              "tests/core/test_insertion_run.cpp)",
+          std::nullopt};
+}
+
+PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
+                           const InsertionRunOptions& options, double crack_depth) {
+  fe::AxisymmetricProblem p;
+  for (const fe::TissueLayer& l : plan.layers) p.layers.push_back({l.thickness, l.material});
+  p.radius_m = plan.axisymmetric_radius_m;
+  p.needle = *needle.axisymmetric;
+  p.depth_m = plan.depth_m;
+  p.fidelity = options.fidelity;
+  p.contact = to_fe(options.contact);
+  p.output_steps = plan.steps;
+  p.overrides = options.overrides;
+  p.vtu_directory = plan.vtu_directory;
+  if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Stress)
+    p.stress_average_length_m = plan.threshold->average_length_m;
+  if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
+    p.crack_depth_m = crack_depth;
+  CrossingWatch watch(1, plan.threshold);
+  p.on_step = [&](const fe::InsertionStep& step) {
+    return watch.keep_going(0, sample_of(step.depth_m, step));
+  };
+  const fe::InsertionResult r = fe::simulate_axisymmetric(p);
+  PreResult out;
+  out.needles.resize(1);
+  for (const fe::InsertionStep& st : r.steps) {
+    RunPoint pt;
+    pt.depth_m = st.depth_m;
+    pt.force_N = st.force_N;
+    pt.contact_area_m2 = st.contact_area_m2;
+    pt.contact_pressure_Pa = st.contact_pressure_Pa;
+    pt.strain_energy_J = st.strain_energy_J;
+    pt.tip_stress_Pa = st.tip_stress_Pa;
+    pt.energy_release_rate_J_per_m2 = st.energy_release_rate_J_per_m2;
+    out.needles[0].points.push_back(pt);
+    out.needles[0].samples.push_back(sample_of(st.depth_m, st));
+  }
+  out.nodes = static_cast<int>(r.nodes);
+  out.elements = static_cast<int>(r.elements);
+  out.order = 2;
+  out.axisymmetric = true;
+  out.model = "axisymmetric_fe";
+  return out;
+}
+
+// Closed-form path: each needle alone on the layered half-space through its equivalent body of
+// revolution (arrays: no interaction between the needles). Pressure is its only criterion.
+PreResult run_analytic(const RunPlan& plan, const Scene& scene,
+                       const std::vector<PreparedNeedle>& needles) {
+  if (plan.threshold && plan.threshold->criterion != PunctureCriterion::Pressure)
+    throw InputError(
+        "simulate: the analytic model gives no stress field or energy release rate; "
+        "the " +
+        std::string(to_string(plan.threshold->criterion)) +
+        " criterion needs --model axisymmetric or 3d");
+  std::vector<double> depths;
+  for (int k = 1; k <= plan.steps; ++k) depths.push_back(plan.depth_m * k / plan.steps);
+  PreResult out;
+  for (const PreparedNeedle& n : needles) {
+    auto profile = std::make_shared<const fe::AxisymmetricNeedle>(
+        n.axisymmetric ? *n.axisymmetric
+                       : equivalent_axisymmetric_needle(n.mesh, 1.05 * plan.depth_m));
+    PreSeries series;
+    CrossingWatch watch(1, plan.threshold);
+    for (const AnalyticStep& st : analytic_indentation(scene.tissue, *profile, depths)) {
+      RunPoint p;
+      p.depth_m = st.depth_m;
+      p.force_N = st.force_N;
+      p.contact_area_m2 = st.contact_area_m2;
+      p.contact_pressure_Pa = st.contact_pressure_Pa;
+      CriterionSample c;
+      c.depth_m = st.depth_m;
+      c.contact_pressure_Pa = st.contact_pressure_Pa;
+      series.points.push_back(p);
+      series.samples.push_back(c);
+      if (!watch.keep_going(0, c)) break;
+    }
+    const Tissue tissue = scene.tissue;
+    series.resolve = [tissue, profile](double depth) {
+      return analytic_indentation(tissue, *profile, {depth}).front().contact_pressure_Pa;
+    };
+    out.needles.push_back(std::move(series));
+  }
+  out.model = "analytic";
+  return out;
+}
+
+// Records a reduction's measured effect (relative force change); above the fidelity's
+// tolerance renames it "<name>_rejected", says what was used instead and returns false.
+bool keep_reduction(Reduction& reduction, double f_reduced, double f_full,
+                    const InsertionRunOptions& options, const std::string& instead) {
+  if (!(f_full > 0.0)) return true;
+  reduction.measured_effect = std::abs(f_reduced - f_full) / f_full;
+  const double tolerance =
+      options.reduction_tolerance.value_or(detail::reduction_tolerance(options.fidelity));
+  if (*reduction.measured_effect <= tolerance) return true;
+  reduction.name += "_rejected";
+  reduction.detail += "; measured effect above the " +
+                      std::to_string(tolerance * 100.0).substr(0, 4) + " % tolerance: " + instead;
+  return false;
+}
+
+// The axisymmetric model is cheap: where layers were merged, run it once more on the scene's own
+// layers and measure the relative change of the force at the last common step. A merge that
+// changes it by more than the fidelity's tolerance is undone (the full-layer run is used).
+void check_layer_merge(const RunPlan& plan, const PreparedNeedle& needle,
+                       const InsertionRunOptions& options, double crack_depth, PreResult& reduced,
+                       std::vector<Reduction>& reductions) {
+  auto merge = std::find_if(reductions.begin(), reductions.end(),
+                            [](const Reduction& r) { return r.name == "layer_merge"; });
+  if (merge == reductions.end() || reduced.needles[0].points.empty()) return;
+  RunPlan full = plan;
+  full.layers = plan.full_layers;
+  full.threshold.reset();  // same depth steps, no early stop: compare at the reduced run's end
+  full.vtu_directory.clear();
+  full.depth_m = reduced.needles[0].points.back().depth_m;
+  full.steps = static_cast<int>(reduced.needles[0].points.size());
+  const PreResult reference = run_axisymmetric(full, needle, options, 0.0);
+  if (keep_reduction(*merge, reduced.needles[0].points.back().force_N,
+                     reference.needles[0].points.back().force_N, options,
+                     "the scene's own layers were used"))
+    return;
+  RunPlan unmerged = plan;
+  unmerged.layers = plan.full_layers;
+  reduced = run_axisymmetric(unmerged, needle, options, crack_depth);
+}
+
+// The domain cut's truncation error, measured with the axisymmetric model (the needle itself, or
+// for the 3-D model the first needle's body of revolution): the force at the reduced run's last
+// step on the cut and on the full domain. Above the fidelity's tolerance the cut is undone and
+// the pre-puncture model runs again on the full block.
+void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
+                      const InsertionRunOptions& options, double crack_depth, PreResult& reduced,
+                      std::vector<Reduction>& reductions) {
+  auto cut = std::find_if(reductions.begin(), reductions.end(),
+                          [](const Reduction& r) { return r.name == "domain_cut"; });
+  if (cut == reductions.end() || reduced.needles[0].points.empty()) return;
+  PreparedNeedle proxy = needles[0];
+  if (!proxy.axisymmetric)
+    proxy.axisymmetric = equivalent_axisymmetric_needle(proxy.mesh, 1.05 * plan.depth_m);
+  auto reference_on = [&](double size_x, double size_y) {
+    RunPlan probe = plan;
+    probe.axisymmetric_radius_m = fe::equal_area_radius(std::sqrt(size_x * size_y));
+    probe.threshold.reset();  // same depth steps, no early stop
+    probe.vtu_directory.clear();
+    probe.depth_m = reduced.needles[0].points.back().depth_m;
+    probe.steps = static_cast<int>(reduced.needles[0].points.size());
+    return run_axisymmetric(probe, proxy, options, 0.0).needles[0].points.back().force_N;
+  };
+  const double f_full = reference_on(plan.full_block_x_m, plan.full_block_y_m);
+  const double f_cut = plan.pre == PreKind::Axisymmetric
+                           ? reduced.needles[0].points.back().force_N
+                           : reference_on(plan.block_x_m, plan.block_y_m);
+  if (keep_reduction(*cut, f_cut, f_full, options, "the full block was used")) return;
+  plan.block_x_m = plan.full_block_x_m;
+  plan.block_y_m = plan.full_block_y_m;
+  plan.axisymmetric_radius_m = fe::equal_area_radius(std::sqrt(plan.block_x_m * plan.block_y_m));
+  reduced = plan.pre == PreKind::Axisymmetric
+                ? run_axisymmetric(plan, needles[0], options, crack_depth)
+                : run_3d(plan, needles, options, crack_depth);
+}
+
+double axisymmetric_tip_size(const RunPlan& plan, const PreparedNeedle& needle,
+                             const InsertionRunOptions& options) {
+  if (options.overrides.tip_size_m) return *options.overrides.tip_size_m;
+  fe::AxisymmetricProblem p;
+  for (const fe::TissueLayer& l : plan.layers) p.layers.push_back({l.thickness, l.material});
+  p.radius_m = plan.axisymmetric_radius_m;
+  p.needle = *needle.axisymmetric;
+  p.depth_m = plan.depth_m;
+  p.fidelity = options.fidelity;
+  return fe::mesh_options_for(p).h_m;
+}
+
+std::vector<double> post_depths(const RunPlan& plan) {
+  const int n = std::max(plan.steps, 20);
+  std::vector<double> d;
+  for (int k = 1; k <= n; ++k) d.push_back(plan.depth_m * k / n);
+  return d;
+}
+
+RunPoint post_point(const SurfaceLoadModel& model, double depth) {
+  const LoadSample s = model.at(depth);
+  RunPoint p;
+  p.depth_m = depth;
+  p.stage = Stage::Post;
+  p.force_N = s.force_N;
+  p.alpha_N = s.alpha_N;
+  p.beta_N = s.beta_N;
+  p.friction_N = s.friction_N;
+  return p;
+}
+
+// Pre-puncture point at a depth between two steps (0 before the first): each quantity linear.
+RunPoint interpolated_point(const std::vector<RunPoint>& points, double depth) {
+  RunPoint before;
+  for (const RunPoint& p : points) {
+    if (p.depth_m >= depth) {
+      const double span = p.depth_m - before.depth_m;
+      const double t = span > 0.0 ? (depth - before.depth_m) / span : 1.0;
+      auto mix = [t](double a, double b) { return a + t * (b - a); };
+      RunPoint r;
+      r.depth_m = depth;
+      r.force_N = mix(before.force_N, p.force_N);
+      r.lateral_force_N[0] = mix(before.lateral_force_N[0], p.lateral_force_N[0]);
+      r.lateral_force_N[1] = mix(before.lateral_force_N[1], p.lateral_force_N[1]);
+      r.contact_area_m2 = mix(before.contact_area_m2, p.contact_area_m2);
+      r.contact_pressure_Pa = r.contact_area_m2 > 0.0 ? r.force_N / r.contact_area_m2 : 0.0;
+      r.strain_energy_J = mix(before.strain_energy_J, p.strain_energy_J);
+      r.tip_stress_Pa = mix(before.tip_stress_Pa, p.tip_stress_Pa);
+      r.energy_release_rate_J_per_m2 =
+          mix(before.energy_release_rate_J_per_m2, p.energy_release_rate_J_per_m2);
+      return r;
+    }
+    before = p;
+  }
+  return points.empty() ? RunPoint{} : points.back();
+}
+
+NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const RunPlan& plan,
+                          const SurfaceLoadModel* post) {
+  NeedleRun run;
+  run.name = name;
+  std::optional<Crossing> crossing;
+  if (plan.threshold) {
+    std::vector<double> depths, values;
+    for (const CriterionSample& s : pre.samples) {
+      depths.push_back(s.depth_m);
+      values.push_back(criterion_value(plan.threshold->criterion, s));
+    }
+    // Bisection where the criterion is cheap to re-evaluate: the depth is then exact to 1e-4
+    // of a step rather than linear between the steps.
+    const double tolerance = plan.depth_m / std::max(plan.steps, 1) * 1e-4;
+    crossing = first_crossing(depths, values, plan.threshold->threshold, pre.resolve, tolerance);
+  }
+  if (!crossing) {
+    run.curve = pre.points;
+  } else {
+    for (const RunPoint& p : pre.points)
+      if (p.depth_m < crossing->depth_m) run.curve.push_back(p);
+    const RunPoint at = interpolated_point(pre.points, crossing->depth_m);
+    run.curve.push_back(at);
+    Puncture puncture;
+    puncture.depth_m = crossing->depth_m;
+    puncture.force_N = at.force_N;
+    puncture.criterion = plan.threshold->criterion;
+    if (post != nullptr) {
+      puncture.post_force_N = post->at(crossing->depth_m).force_N;
+      if (plan.post_stage) {
+        run.curve.push_back(post_point(*post, crossing->depth_m));
+        for (double d : post_depths(plan))
+          if (d > crossing->depth_m) run.curve.push_back(post_point(*post, d));
+      }
+    }
+    run.puncture = puncture;
+  }
+  for (const RunPoint& p : run.curve) run.max_force_N = std::max(run.max_force_N, p.force_N);
+  return run;
+}
+
+NeedleRun post_only_needle(const std::string& name, const RunPlan& plan,
+                           const SurfaceLoadModel& post) {
+  NeedleRun run;
+  run.name = name;
+  for (double d : post_depths(plan)) run.curve.push_back(post_point(post, d));
+  for (const RunPoint& p : run.curve) run.max_force_N = std::max(run.max_force_N, p.force_N);
+  return run;
+}
+
+// Value of a needle's curve at `depth`: at a depth listed twice (the puncture) the first or the
+// second point; between points linear; past its last point (a curve that stops at puncture) its
+// last point.
+RunPoint curve_at(const std::vector<RunPoint>& curve, double depth, bool after) {
+  RunPoint before;
+  for (std::size_t i = 0; i < curve.size(); ++i) {
+    const RunPoint& p = curve[i];
+    if (p.depth_m == depth) {
+      if (after && i + 1 < curve.size() && curve[i + 1].depth_m == depth) return curve[i + 1];
+      return p;
+    }
+    if (p.depth_m > depth) {
+      const double span = p.depth_m - before.depth_m;
+      const double t = span > 0.0 ? (depth - before.depth_m) / span : 1.0;
+      RunPoint r = p;
+      r.depth_m = depth;
+      auto mix = [t](double a, double b) { return a + t * (b - a); };
+      r.force_N = mix(before.force_N, p.force_N);
+      r.lateral_force_N[0] = mix(before.lateral_force_N[0], p.lateral_force_N[0]);
+      r.lateral_force_N[1] = mix(before.lateral_force_N[1], p.lateral_force_N[1]);
+      r.contact_area_m2 = mix(before.contact_area_m2, p.contact_area_m2);
+      r.strain_energy_J = mix(before.strain_energy_J, p.strain_energy_J);
+      r.alpha_N = mix(before.alpha_N, p.alpha_N);
+      r.beta_N = mix(before.beta_N, p.beta_N);
+      r.friction_N = mix(before.friction_N, p.friction_N);
+      return r;
+    }
+    before = p;
+  }
+  return curve.empty() ? RunPoint{} : curve.back();
+}
+
+std::vector<RunPoint> total_curve(const std::vector<NeedleRun>& needles) {
+  std::vector<double> depths;
+  for (const NeedleRun& n : needles)
+    for (const RunPoint& p : n.curve) depths.push_back(p.depth_m);
+  std::sort(depths.begin(), depths.end());
+  depths.erase(std::unique(depths.begin(), depths.end()), depths.end());
+  std::vector<RunPoint> total;
+  for (double d : depths) {
+    bool split = false;  // some needle punctures exactly here: a point before and after
+    for (const NeedleRun& n : needles) split = split || (n.puncture && n.puncture->depth_m == d);
+    for (int side = 0; side < (split ? 2 : 1); ++side) {
+      RunPoint sum;
+      sum.depth_m = d;
+      for (std::size_t i = 0; i < needles.size(); ++i) {
+        const RunPoint p = curve_at(needles[i].curve, d, side == 1);
+        if (i == 0) sum.stage = p.stage;
+        sum.force_N += p.force_N;
+        sum.lateral_force_N[0] += p.lateral_force_N[0];
+        sum.lateral_force_N[1] += p.lateral_force_N[1];
+        sum.contact_area_m2 += p.contact_area_m2;
+        sum.alpha_N += p.alpha_N;
+        sum.beta_N += p.beta_N;
+        sum.friction_N += p.friction_N;
+        if (i == 0) sum.strain_energy_J = p.strain_energy_J;  // one tissue: the system's energy
+      }
+      sum.contact_pressure_Pa = sum.contact_area_m2 > 0.0 ? sum.force_N / sum.contact_area_m2 : 0.0;
+      total.push_back(sum);
+    }
+  }
+  return total;
+}
+
+void check_needles(const Scene& scene, const std::vector<PreparedNeedle>& needles) {
+  if (needles.size() != scene.needles.size())
+    throw InputError(scene.source_name + ": needles: " + std::to_string(scene.needles.size()) +
+                     " in the scene but " + std::to_string(needles.size()) + " prepared");
+  if (!(scene.insertion.depth > 0.0))
+    throw InputError(scene.source_name + ": insertion.depth: must be positive");
+}
+
+}  // namespace
+
+InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>& needles,
+                           const InsertionRunOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  check_needles(scene, needles);
+  RunPlan plan = detail::plan_insertion(scene, needles, options);
+  InsertionRun run;
+  run.fidelity = options.fidelity;
+  run.reductions = plan.reductions;
+  if (plan.threshold) {
+    run.criterion = plan.threshold->criterion;
+    run.threshold = plan.threshold->threshold;
+  }
+  if (!plan.vtu_directory.empty()) std::filesystem::create_directories(plan.vtu_directory);
+
+  std::vector<std::optional<SurfaceLoadModel>> post(needles.size());
+  const LoadConstants constants = load_constants(scene);
+  const bool need_post = plan.pre == PreKind::None || plan.threshold.has_value();
+  if (need_post)
+    for (std::size_t i = 0; i < needles.size(); ++i) post[i].emplace(needles[i].mesh, constants);
+
+  if (plan.pre == PreKind::None) {
+    for (std::size_t i = 0; i < needles.size(); ++i)
+      run.needles.push_back(post_only_needle(needles[i].name, plan, *post[i]));
+    run.models_run.push_back("surface_loads");
+  } else {
+    PreResult pre;
+    switch (plan.pre) {
+      case PreKind::Full3d:
+        if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
+          run.crack_depth_m = crack_depth_for(plan.needle_radius_m, tip_size_3d(plan, options));
+        pre = run_3d(plan, needles, options, run.crack_depth_m);
+        check_domain_cut(plan, needles, options, run.crack_depth_m, pre, run.reductions);
+        if (plan.half_model || plan.mirror_x) run.reductions.push_back(mirror_reduction(plan));
+        break;
+      case PreKind::Axisymmetric:
+        if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
+          run.crack_depth_m = crack_depth_for(plan.needle_radius_m,
+                                              axisymmetric_tip_size(plan, needles[0], options));
+        pre = run_axisymmetric(plan, needles[0], options, run.crack_depth_m);
+        check_layer_merge(plan, needles[0], options, run.crack_depth_m, pre, run.reductions);
+        check_domain_cut(plan, needles, options, run.crack_depth_m, pre, run.reductions);
+        break;
+      case PreKind::Analytic:
+        pre = run_analytic(plan, scene, needles);
+        break;
+      case PreKind::None:
+        break;
+    }
+    run.models_run.push_back(pre.model);
+    run.nodes = pre.nodes;
+    run.elements = pre.elements;
+    run.order = pre.order;
+    run.axisymmetric = pre.axisymmetric;
+    run.min_dihedral_deg = pre.min_dihedral_deg;
+    run.max_aspect_ratio = pre.max_aspect_ratio;
+    bool any_post = false;
+    for (std::size_t i = 0; i < needles.size(); ++i) {
+      run.needles.push_back(
+          assemble_needle(needles[i].name, pre.needles[i], plan, post[i] ? &*post[i] : nullptr));
+      any_post = any_post || run.needles.back().puncture.has_value();
+    }
+    if (any_post) run.models_run.push_back("surface_loads");
+  }
+  run.total_curve = total_curve(run.needles);
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+}  // namespace mneedle

@@ -1,0 +1,149 @@
+#include "mneedle/insertion/puncture.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mneedle/base/error.h"
+
+namespace mneedle {
+namespace {
+
+std::string layer_where(const Scene& scene, std::size_t index) {
+  const TissueLayer& layer = scene.tissue.layers[index];
+  return scene.source_name + ":" + std::to_string(layer.line) + ": tissue.layers[" +
+         std::to_string(index) + "] '" + layer.name + "'";
+}
+
+[[noreturn]] void missing(const Scene& scene, const std::string& key, PunctureCriterion c) {
+  throw InputError(layer_where(scene, 0) + ": " + key + ": missing (the " +
+                   std::string(to_string(c)) + " criterion needs it)");
+}
+
+void check_sequence(const std::vector<double>& depths, const std::vector<double>& values,
+                    double threshold) {
+  if (depths.size() != values.size())
+    throw InputError("puncture: " + std::to_string(depths.size()) + " depths but " +
+                     std::to_string(values.size()) + " criterion values");
+  if (!(threshold > 0.0) || !std::isfinite(threshold))
+    throw InputError("puncture: the criterion threshold must be positive and finite");
+  for (std::size_t i = 0; i < depths.size(); ++i) {
+    if (!std::isfinite(depths[i]) || !std::isfinite(values[i]))
+      throw InputError("puncture: step " + std::to_string(i) + " is not finite");
+    if (depths[i] < 0.0 || (i > 0 && !(depths[i] > depths[i - 1])))
+      throw InputError("puncture: depths must be ascending and non-negative (step " +
+                       std::to_string(i) + ")");
+  }
+}
+
+// Bisection on [lo, hi], value(lo) < threshold <= value(hi): the criterion need not be linear
+// between the steps, so the located depth is as exact as the tolerance asks.
+double bisect(const std::function<double(double)>& resolve, double lo, double hi, double threshold,
+              double tolerance) {
+  const double tol = tolerance > 0.0 ? tolerance : 1e-6 * (hi - lo);
+  for (int i = 0; i < 200 && hi - lo > tol; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    const double v = resolve(mid);
+    if (!std::isfinite(v)) throw SolverError("puncture: the criterion is not finite at depth");
+    (v >= threshold ? hi : lo) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+bool has_puncture_data(const Scene& scene) {
+  if (scene.tissue.layers.empty()) return false;
+  const TissueLayer& top = scene.tissue.layers.front();
+  return top.fracture.has_value() || top.strength.has_value();
+}
+
+PunctureThreshold puncture_threshold(const Scene& scene, PunctureCriterion criterion) {
+  if (scene.tissue.layers.empty())
+    throw InputError(scene.source_name + ": tissue.layers: no layer to puncture");
+  const TissueLayer& top = scene.tissue.layers.front();
+  const std::string fracture_key =
+      top.fracture_is_own || !scene.tissue.fracture ? "fracture" : "tissue.fracture";
+  PunctureThreshold t;
+  t.criterion = criterion;
+  t.layer = 0;
+  switch (criterion) {
+    case PunctureCriterion::Pressure:
+      if (!top.fracture || !(top.fracture->critical_pressure > 0.0))
+        missing(scene, fracture_key + ".critical_pressure", criterion);
+      t.threshold = top.fracture->critical_pressure;
+      break;
+    case PunctureCriterion::Energy:
+      if (!top.fracture || !(top.fracture->toughness > 0.0))
+        missing(scene, fracture_key + ".toughness", criterion);
+      t.threshold = top.fracture->toughness;
+      break;
+    case PunctureCriterion::Stress:
+      if (!top.strength) missing(scene, "strength", criterion);
+      t.threshold = top.strength->strength;
+      t.average_length_m = top.strength->length;
+      break;
+  }
+  return t;
+}
+
+double criterion_value(PunctureCriterion criterion, const CriterionSample& sample) {
+  switch (criterion) {
+    case PunctureCriterion::Pressure:
+      return sample.contact_pressure_Pa;
+    case PunctureCriterion::Energy:
+      return sample.energy_release_rate_J_per_m2;
+    case PunctureCriterion::Stress:
+      return sample.tip_stress_Pa;
+  }
+  return 0.0;
+}
+
+std::optional<Crossing> first_crossing(const std::vector<double>& depths_m,
+                                       const std::vector<double>& values, double threshold,
+                                       const std::function<double(double)>& resolve,
+                                       double depth_tolerance_m) {
+  check_sequence(depths_m, values, threshold);
+  double previous_depth = 0.0;
+  double previous_value = 0.0;
+  for (std::size_t i = 0; i < depths_m.size(); ++i) {
+    if (values[i] >= threshold) {
+      Crossing c;
+      c.step = i;
+      if (resolve) {
+        c.depth_m = bisect(resolve, previous_depth, depths_m[i], threshold, depth_tolerance_m);
+      } else {
+        // previous_value < threshold <= values[i], so the denominator is positive.
+        const double f = (threshold - previous_value) / (values[i] - previous_value);
+        c.depth_m = previous_depth + f * (depths_m[i] - previous_depth);
+      }
+      const double span = depths_m[i] - previous_depth;
+      c.fraction = span > 0.0 ? std::clamp((c.depth_m - previous_depth) / span, 0.0, 1.0) : 1.0;
+      return c;
+    }
+    previous_depth = depths_m[i];
+    previous_value = values[i];
+  }
+  return std::nullopt;
+}
+
+double interpolate_at(const std::vector<double>& depths_m, const std::vector<double>& values,
+                      double depth_m) {
+  if (depths_m.empty()) return 0.0;
+  double d0 = 0.0, v0 = 0.0;
+  for (std::size_t i = 0; i < depths_m.size(); ++i) {
+    if (depth_m <= depths_m[i]) {
+      const double span = depths_m[i] - d0;
+      if (span <= 0.0) return values[i];
+      return v0 + (values[i] - v0) * (depth_m - d0) / span;
+    }
+    d0 = depths_m[i];
+    v0 = values[i];
+  }
+  return values.back();
+}
+
+double crack_depth_for(double needle_radius_m, double tip_element_size_m) {
+  return std::max(needle_radius_m, 2.0 * tip_element_size_m);
+}
+
+}  // namespace mneedle

@@ -1,0 +1,254 @@
+#include "mneedle/needle/needle_frame.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+#include "mneedle/base/error.h"
+
+namespace mneedle {
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+Vector3d to_eigen(const Vec3& p) {
+  return {p[0], p[1], p[2]};
+}
+Vec3 to_vec3(const Vector3d& p) {
+  return {p.x(), p.y(), p.z()};
+}
+
+// Relative tolerance on lengths: far below any feature a needle mesh resolves, far above
+// the rounding of coordinates read as floats.
+constexpr double kRelativeTolerance = 1e-6;
+// Where `auto` probes each end's cross-section, as a fraction of the length from the end.
+constexpr double kProbeFraction = 0.05;
+// Ends whose probed widths differ by less than this fraction count as alike.
+constexpr double kAlikeFraction = 0.02;
+
+double size_of(const TriangleMesh& mesh) {
+  const BoundingBox box = bounding_box(mesh);
+  return (to_eigen(box.max) - to_eigen(box.min)).norm();
+}
+
+// Area centroid of the surface; the fallback for meshes that enclose no volume.
+Vector3d area_centroid(const TriangleMesh& mesh) {
+  Vector3d weighted = Vector3d::Zero();
+  double area = 0.0;
+  for (const Triangle& t : mesh.triangles) {
+    const Vector3d a = to_eigen(mesh.vertices[t[0]]);
+    const Vector3d b = to_eigen(mesh.vertices[t[1]]);
+    const Vector3d c = to_eigen(mesh.vertices[t[2]]);
+    const double dA = 0.5 * (b - a).cross(c - a).norm();
+    weighted += dA * (a + b + c) / 3.0;
+    area += dA;
+  }
+  return area > 0.0 ? Vector3d(weighted / area) : to_eigen(mesh.vertices.front());
+}
+
+Vector3d centroid(const TriangleMesh& mesh) {
+  // Tetrahedra from a point near the mesh keep the sums well conditioned far from the origin.
+  const Vector3d origin = area_centroid(mesh);
+  Vector3d weighted = Vector3d::Zero();
+  double six_volume = 0.0;
+  for (const Triangle& t : mesh.triangles) {
+    const Vector3d a = to_eigen(mesh.vertices[t[0]]) - origin;
+    const Vector3d b = to_eigen(mesh.vertices[t[1]]) - origin;
+    const Vector3d c = to_eigen(mesh.vertices[t[2]]) - origin;
+    const double dv = a.dot(b.cross(c));
+    weighted += dv * (a + b + c) / 4.0;
+    six_volume += dv;
+  }
+  const double scale = size_of(mesh);
+  if (std::abs(six_volume) <= kRelativeTolerance * scale * scale * scale) return origin;
+  return origin + weighted / six_volume;
+}
+
+// Second moment of the surface about `center`: the integral of (x-c)(x-c)^T over each
+// triangle is A/12 (sum of v v^T over the corners + 9 m m^T), m the triangle's centroid.
+Matrix3d surface_second_moment(const TriangleMesh& mesh, const Vector3d& center) {
+  Matrix3d moment = Matrix3d::Zero();
+  for (const Triangle& t : mesh.triangles) {
+    const Vector3d a = to_eigen(mesh.vertices[t[0]]) - center;
+    const Vector3d b = to_eigen(mesh.vertices[t[1]]) - center;
+    const Vector3d c = to_eigen(mesh.vertices[t[2]]) - center;
+    const double area = 0.5 * (b - a).cross(c - a).norm();
+    const Vector3d m = (a + b + c) / 3.0;
+    moment += area / 12.0 *
+              (a * a.transpose() + b * b.transpose() + c * c.transpose() + 9.0 * m * m.transpose());
+  }
+  return moment;
+}
+
+// Points where the plane (x - center).axis = level cuts the surface.
+std::vector<Vector3d> cross_section_points(const TriangleMesh& mesh, const Vector3d& center,
+                                           const Vector3d& axis, double level) {
+  std::vector<Vector3d> points;
+  for (const Triangle& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const Vector3d p = to_eigen(mesh.vertices[t[k]]);
+      const Vector3d q = to_eigen(mesh.vertices[t[(k + 1) % 3]]);
+      const double hp = (p - center).dot(axis) - level;
+      const double hq = (q - center).dot(axis) - level;
+      if (hp == 0.0) points.push_back(p);
+      if ((hp < 0.0 && hq > 0.0) || (hp > 0.0 && hq < 0.0)) {
+        points.push_back(p + (q - p) * (hp / (hp - hq)));
+      }
+    }
+  }
+  return points;
+}
+
+// Width of a cross-section: the diagonal of its bounding rectangle in the section plane.
+double section_width(const std::vector<Vector3d>& points, const Vector3d& u, const Vector3d& w) {
+  if (points.empty()) return 0.0;
+  double u_min = std::numeric_limits<double>::infinity(), u_max = -u_min;
+  double w_min = u_min, w_max = -u_min;
+  for (const Vector3d& p : points) {
+    u_min = std::min(u_min, p.dot(u));
+    u_max = std::max(u_max, p.dot(u));
+    w_min = std::min(w_min, p.dot(w));
+    w_max = std::max(w_max, p.dot(w));
+  }
+  return std::hypot(u_max - u_min, w_max - w_min);
+}
+
+std::pair<double, double> extent_along(const TriangleMesh& mesh, const Vector3d& center,
+                                       const Vector3d& axis) {
+  double low = std::numeric_limits<double>::infinity(), high = -low;
+  for (const Vec3& p : mesh.vertices) {
+    const double h = (to_eigen(p) - center).dot(axis);
+    low = std::min(low, h);
+    high = std::max(high, h);
+  }
+  return {low, high};
+}
+
+std::string format_vector(const Vector3d& v) {
+  std::ostringstream out;
+  out.precision(4);
+  out << "(" << v.x() + 0.0 << ", " << v.y() + 0.0 << ", " << v.z() + 0.0 << ")";  // no "-0"
+  return out.str();
+}
+
+// The principal axis, signed so that it points toward the narrower end.
+Vector3d automatic_tip_direction(const TriangleMesh& mesh, const Vector3d& center,
+                                 std::string& note) {
+  const Eigen::SelfAdjointEigenSolver<Matrix3d> solver(surface_second_moment(mesh, center));
+  Vector3d axis = solver.eigenvectors().col(2);  // eigenvalues ascend: the longest direction
+  Eigen::Index largest = 0;
+  axis.cwiseAbs().maxCoeff(&largest);
+  if (axis[largest] < 0.0) axis = -axis;  // a reproducible sign for the tie-break below
+  const Vector3d u = solver.eigenvectors().col(0);
+  const Vector3d w = solver.eigenvectors().col(1);
+  const auto [low, high] = extent_along(mesh, center, axis);
+  const double probe = kProbeFraction * (high - low);
+  const double low_width =
+      section_width(cross_section_points(mesh, center, axis, low + probe), u, w);
+  const double high_width =
+      section_width(cross_section_points(mesh, center, axis, high - probe), u, w);
+  std::ostringstream out;
+  out.precision(4);
+  out << "auto axis: principal axis " << format_vector(axis) << "; cross-section widths "
+      << kProbeFraction * 100 << "% from each end: " << low_width << " m (low end) and "
+      << high_width << " m (high end); ";
+  if (std::abs(low_width - high_width) <= kAlikeFraction * std::max(low_width, high_width)) {
+    out << "the ends look alike: chose the low end as the tip";
+    note = out.str();
+    return -axis;
+  }
+  const bool low_is_tip = low_width < high_width;
+  out << "chose the " << (low_is_tip ? "low" : "high") << " end (narrower) as the tip";
+  note = out.str();
+  return low_is_tip ? Vector3d(-axis) : axis;
+}
+
+Vector3d normalized_direction(const Vec3& direction) {
+  const Vector3d d = to_eigen(direction);
+  const double length = d.norm();
+  if (!std::isfinite(length) || length == 0.0) {
+    throw InputError("axis: the tip direction must be a non-zero, finite vector (got " +
+                     format_vector(d) + ")");
+  }
+  return d / length;
+}
+
+// The extreme vertex along the tip direction, or for a flat or hollow tip the point of the
+// centroid's axis line at the level of the lowest cross-section.
+Vector3d find_tip(const TriangleMesh& mesh, const Vector3d& center, const Vector3d& direction,
+                  std::string& note) {
+  const auto [low, high] = extent_along(mesh, center, direction);
+  const double level_tolerance = kRelativeTolerance * std::max(high - low, size_of(mesh));
+  std::vector<Vector3d> extreme;
+  for (const Vec3& p : mesh.vertices) {
+    if ((to_eigen(p) - center).dot(direction) >= high - level_tolerance) {
+      extreme.push_back(to_eigen(p));
+    }
+  }
+  Vector3d mean = Vector3d::Zero();
+  for (const Vector3d& p : extreme) mean += p;
+  mean /= static_cast<double>(extreme.size());
+  double spread = 0.0;
+  for (const Vector3d& p : extreme) spread = std::max(spread, (p - mean).norm());
+  if (spread <= level_tolerance) {
+    note += (note.empty() ? "" : "; ") + std::string("tip at the extreme vertex");
+    return mean;
+  }
+  note += (note.empty() ? "" : "; ") +
+          std::string("flat or hollow tip: tip on the centroid axis in the lowest cross-section");
+  return center + high * direction;
+}
+
+}  // namespace
+
+FrameInfo find_needle_frame(const TriangleMesh& mesh, const AxisChoice& choice) {
+  if (mesh.triangles.empty() || mesh.vertices.empty()) {
+    throw InputError("needle frame: the mesh is empty");
+  }
+  FrameInfo info;
+  const Vector3d center = centroid(mesh);
+  Vector3d direction(0.0, 0.0, -1.0);
+  switch (choice.kind) {
+    case AxisChoice::Kind::input_z:
+      info.note = "axis: input z, tip at the lowest z";
+      break;
+    case AxisChoice::Kind::given:
+      direction = normalized_direction(choice.tip_direction);
+      info.note = "axis: given tip direction " + format_vector(direction);
+      break;
+    case AxisChoice::Kind::automatic:
+      direction = automatic_tip_direction(mesh, center, info.note);
+      info.auto_axis = true;
+      break;
+  }
+  info.axis = to_vec3(direction);
+  info.tip = to_vec3(find_tip(mesh, center, direction, info.note));
+  return info;
+}
+
+FrameInfo place_in_needle_frame(TriangleMesh& mesh, const AxisChoice& choice) {
+  const FrameInfo info = find_needle_frame(mesh, choice);
+  // The smallest rotation taking the tip direction onto -z keeps the input's roll about
+  // the axis (a bevel facing +x still faces +x).
+  const Matrix3d rotation =
+      Eigen::Quaterniond::FromTwoVectors(to_eigen(info.axis), Vector3d(0.0, 0.0, -1.0))
+          .toRotationMatrix();
+  const Vector3d tip = to_eigen(info.tip);
+  for (Vec3& p : mesh.vertices) p = to_vec3(rotation * (to_eigen(p) - tip));
+  return info;
+}
+
+FrameInfo place_in_needle_frame(TriangleMesh& mesh, std::optional<Vec3> tip_direction) {
+  AxisChoice choice;
+  if (tip_direction) {
+    choice.kind = AxisChoice::Kind::given;
+    choice.tip_direction = *tip_direction;
+  }
+  return place_in_needle_frame(mesh, choice);
+}
+
+}  // namespace mneedle

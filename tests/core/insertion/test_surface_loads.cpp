@@ -1,0 +1,189 @@
+#include "mneedle/insertion/surface_loads.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "mneedle/base/error.h"
+#include "needle_shapes.h"
+
+namespace {
+
+using mneedle::LoadConstants;
+using mneedle::SurfaceLoadModel;
+using mneedle::test::ShapeOptions;
+constexpr double kPi = std::numbers::pi;
+constexpr double kR = 115e-6;
+constexpr double kK = 0.26e6;  // Pa, about silicone's E / (1 - nu^2)
+constexpr double kS = 0.168;
+
+LoadConstants fixed_k() {
+  LoadConstants c;
+  c.stiffness_Pa = kK;
+  return c;
+}
+
+double polygon_area(int n, double r) {
+  return 0.5 * n * r * r * std::sin(2.0 * kPi / n);
+}
+
+double triangle_area(const std::array<mneedle::Vec3, 3>& t) {
+  const mneedle::Vec3 a{t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]};
+  const mneedle::Vec3 b{t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]};
+  const double x = a[1] * b[2] - a[2] * b[1];
+  const double y = a[2] * b[0] - a[0] * b[2];
+  const double z = a[0] * b[1] - a[1] * b[0];
+  return 0.5 * std::sqrt(x * x + y * y + z * z);
+}
+
+// For each of paper A's cases (0, 1 or 2 vertices on the tip) the pentahedron's volume must be
+// the area times the mean vertex load, whatever the triangle and which vertices are unloaded.
+TEST(SurfaceLoads, PentahedronVolumeIsAreaTimesMeanLoadInAllThreeCases) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> coord(-1e-4, 1e-4);
+  std::uniform_real_distribution<double> load(1e3, 5e4);
+  for (int unloaded = 0; unloaded <= 2; ++unloaded) {
+    for (int trial = 0; trial < 50; ++trial) {
+      std::array<mneedle::Vec3, 3> t;
+      for (auto& p : t) p = {coord(rng), coord(rng), coord(rng)};
+      std::array<double, 3> f{load(rng), load(rng), load(rng)};
+      for (int k = 0; k < unloaded; ++k) f[(trial + k) % 3] = 0.0;
+      const double expected = triangle_area(t) * (f[0] + f[1] + f[2]) / 3.0;
+      EXPECT_NEAR(mneedle::pentahedron_load(t, f), expected, 1e-10 * expected)
+          << "case with " << unloaded << " unloaded vertices, trial " << trial;
+    }
+  }
+}
+
+TEST(SurfaceLoads, FlatCylinderCarriesKSTimesItsEndPlusCoulombFriction) {
+  const ShapeOptions o;
+  const SurfaceLoadModel model(mneedle::test::cylinder(o), fixed_k());
+  const double depth = 300e-6;
+  const auto s = model.at(depth);
+  EXPECT_NEAR(s.alpha_N, kK * kS * polygon_area(o.segments, kR), 1e-12);
+  EXPECT_DOUBLE_EQ(s.beta_N, 0.0);
+  const double perimeter = o.segments * 2.0 * kR * std::sin(kPi / o.segments);
+  EXPECT_NEAR(s.friction_N, 0.2 * kK * kS * perimeter * depth, 1e-12);
+  EXPECT_DOUBLE_EQ(s.force_N, s.alpha_N + s.beta_N + s.friction_N);
+}
+
+TEST(SurfaceLoads, BoreWallsCarryNoFriction) {
+  ShapeOptions hollow;
+  hollow.bore = 45e-6;
+  const double depth = 400e-6;
+  const double solid =
+      SurfaceLoadModel(mneedle::test::cylinder({}), fixed_k()).at(depth).friction_N;
+  const auto s = SurfaceLoadModel(mneedle::test::cylinder(hollow), fixed_k()).at(depth);
+  EXPECT_NEAR(s.friction_N, solid, 1e-12 * solid);
+  const double annulus = polygon_area(64, kR) - polygon_area(64, 45e-6);
+  EXPECT_NEAR(s.alpha_N, kK * kS * annulus, 1e-12);
+}
+
+TEST(SurfaceLoads, SubmergedConeCarriesTwoThirdsOfAFlat) {
+  ShapeOptions o;
+  o.segments = 128;
+  const double half = kPi / 12.0;
+  LoadConstants c = fixed_k();
+  c.friction = mneedle::ShaftFriction::none;
+  const SurfaceLoadModel model(mneedle::test::cone(o, half, 16), c);
+  const double expected = 2.0 / 3.0 * kK * kS * kPi * kR * kR;
+  const auto s = model.at(kR / std::tan(half) + 10e-6);
+  EXPECT_NEAR(s.beta_N, expected, 0.01 * expected);
+  EXPECT_DOUBLE_EQ(s.friction_N, 0.0);
+}
+
+TEST(SurfaceLoads, SubmergedSharpBevelCarriesAsMuchAsAFlat) {
+  LoadConstants c = fixed_k();
+  c.friction = mneedle::ShaftFriction::none;
+  const double bevel = kPi / 6.0;
+  const SurfaceLoadModel model(mneedle::test::sharp_bevel({}, bevel), c);
+  const double expected = kK * kS * kPi * kR * kR;
+  EXPECT_NEAR(model.at(2.0 * kR / std::tan(bevel) + 1e-6).beta_N, expected, 0.01 * expected);
+}
+
+TEST(SurfaceLoads, ForceIsContinuousAcrossVertexHeights) {
+  const double half = kPi / 12.0;
+  const SurfaceLoadModel model(mneedle::test::cone({}, half, 4), fixed_k());
+  const double cone_height = kR / std::tan(half);
+  for (int k = 1; k <= 4; ++k) {
+    const double h = cone_height * k / 4.0;
+    const double below = model.at(h - 1e-12).force_N;
+    const double above = model.at(h + 1e-12).force_N;
+    EXPECT_NEAR(below, above, 1e-6 * above) << "ring " << k;
+  }
+}
+
+TEST(SurfaceLoads, ForceIsInvariantUnderRigidMotion) {
+  const auto needle = mneedle::test::blunt_bevel({}, 25.0 * kPi / 180.0, 40e-6);
+  const mneedle::Vec3 axis{0.0, 0.6, 0.8};
+  const double angle = 2.3;
+  const auto moved = mneedle::test::moved(needle, axis, angle, {-1e-3, 4e-3, 2e-3});
+  const auto d = mneedle::test::rigid_motion({0, 0, -1}, axis, angle, {0, 0, 0});
+  const SurfaceLoadModel a(needle, fixed_k());
+  const SurfaceLoadModel b(moved, fixed_k(), d);
+  for (double depth : {20e-6, 150e-6, 600e-6}) {
+    const auto sa = a.at(depth);
+    const auto sb = b.at(depth);
+    EXPECT_NEAR(sa.alpha_N, sb.alpha_N, 1e-9 * sa.force_N);
+    EXPECT_NEAR(sa.beta_N, sb.beta_N, 1e-9 * sa.force_N);
+    EXPECT_NEAR(sa.friction_N, sb.friction_N, 1e-9 * sa.force_N);
+  }
+}
+
+TEST(SurfaceLoads, TenTimesFinerTessellationChangesForceByLessThanOnePercent) {
+  const double bevel = kPi / 6.0;
+  ShapeOptions fine;
+  fine.segments = 640;
+  fine.rings = 80;
+  const SurfaceLoadModel coarse_model(mneedle::test::sharp_bevel({}, bevel), fixed_k());
+  const SurfaceLoadModel fine_model(mneedle::test::sharp_bevel(fine, bevel), fixed_k());
+  for (double depth : {30e-6, 120e-6, 250e-6, 700e-6}) {
+    const double coarse = coarse_model.at(depth).force_N;
+    const double refined = fine_model.at(depth).force_N;
+    EXPECT_NEAR(coarse, refined, 0.01 * refined) << "depth " << depth;
+  }
+}
+
+TEST(SurfaceLoads, EachLayerLoadsWithItsOwnStiffness) {
+  LoadConstants c;
+  c.friction = mneedle::ShaftFriction::none;
+  c.layers = {{100e-6, 1e6, 0.0}, {0.0, 0.2e6, 0.4}};
+  const SurfaceLoadModel model(mneedle::test::cylinder({}), c);
+  const double end = polygon_area(64, kR);
+  EXPECT_NEAR(model.at(50e-6).alpha_N, 1e6 * kS * end, 1e-12);
+  EXPECT_NEAR(model.at(150e-6).alpha_N, 0.2e6 / (1 - 0.16) * kS * end, 1e-12);
+}
+
+TEST(SurfaceLoads, LinearGrowthFrictionSaturatesAtItsDepth) {
+  LoadConstants c = fixed_k();
+  c.friction = mneedle::ShaftFriction::linear_growth;
+  c.friction_max_force_N = 0.05;
+  c.friction_saturation_depth_m = 500e-6;
+  const SurfaceLoadModel model(mneedle::test::cylinder({}), c);
+  EXPECT_NEAR(model.at(250e-6).friction_N, 0.025, 1e-15);
+  EXPECT_NEAR(model.at(900e-6).friction_N, 0.05, 1e-15);
+}
+
+TEST(SurfaceLoads, AboveTheSurfaceThereIsNoLoad) {
+  const auto s = mneedle::surface_load(mneedle::test::cylinder({}), fixed_k(), -10e-6);
+  EXPECT_DOUBLE_EQ(s.force_N, 0.0);
+}
+
+TEST(SurfaceLoads, MissingStiffnessAndLayersIsAnInputError) {
+  EXPECT_THROW(SurfaceLoadModel(mneedle::test::cylinder({}), LoadConstants{}), mneedle::InputError);
+}
+
+TEST(SurfaceLoads, LinearGrowthWithoutItsConstantsIsAnInputError) {
+  LoadConstants c = fixed_k();
+  c.friction = mneedle::ShaftFriction::linear_growth;
+  EXPECT_THROW(SurfaceLoadModel(mneedle::test::cylinder({}), c), mneedle::InputError);
+}
+
+TEST(SurfaceLoads, NanDepthIsAnInputError) {
+  const SurfaceLoadModel model(mneedle::test::cylinder({}), fixed_k());
+  EXPECT_THROW(model.at(std::nan("")), mneedle::InputError);
+}
+
+}  // namespace

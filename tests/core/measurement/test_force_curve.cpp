@@ -1,0 +1,123 @@
+#include "mneedle/measurement/force_curve.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "mneedle/base/error.h"
+
+namespace {
+
+const std::string kCurves = std::string(MNEEDLE_TEST_ASSETS) + "/curves/";
+const std::filesystem::path kRefdata =
+    std::filesystem::path(MNEEDLE_SOURCE_ROOT) / ".." / "shared" / "refdata";
+
+std::string error_of(const std::string& file, const mneedle::CurveColumns& columns = {}) {
+  try {
+    const auto curve = mneedle::read_force_curve_csv(kCurves + file, columns);
+    mneedle::extract_loading_branch(curve);
+  } catch (const mneedle::InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(ForceCurve, ReadsColumnsAndConvertsUnitsFromTheirSuffix) {
+  const auto c = mneedle::read_force_curve_csv(kCurves + "loading_hold_retraction.csv");
+  ASSERT_EQ(c.depth_m.size(), c.force_N.size());
+  ASSERT_EQ(c.time_s.size(), c.force_N.size());
+  EXPECT_NEAR(c.depth_m[1], 0.1e-3, 1e-12);  // travel_mm
+  EXPECT_NEAR(c.time_s[1], 0.1, 1e-12);
+  EXPECT_EQ(c.line.front(), 2u);
+}
+
+TEST(ForceCurve, ExplicitUnitOverridesTheSuffix) {
+  const mneedle::CurveColumns columns{"", "fz_N", "", "", "mN"};
+  const auto c = mneedle::read_force_curve_csv(kCurves + "loading_hold_retraction.csv", columns);
+  const auto plain = mneedle::read_force_curve_csv(kCurves + "loading_hold_retraction.csv");
+  EXPECT_NEAR(c.force_N[40], plain.force_N[40] * 1e-3, 1e-15);
+}
+
+TEST(ForceCurve, MissingColumnNamesFileAndHeaderLine) {
+  const auto msg = error_of("missing_column.csv");
+  EXPECT_NE(msg.find("missing_column.csv:1"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("no force column"), std::string::npos) << msg;
+}
+
+TEST(ForceCurve, AskedColumnThatIsAbsentIsNamed) {
+  const mneedle::CurveColumns columns{"depth_mm", "", "", "", ""};
+  const auto msg = error_of("loading_hold_retraction.csv", columns);
+  EXPECT_NE(msg.find(":1: no column 'depth_mm'"), std::string::npos) << msg;
+}
+
+TEST(ForceCurve, TextInANumberNamesFileLineAndColumn) {
+  const auto msg = error_of("text_in_number.csv");
+  EXPECT_NE(msg.find("text_in_number.csv:4"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("'abc' is not a number"), std::string::npos) << msg;
+}
+
+TEST(ForceCurve, FlatRecordingHasNoLoadingBranch) {
+  const auto msg = error_of("no_loading_branch.csv");
+  EXPECT_NE(msg.find("no_loading_branch.csv:10"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("no loading branch"), std::string::npos) << msg;
+}
+
+TEST(ForceCurve, LoadingBranchStartsAtContactAndCutsHoldAndRetraction) {
+  const auto raw = mneedle::read_force_curve_csv(kCurves + "loading_hold_retraction.csv");
+  const auto b = mneedle::extract_loading_branch(raw);
+  EXPECT_NEAR(b.baseline_N, -0.010, 1e-3);
+  EXPECT_GT(b.contact_travel_m, 1.75e-3);
+  EXPECT_LT(b.contact_travel_m, 2.05e-3);
+  EXPECT_NEAR(b.curve.depth_m.back() + b.contact_travel_m, 6.0e-3, 0.11e-3);
+  EXPECT_NEAR(static_cast<double>(b.hold_samples), 9.5, 0.6);
+  EXPECT_NEAR(static_cast<double>(b.retraction_samples), 60.0, 1.0);
+  EXPECT_NEAR(b.curve.depth_m.front(), 0.0, 1e-15);
+  // Force is baseline-corrected: 0.5 (x - 2)^2 N at 4 mm travel.
+  const auto it = std::find_if(b.curve.depth_m.begin(), b.curve.depth_m.end(),
+                               [&](double d) { return d + b.contact_travel_m > 3.99e-3; });
+  const auto i = static_cast<std::size_t>(it - b.curve.depth_m.begin());
+  EXPECT_NEAR(b.curve.force_N[i], 2.0, 0.01);
+  EXPECT_NE(b.summary.find(" in the hold"), std::string::npos) << b.summary;
+}
+
+TEST(ForceCurve, HoldSegmentStartsAtTheEndOfLoading) {
+  const auto raw = mneedle::read_force_curve_csv(kCurves + "loading_hold_retraction.csv");
+  const auto b = mneedle::extract_loading_branch(raw);
+  const auto hold = mneedle::hold_segment(raw, b);
+  ASSERT_GE(hold.time_s.size(), 10u);
+  EXPECT_NEAR(hold.time_s.front(), 0.0, 1e-12);
+  EXPECT_NEAR(hold.force_N.back(), 8.0 - 0.9, 0.02);
+  EXPECT_NEAR(hold.time_s.back() - hold.time_s[hold.time_s.size() - 2], 0.1, 1e-9);
+}
+
+TEST(ForceCurve, LoadingSpeedIsTheSlopeOfTravelOverTime) {
+  const auto raw = mneedle::read_force_curve_csv(kCurves + "loading_hold_retraction.csv");
+  EXPECT_NEAR(mneedle::loading_speed(mneedle::extract_loading_branch(raw)), 1e-3, 1e-6);
+}
+
+TEST(ForceCurve, RealPhantomRecordingContactsAFewMillimetresIn) {
+  const auto file =
+      kRefdata / "phantom_insertions" / "skin-on-muscle_1_0_3_2_2024-06-19-11-43-49.csv";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "refdata absent: " << file;
+  const auto b = mneedle::extract_loading_branch(mneedle::read_force_curve_csv(file));
+  EXPECT_GT(b.contact_travel_m, 1.0e-3);
+  EXPECT_LT(b.contact_travel_m, 4.0e-3);
+  EXPECT_GT(b.hold_samples, 400u);  // 5 s at about 100 Hz
+  EXPECT_GT(b.retraction_samples, 1000u);
+  EXPECT_NEAR(mneedle::loading_speed(b), 1e-3, 0.05e-3);
+}
+
+TEST(ForceCurve, DigitisedLiverCurveWithoutTimeColumnIsReadable) {
+  const auto file = kRefdata / "okamura_liver" / "depth_force_curveA_mm.csv";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "refdata absent: " << file;
+  const auto raw = mneedle::read_force_curve_csv(file);
+  EXPECT_TRUE(raw.time_s.empty());
+  const auto b = mneedle::extract_loading_branch(raw);
+  // Flat (digitised noise) to 5.35 mm, next point 9.46 mm at 0.025 N: contact lies in between.
+  EXPECT_GT(b.contact_travel_m, 4e-3);
+  EXPECT_LT(b.contact_travel_m, 9.5e-3);
+  EXPECT_GT(*std::max_element(b.curve.force_N.begin(), b.curve.force_N.end()), 2.0);
+}
+
+}  // namespace

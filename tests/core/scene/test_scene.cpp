@@ -1,0 +1,565 @@
+#include "mneedle/scene/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <numbers>
+#include <string>
+#include <string_view>
+#include <variant>
+
+#include "mneedle/base/error.h"
+
+namespace {
+
+using mneedle::InputError;
+using mneedle::Scene;
+
+const std::filesystem::path kAssets = std::filesystem::path(MNEEDLE_TEST_ASSETS) / "scenes";
+const std::filesystem::path kDesigns =
+    std::filesystem::path(MNEEDLE_SOURCE_ROOT) / "designs" / "scenes";
+
+// Line numbers matter: the error tests below name them.
+constexpr std::string_view kBase = R"([tissue]
+size = ["3000 um", "3000 um", "1150 um"]
+boundary = "fixed"
+
+[[tissue.layers]]
+name = "stratum_corneum"
+thickness = "20 um"
+material = { model = "linear", E = "1 GPa", nu = 0.4 }
+
+[[tissue.layers]]
+name = "dermis"
+thickness = "1130 um"
+material = { model = "linear", E = "0.08 MPa", nu = 0.4 }
+
+[tissue.fracture]
+toughness = "0.019 N/mm"
+critical_pressure = "0.663 MPa"
+
+[[needles]]
+geometry = { plugin = "sharp_bevel", diameter = "230 um", length = "1000 um", bevel_angle = "30 deg" }
+at = ["0 um", "0 um"]
+material = "silicon"
+
+[insertion]
+depth = "800 um"
+speed = "1 mm/s"
+angle = "90 deg"
+
+[model]
+fidelity = "standard"
+outputs = ["puncture", "force_curve"]
+)";
+
+// kBase with one exact piece of text replaced (the piece must occur once).
+std::string with(std::string_view from, std::string_view to,
+                 std::string text = std::string(kBase)) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "fixture text not found: " << from;
+  EXPECT_EQ(text.find(from, at + 1), std::string::npos) << "fixture text not unique: " << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+Scene parse(const std::string& toml) {
+  return mneedle::parse_scene(toml, "test.toml");
+}
+
+// Parses `toml`, expects an InputError and checks that its message holds every piece.
+void expect_error(const std::string& toml, std::initializer_list<std::string_view> pieces) {
+  try {
+    parse(toml);
+    ADD_FAILURE() << "expected an InputError for:\n" << toml;
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    for (const auto piece : pieces) {
+      EXPECT_NE(msg.find(piece), std::string::npos) << "'" << piece << "' missing in: " << msg;
+    }
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << "message is not one line: " << msg;
+  }
+}
+
+// ---- valid scenes ---------------------------------------------------------------------------
+
+TEST(Scene, BaseSceneParsesIntoSi) {
+  const Scene s = parse(std::string(kBase));
+  EXPECT_EQ(s.source_name, "test.toml");
+  EXPECT_DOUBLE_EQ(s.tissue.size[0], 3e-3);
+  EXPECT_DOUBLE_EQ(s.tissue.depth(), 1.15e-3);
+  ASSERT_EQ(s.tissue.layers.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[0].material.youngs_modulus, 1e9);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[1].top, 20e-6);
+  ASSERT_TRUE(s.tissue.layers[1].fracture);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[1].fracture->toughness, 19.0);
+  EXPECT_FALSE(s.tissue.layers[1].fracture_is_own);
+  ASSERT_EQ(s.needles.size(), 1u);
+  EXPECT_EQ(s.needles[0].name, "sharp_bevel");
+  const auto& geometry = std::get<mneedle::PluginGeometry>(s.needles[0].geometry);
+  EXPECT_EQ(geometry.plugin, "sharp_bevel");
+  EXPECT_DOUBLE_EQ(geometry.parameters.at("diameter").value_si, 230e-6);
+  EXPECT_EQ(geometry.parameters.at("bevel_angle").dimension, mneedle::Dimension::Angle);
+  EXPECT_DOUBLE_EQ(s.insertion.depth, 800e-6);
+  EXPECT_DOUBLE_EQ(s.insertion.speed, 1e-3);
+  EXPECT_DOUBLE_EQ(s.insertion.angle, std::numbers::pi / 2.0);
+}
+
+TEST(Scene, OptionalTablesTakeTheirDefaults) {
+  const Scene s =
+      parse(with("[model]\nfidelity = \"standard\"\noutputs = [\"puncture\", "
+                 "\"force_curve\"]\n",
+                 ""));
+  EXPECT_EQ(s.model.fidelity, mneedle::Fidelity::Standard);
+  EXPECT_TRUE(s.model.wants(mneedle::Output::Puncture));
+  EXPECT_TRUE(s.model.wants(mneedle::Output::ForceCurve));
+  EXPECT_FALSE(s.model.wants(mneedle::Output::Fields));
+  EXPECT_EQ(s.model.criterion, mneedle::PunctureCriterion::Pressure);
+  EXPECT_EQ(s.model.contact, mneedle::Contact::Sticking);
+  EXPECT_DOUBLE_EQ(s.loads.scale, 0.168);
+  EXPECT_FALSE(s.loads.stiffness);
+  EXPECT_EQ(s.loads.friction, mneedle::FrictionLaw::Coulomb);
+  EXPECT_DOUBLE_EQ(s.loads.friction_coefficient, 0.2);
+  EXPECT_FALSE(s.requirements.target_depth);
+  EXPECT_DOUBLE_EQ(s.requirements.safety_factor, 1.5);
+  EXPECT_TRUE(s.materials.empty());
+}
+
+TEST(Scene, PlainNumbersAreSi) {
+  const Scene s =
+      parse(with(R"(size = ["3000 um", "3000 um", "1150 um"])", "size = [0.003, 0.003, 1.15e-3]"));
+  EXPECT_DOUBLE_EQ(s.tissue.size[2], 1.15e-3);
+}
+
+TEST(Scene, LastLayerWithoutThicknessFillsTheBlock) {
+  const Scene s = parse(with("thickness = \"1130 um\"\n", ""));
+  EXPECT_NEAR(s.tissue.layers[1].thickness, 1.13e-3, 1e-15);
+  EXPECT_NEAR(s.tissue.layers[1].top + s.tissue.layers[1].thickness, 1.15e-3, 1e-15);
+}
+
+TEST(Scene, LayerFractureOverridesTheTissueDefault) {
+  const Scene s = parse(with("name = \"dermis\"\n",
+                             "name = \"dermis\"\nfracture = { toughness = \"100 J/m^2\", "
+                             "critical_pressure = \"2 MPa\" }\n"));
+  EXPECT_DOUBLE_EQ(s.tissue.layers[0].fracture->toughness, 19.0);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[1].fracture->toughness, 100.0);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[1].fracture->critical_pressure, 2e6);
+  EXPECT_TRUE(s.tissue.layers[1].fracture_is_own);
+}
+
+TEST(Scene, WithoutAnyFractureDataLayersHaveNone) {
+  const Scene s = parse(with(
+      "[tissue.fracture]\ntoughness = \"0.019 N/mm\"\ncritical_pressure = \"0.663 MPa\"\n", ""));
+  EXPECT_FALSE(s.tissue.layers[0].fracture);
+  EXPECT_FALSE(s.tissue.fracture);
+}
+
+TEST(Scene, LayerIndexAtDepthPutsInterfacesInTheDeeperLayer) {
+  const Scene s = parse(std::string(kBase));
+  EXPECT_EQ(mneedle::layer_index_at_depth(s.tissue, 0.0), 0u);
+  EXPECT_EQ(mneedle::layer_index_at_depth(s.tissue, 19e-6), 0u);
+  EXPECT_EQ(mneedle::layer_index_at_depth(s.tissue, 20e-6), 1u);
+  EXPECT_EQ(mneedle::layer_index_at_depth(s.tissue, 5e-3), 1u);
+}
+
+TEST(Scene, MooneyRivlinTakesPoissonRatio) {
+  const Scene s = parse(
+      with(R"(material = { model = "linear", E = "0.08 MPa", nu = 0.4 })",
+           R"(material = { model = "mooney_rivlin", C10 = "10 kPa", C01 = "5 kPa", nu = 0.45 })"));
+  const auto& m = s.tissue.layers[1].material;
+  EXPECT_EQ(m.model, mneedle::MaterialModel::MooneyRivlin);
+  EXPECT_DOUBLE_EQ(m.shear_modulus(), 2.0 * (10e3 + 5e3));
+  EXPECT_DOUBLE_EQ(m.youngs_modulus, 2.0 * 30e3 * 1.45);
+}
+
+TEST(Scene, MooneyRivlinTakesBulkModulus) {
+  const Scene s = parse(with(
+      R"(material = { model = "linear", E = "0.08 MPa", nu = 0.4 })",
+      R"(material = { model = "mooney_rivlin", C10 = "10 kPa", C01 = "5 kPa", K = "1 MPa" })"));
+  const auto& m = s.tissue.layers[1].material;
+  EXPECT_NEAR(m.bulk_modulus(), 1e6, 1e-6);
+  EXPECT_NEAR(m.shear_modulus(), 30e3, 1e-9);
+  EXPECT_GT(m.poisson_ratio, 0.48);
+  EXPECT_LT(m.poisson_ratio, 0.5);
+}
+
+TEST(Scene, UnnamedNeedlesGetUniqueNames) {
+  const std::string needle =
+      "[[needles]]\ngeometry = { plugin = \"cone\", half_angle = \"20 deg\" }\nat = [\"%X\", "
+      "\"0 um\"]\n";
+  std::string toml = std::string(kBase);
+  for (const char* x : {"-1 mm", "1 mm"}) toml += with("%X", x, needle);
+  toml +=
+      "[[needles]]\nname = \"cone_2\"\ngeometry = { plugin = \"cone\" }\nat = [\"0 um\", "
+      "\"1 mm\"]\n";
+  const Scene s = parse(toml);
+  ASSERT_EQ(s.needles.size(), 4u);
+  EXPECT_EQ(s.needles[1].name, "cone");
+  EXPECT_EQ(s.needles[2].name, "cone_3");  // cone_2 is taken by the explicit name
+  EXPECT_EQ(s.needles[3].name, "cone_2");
+  EXPECT_DOUBLE_EQ(s.needles[1].at[0], -1e-3);
+}
+
+TEST(Scene, PluginParametersKeepTheirQuantities) {
+  const Scene s = parse(with(R"(bevel_angle = "30 deg" })",
+                             R"(bevel_angle = "30 deg", resolution = 64, bore = 9e-5 })"));
+  const auto& p = std::get<mneedle::PluginGeometry>(s.needles[0].geometry).parameters;
+  EXPECT_EQ(p.at("resolution").dimension, mneedle::Dimension::Dimensionless);
+  EXPECT_DOUBLE_EQ(p.at("resolution").value_si, 64.0);
+  EXPECT_DOUBLE_EQ(p.at("bore").value_si, 9e-5);
+}
+
+TEST(Scene, StlNeedleResolvesRelativeToTheSceneFile) {
+  const Scene s = mneedle::load_scene(kAssets / "stl_needle.toml");
+  ASSERT_EQ(s.needles.size(), 2u);
+  const auto& stl = std::get<mneedle::StlGeometry>(s.needles[0].geometry);
+  EXPECT_TRUE(std::filesystem::equivalent(stl.path, kAssets / "tiny_needle.stl"));
+  EXPECT_EQ(stl.unit, "mm");
+  EXPECT_DOUBLE_EQ(stl.unit_scale, 1e-3);
+  EXPECT_EQ(s.needles[0].name, "tiny_needle");
+  EXPECT_EQ(s.needles[1].name, "tiny_needle_2");
+  EXPECT_EQ(s.tissue.layers[0].material.model, mneedle::MaterialModel::NeoHookean);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[0].thickness, 1e-3);
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_EQ(s.materials[0].name, "my_pla");
+  EXPECT_DOUBLE_EQ(s.materials[0].youngs_modulus, 3.5e9);
+  EXPECT_DOUBLE_EQ(*s.materials[0].density, 1240.0);
+  EXPECT_EQ(*s.needles[0].material, "my_pla");
+}
+
+TEST(Scene, LoadsAndRequirementsAreRead) {
+  const Scene s = parse(std::string(kBase) + R"(
+[loads]
+scale = 0.2
+stiffness = "50 kPa"
+friction = "linear_growth"
+friction_max_force = "0.919 N"
+friction_saturation_depth = "86 mm"
+
+[requirements]
+target_depth = "300 um"
+safety_factor = 2
+)");
+  EXPECT_DOUBLE_EQ(s.loads.scale, 0.2);
+  EXPECT_DOUBLE_EQ(*s.loads.stiffness, 5e4);
+  EXPECT_EQ(s.loads.friction, mneedle::FrictionLaw::LinearGrowth);
+  EXPECT_DOUBLE_EQ(s.loads.friction_max_force, 0.919);
+  EXPECT_DOUBLE_EQ(s.loads.friction_saturation_depth, 0.086);
+  EXPECT_DOUBLE_EQ(*s.requirements.target_depth, 3e-4);
+  EXPECT_DOUBLE_EQ(s.requirements.safety_factor, 2.0);
+}
+
+// ---- shipped scenes -------------------------------------------------------------------------
+
+TEST(Scene, ShippedHumanSkinRoundTrips) {
+  const Scene s = mneedle::load_scene(kDesigns / "human_skin.toml");
+  EXPECT_DOUBLE_EQ(s.tissue.size[0], 3e-3);
+  EXPECT_DOUBLE_EQ(s.tissue.size[2], 1.15e-3);
+  ASSERT_EQ(s.tissue.layers.size(), 3u);
+  EXPECT_EQ(s.tissue.layers[0].name, "stratum_corneum");
+  EXPECT_DOUBLE_EQ(s.tissue.layers[0].thickness, 20e-6);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[0].material.youngs_modulus, 1e9);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[1].thickness, 100e-6);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[1].material.youngs_modulus, 0.134e6);
+  EXPECT_NEAR(s.tissue.layers[2].thickness, 1030e-6, 1e-15);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[2].material.youngs_modulus, 0.08e6);
+  for (const auto& layer : s.tissue.layers) {
+    EXPECT_DOUBLE_EQ(layer.material.poisson_ratio, 0.4);
+    ASSERT_TRUE(layer.fracture);
+  }
+  ASSERT_EQ(s.needles.size(), 1u);
+  const auto& g = std::get<mneedle::PluginGeometry>(s.needles[0].geometry);
+  EXPECT_EQ(g.plugin, "sharp_bevel");
+  EXPECT_DOUBLE_EQ(g.parameters.at("diameter").value_si, 230e-6);
+  EXPECT_DOUBLE_EQ(g.parameters.at("length").value_si, 1000e-6);
+  EXPECT_NEAR(g.parameters.at("bevel_angle").value_si, std::numbers::pi / 6.0, 1e-15);
+  EXPECT_EQ(*s.needles[0].material, "silicon");
+  EXPECT_DOUBLE_EQ(s.insertion.depth, 800e-6);
+  EXPECT_LT(s.insertion.depth, g.parameters.at("length").value_si);
+}
+
+TEST(Scene, ShippedSiliconePhantomRoundTrips) {
+  const Scene s = mneedle::load_scene(kDesigns / "silicone_phantom.toml");
+  EXPECT_DOUBLE_EQ(s.tissue.size[0], 10e-3);
+  EXPECT_DOUBLE_EQ(s.tissue.size[2], 5e-3);
+  ASSERT_EQ(s.tissue.layers.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[0].thickness, 5e-3);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[0].material.youngs_modulus, 0.2e6);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[0].material.poisson_ratio, 0.49);
+  ASSERT_TRUE(s.tissue.layers[0].fracture);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[0].fracture->toughness, 19.0);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[0].fracture->critical_pressure, 0.663e6);
+  EXPECT_DOUBLE_EQ(s.insertion.depth, 2e-3);
+  const auto& g = std::get<mneedle::PluginGeometry>(s.needles[0].geometry);
+  EXPECT_GT(g.parameters.at("length").value_si, s.insertion.depth);
+}
+
+// ---- errors: each names file:line, the key path and the problem -----------------------------
+
+TEST(SceneErrors, UnknownUnit) {
+  expect_error(with("\"20 um\"", "\"20 uf\""),
+               {"test.toml:7:", "tissue.layers[0].thickness", "unknown unit 'uf'"});
+}
+
+TEST(SceneErrors, WrongDimension) {
+  expect_error(with("depth = \"800 um\"", "depth = \"800 kPa\""),
+               {"test.toml:25:", "insertion.depth", "is a pressure; expected a length"});
+}
+
+TEST(SceneErrors, NegativeBlockSize) {
+  expect_error(with(R"("3000 um", "3000 um", "1150 um")", R"("3000 um", "-3000 um", "1150 um")"),
+               {"test.toml:2:", "tissue.size[1]", "must be positive"});
+}
+
+TEST(SceneErrors, ZeroThickness) {
+  expect_error(with("\"20 um\"", "\"0 um\""),
+               {"test.toml:7:", "tissue.layers[0].thickness", "must be positive"});
+}
+
+TEST(SceneErrors, SizeNeedsThreeLengths) {
+  expect_error(with(R"("3000 um", "3000 um", "1150 um")", R"("3000 um", "3000 um")"),
+               {"test.toml:2:", "tissue.size", "array of 3 lengths"});
+}
+
+TEST(SceneErrors, IncompressiblePoissonRatioSuggests049) {
+  expect_error(with("E = \"1 GPa\", nu = 0.4", "E = \"1 GPa\", nu = 0.5"),
+               {"test.toml:8:", "tissue.layers[0].material.nu", "incompressible", "0.49"});
+}
+
+TEST(SceneErrors, PoissonRatioOutsideRange) {
+  expect_error(with("E = \"1 GPa\", nu = 0.4", "E = \"1 GPa\", nu = -1.2"),
+               {"test.toml:8:", "tissue.layers[0].material.nu", "(-1, 0.5)"});
+  expect_error(with("E = \"1 GPa\", nu = 0.4", "E = \"1 GPa\", nu = 0.7"),
+               {"tissue.layers[0].material.nu", "(-1, 0.5)"});
+}
+
+TEST(SceneErrors, NonPositiveModulus) {
+  expect_error(with("E = \"0.08 MPa\"", "E = \"-0.08 MPa\""),
+               {"test.toml:13:", "tissue.layers[1].material.E", "must be positive"});
+  expect_error(with("E = \"0.08 MPa\"", "E = 0"), {"tissue.layers[1].material.E", "positive"});
+}
+
+TEST(SceneErrors, MissingRequiredKey) {
+  expect_error(with("depth = \"800 um\"\n", ""),
+               {"test.toml:24:", "insertion.depth", "required key is missing", "length"});
+  expect_error(with("name = \"dermis\"\n", ""),
+               {"test.toml:10:", "tissue.layers[1].name", "missing"});
+  expect_error(with("model = \"linear\", E = \"1 GPa\"", "E = \"1 GPa\""),
+               {"tissue.layers[0].material.model", "missing"});
+}
+
+TEST(SceneErrors, MissingTopLevelTable) {
+  expect_error(
+      with("[insertion]\ndepth = \"800 um\"\nspeed = \"1 mm/s\"\nangle = \"90 deg\"\n", ""),
+      {"test.toml:1:", "insertion", "missing"});
+}
+
+TEST(SceneErrors, UnknownKeyWithSuggestion) {
+  expect_error(with("thickness = \"20 um\"", "thicknes = \"20 um\""),
+               {"test.toml:7:", "tissue.layers[0].thicknes", "unknown key",
+                "did you mean "
+                "'thickness'"});
+}
+
+TEST(SceneErrors, UnknownKeyAnywhere) {
+  expect_error(with("[model]", "[modle]"), {"test.toml:29:", "modle", "unknown key"});
+  expect_error(with("nu = 0.4 }\n\n[[tissue.layers]]\nname = \"dermis\"",
+                    "nu = 0.4, G = 3 }\n\n[[tissue.layers]]\nname = \"dermis\""),
+               {"test.toml:8:", "tissue.layers[0].material.G", "unknown key"});
+  expect_error(with("toughness = \"0.019 N/mm\"", "toughness = \"0.019 N/mm\"\nPc = 1"),
+               {"test.toml:17:", "tissue.fracture.Pc", "unknown key"});
+  expect_error(with("angle = \"90 deg\"", "angle = \"90 deg\"\ndepht = 1"),
+               {"test.toml:28:", "insertion.depht", "unknown key"});
+}
+
+TEST(SceneErrors, LayersThickerThanTheBlock) {
+  expect_error(with("\"1130 um\"", "\"1200 um\""),
+               {"test.toml:5:", "tissue.layers", "add up to 1.22 mm", "block depth"});
+}
+
+TEST(SceneErrors, LayersThinnerThanTheBlockSuggestLeavingOutTheLastThickness) {
+  expect_error(with("\"1130 um\"", "\"1000 um\""),
+               {"test.toml:10:", "tissue.layers[1]", "1.15 mm", "leave out the last layer"});
+}
+
+TEST(SceneErrors, LastLayerLeftWithNothing) {
+  expect_error(with("\"20 um\"", "\"1150 um\"", with("thickness = \"1130 um\"\n", "")),
+               {"tissue.layers[1]", "leaving nothing"});
+}
+
+TEST(SceneErrors, OnlyTheLastLayerMayOmitItsThickness) {
+  expect_error(with("thickness = \"20 um\"\n", ""),
+               {"test.toml:5:", "tissue.layers[0].thickness", "only the last layer"});
+}
+
+TEST(SceneErrors, DepthReachesTheBlockBottom) {
+  expect_error(with("\"800 um\"", "\"1150 um\""),
+               {"test.toml:25:", "insertion.depth", "bottom of the block"});
+}
+
+TEST(SceneErrors, DepthReachesTheNeedleLength) {
+  expect_error(with("\"800 um\"", "\"1000 um\""),
+               {"test.toml:25:", "insertion.depth", "needle 'sharp_bevel'",
+                "needles[0].geometry.length", "base would enter"});
+}
+
+TEST(SceneErrors, ObliqueAngle) {
+  expect_error(with("\"90 deg\"", "\"45 deg\""),
+               {"test.toml:27:", "insertion.angle", "oblique insertion is not modelled yet"});
+}
+
+TEST(SceneErrors, NoNeedles) {
+  expect_error(with("[[needles]]\ngeometry = { plugin = \"sharp_bevel\", diameter = \"230 um\", "
+                    "length = \"1000 um\", bevel_angle = \"30 deg\" }\nat = [\"0 um\", \"0 um\"]\n"
+                    "material = \"silicon\"\n",
+                    ""),
+               {"test.toml:1:", "needles", "at least one"});
+}
+
+TEST(SceneErrors, DuplicateNeedleNames) {
+  const std::string needle =
+      "[[needles]]\nname = \"a\"\ngeometry = { plugin = \"cone\" }\nat = [\"%X\", \"0 um\"]\n";
+  std::string toml = with("material = \"silicon\"\n", "material = \"silicon\"\nname = \"a\"\n");
+  toml += with("%X", "1 mm", needle);
+  expect_error(toml, {"test.toml:33:", "needles[1].name", "duplicate needle name 'a'"});
+}
+
+TEST(SceneErrors, TomlSyntaxErrorGivesLineAndColumn) {
+  try {
+    mneedle::load_scene(kAssets / "syntax_error.toml");
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("syntax_error.toml:"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("TOML syntax error"), std::string::npos) << msg;
+  }
+  expect_error(with("depth = \"800 um\"", "depth = \"800 um"), {"test.toml:25:", "TOML syntax"});
+}
+
+TEST(SceneErrors, MissingSceneFile) {
+  EXPECT_THROW(mneedle::load_scene(kAssets / "no_such_scene.toml"), InputError);
+}
+
+TEST(SceneErrors, GeometryNeedsPluginOrStlButNotBoth) {
+  expect_error(with("plugin = \"sharp_bevel\",", "plugin = \"sharp_bevel\", stl = \"x.stl\","),
+               {"test.toml:20:", "needles[0].geometry.stl", "not both"});
+  expect_error(with("plugin = \"sharp_bevel\",", ""),
+               {"test.toml:20:", "needles[0].geometry.plugin", "missing"});
+}
+
+TEST(SceneErrors, MissingStlFile) {
+  expect_error(with("plugin = \"sharp_bevel\", diameter = \"230 um\", length = \"1000 um\", "
+                    "bevel_angle = \"30 deg\"",
+                    "stl = \"absent.stl\", unit = \"um\""),
+               {"test.toml:20:", "needles[0].geometry.stl", "no such file"});
+}
+
+TEST(SceneErrors, UnknownStlUnit) {
+  const std::string toml =
+      with("stl = \"tiny_needle.stl\" }", "stl = \"tiny_needle.stl\", unit = \"in\" }", [] {
+        std::ifstream in(kAssets / "stl_needle.toml");
+        return std::string(std::istreambuf_iterator<char>(in), {});
+      }());
+  try {
+    mneedle::parse_scene(toml, (kAssets / "stl_needle.toml").string());
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("stl_needle.toml:15:"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("needles[1].geometry.unit"), std::string::npos) << msg;
+  }
+}
+
+TEST(SceneErrors, PluginLengthMustBeALength) {
+  expect_error(with("length = \"1000 um\"", "length = \"1000 deg\""),
+               {"test.toml:20:", "needles[0].geometry.length", "expected a length"});
+}
+
+TEST(SceneErrors, NeedleOutsideTheBlock) {
+  expect_error(with("at = [\"0 um\", \"0 um\"]", "at = [\"1450 um\", \"0 um\"]"),
+               {"test.toml:21:", "needles[0].at", "not inside the block"});
+}
+
+TEST(SceneErrors, MooneyRivlinConstantsAreChecked) {
+  const std::string_view linear = R"(model = "linear", E = "0.08 MPa", nu = 0.4)";
+  expect_error(with(linear, R"(model = "mooney_rivlin", C10 = "1 kPa", C01 = "1 kPa")"),
+               {"test.toml:13:", "tissue.layers[1].material", "exactly one of nu"});
+  expect_error(with(linear, R"(model = "mooney_rivlin", E = "1 kPa", C10 = "1 kPa", C01 = "0")"),
+               {"tissue.layers[1].material.E", "derived from C10 and C01"});
+  expect_error(with(linear, R"(model = "linear", E = "0.08 MPa", nu = 0.4, C10 = "1 kPa")"),
+               {"tissue.layers[1].material.C10", "mooney_rivlin"});
+  expect_error(with(linear, R"(model = "mooney_rivlin", C10 = "-1 kPa", C01 = "0", nu = 0.4)"),
+               {"tissue.layers[1].material.C10", "C10 + C01 must be positive"});
+}
+
+TEST(SceneErrors, UnknownMaterialModel) {
+  expect_error(with("model = \"linear\", E = \"1 GPa\"", "model = \"ogden\", E = \"1 GPa\""),
+               {"test.toml:8:", "tissue.layers[0].material.model", "'ogden'", "mooney_rivlin"});
+}
+
+TEST(SceneErrors, StrengthNeedsItsLength) {
+  expect_error(with("thickness = \"20 um\"", "thickness = \"20 um\"\nstrength = \"20 MPa\""),
+               {"test.toml:8:", "tissue.layers[0].strength", "strength_length"});
+}
+
+TEST(SceneErrors, ExplicitCriterionNeedsItsData) {
+  expect_error(with("fidelity = \"standard\"", "criterion = \"stress\""),
+               {"test.toml:30:", "model.criterion", "strength"});
+  const std::string no_fracture = with(
+      "[tissue.fracture]\ntoughness = \"0.019 N/mm\"\ncritical_pressure = \"0.663 MPa\"\n", "");
+  expect_error(with("fidelity = \"standard\"", "criterion = \"energy\"", no_fracture),
+               {"model.criterion", "fracture"});
+}
+
+TEST(SceneErrors, BadModelChoices) {
+  expect_error(with("\"standard\"", "\"ultra\""), {"test.toml:30:", "model.fidelity", "fast"});
+  expect_error(with("\"force_curve\"]", "\"stress_map\"]"),
+               {"test.toml:31:", "model.outputs[1]", "'stress_map'"});
+  expect_error(with("\"force_curve\"]", "\"puncture\"]"), {"model.outputs[1]", "listed twice"});
+}
+
+TEST(SceneErrors, LinearGrowthFrictionNeedsBothConstants) {
+  expect_error(std::string(kBase) +
+                   "\n[loads]\nfriction = \"linear_growth\"\n"
+                   "friction_max_force = \"1 N\"\n",
+               {"test.toml:33:", "loads.friction_saturation_depth", "missing"});
+  expect_error(std::string(kBase) + "\n[loads]\nfriction = \"none\"\nfriction_coefficient = 0.3\n",
+               {"test.toml:35:", "loads.friction_coefficient", "coulomb"});
+  expect_error(std::string(kBase) + "\n[loads]\nfriction_max_force = \"1 N\"\n",
+               {"loads.friction_max_force", "linear_growth"});
+  expect_error(std::string(kBase) + "\n[loads]\nscale = -0.1\n", {"loads.scale", "positive"});
+}
+
+TEST(SceneErrors, RequirementsAreChecked) {
+  expect_error(std::string(kBase) + "\n[requirements]\ntarget_depth = \"900 um\"\n",
+               {"test.toml:34:", "requirements.target_depth", "deeper than insertion.depth"});
+  expect_error(std::string(kBase) + "\n[requirements]\nsafety_factor = 0.8\n",
+               {"requirements.safety_factor", "at least 1"});
+}
+
+TEST(SceneErrors, UserMaterialsAreChecked) {
+  const std::string material =
+      "\n[[materials]]\nname = \"pla\"\nE = \"3.5 GPa\"\nnu = 0.36\nstrength = \"60 MPa\"\n";
+  expect_error(std::string(kBase) + material + material,
+               {"test.toml:39:", "materials[1].name", "duplicate material name 'pla'"});
+  expect_error(std::string(kBase) + with("nu = 0.36", "nu = 0.5", material),
+               {"test.toml:36:", "materials[0].nu", "incompressible"});
+  expect_error(std::string(kBase) + with("strength = \"60 MPa\"\n", "", material),
+               {"materials[0].strength", "missing"});
+}
+
+TEST(SceneErrors, WrongValueTypes) {
+  expect_error(with("name = \"dermis\"", "name = 3"),
+               {"test.toml:11:", "tissue.layers[1].name", "string"});
+  expect_error(with("depth = \"800 um\"", "depth = true"),
+               {"test.toml:25:", "insertion.depth", "expected a length"});
+  expect_error(with("E = \"0.08 MPa\"", "E = nan"),
+               {"test.toml:13:", "tissue.layers[1].material.E", "not a finite number"});
+  expect_error(with("[tissue.fracture]", "[tissue.fracture.x]"), {"tissue.fracture", "missing"});
+}
+
+}  // namespace
