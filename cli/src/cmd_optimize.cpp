@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -162,6 +163,13 @@ void write_outputs(const std::filesystem::path& dir, const OptimizerResult& r,
   std::filesystem::create_directories(dir);
   write_stl_binary(best_mesh, dir / "best.stl", 1e-3, "mneedle optimize best design (mm)");
   std::ofstream csv(dir / "history.csv");
+  // Full precision: a history that rounds cannot be compared with the summary it produced.
+  csv << std::setprecision(17);
+  auto number = [](double x) {
+    std::ostringstream out;
+    out << std::setprecision(17) << x;
+    return out.str();
+  };
   for (const auto& v : vars) csv << v.name << "_SI,";
   csv << objective_key;
   for (const char* c : kConstraintNames) csv << "," << c;
@@ -175,9 +183,8 @@ void write_outputs(const std::filesystem::path& dir, const OptimizerResult& r,
     }
     require_finite_row(numbers, columns, "history row", "optimize");
     for (double x : numbers) csv << x << ",";
-    csv << (e.failed ? "" : std::to_string(e.objective));
-    for (int i = 0; i < kConstraints; ++i)
-      csv << "," << (e.failed ? "" : std::to_string(e.constraints[i]));
+    csv << (e.failed ? "" : number(e.objective));
+    for (int i = 0; i < kConstraints; ++i) csv << "," << (e.failed ? "" : number(e.constraints[i]));
     std::string error = e.error;
     std::replace(error.begin(), error.end(), '"', '\'');
     csv << "," << e.feasible << "," << e.failed << "," << e.start << "," << e.seconds << ",\""

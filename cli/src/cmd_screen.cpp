@@ -43,7 +43,9 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
       "Ranked by puncture depth, then puncture force (two-stage model: FE until the %s "
       "criterion fires, then paper A's distributed loads); designs that do not puncture "
       "before the target depth come last. pass = punctures before the target depth and "
-      "margin (capacity / peak force) >= safety factor.\n\n",
+      "margin (capacity / peak force) >= safety factor. A depth marked * is where the "
+      "criterion already fires at the first depth step: not resolved, ranked after the "
+      "resolved ones (docs/model.md, \"Criteria\").\n\n",
       std::string(to_string(scene.model.criterion)).c_str());
   std::printf("%-4s %-24s %-6s %-11s %-11s %-11s %-11s %-9s %-8s %s\n", "rank", "design", "status",
               "puncture at", "force", "peak force", "capacity", "governing", "margin", "model");
@@ -59,8 +61,10 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
     std::string models;
     for (const auto& m : j["models_run"])
       models += (models.empty() ? "" : "+") + m.get<std::string>();
-    const std::string depth =
-        row.puncture_depth_m ? cell(*row.puncture_depth_m, Dimension::Length) : "none";
+    const std::string depth = row.puncture_depth_m
+                                  ? cell(*row.puncture_depth_m, Dimension::Length) +
+                                        (row.puncture_at_first_contact ? "*" : "")
+                                  : "none";
     const std::string force =
         row.puncture_depth_m ? cell(row.puncture_force_n, Dimension::Force) : "-";
     std::printf("%-4d %-24s %-6s %-11s %-11s %-11s %-11s %-9s %-8s %s\n", ++rank,

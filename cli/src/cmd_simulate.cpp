@@ -82,6 +82,8 @@ nlohmann::json point_json(const RunPoint& p, std::optional<PunctureCriterion> cr
     j["lateral_force_N"] = {p.lateral_force_N[0], p.lateral_force_N[1]};
     j["contact_area_m2"] = p.contact_area_m2;
     j["contact_pressure_Pa"] = p.contact_pressure_Pa;
+    j["section_area_m2"] = p.section_area_m2;
+    j["section_pressure_Pa"] = p.section_pressure_Pa;
     j["strain_energy_J"] = p.strain_energy_J;
     if (criterion == PunctureCriterion::Stress) j["tip_stress_Pa"] = p.tip_stress_Pa;
     if (criterion == PunctureCriterion::Energy)
@@ -109,7 +111,8 @@ nlohmann::json to_json(const InsertionRun& run) {
       puncture = {{"depth_m", n.puncture->depth_m},
                   {"force_N", n.puncture->force_N},
                   {"criterion", to_string(n.puncture->criterion)},
-                  {"post_force_N", n.puncture->post_force_N}};
+                  {"post_force_N", n.puncture->post_force_N},
+                  {"at_first_contact", n.puncture->at_first_contact}};
     needles.push_back({{"name", n.name},
                        {"curve", curve_json(n.curve, run.criterion)},
                        {"puncture", puncture},
@@ -141,19 +144,23 @@ nlohmann::json to_json(const InsertionRun& run) {
           {"reductions", reductions},
           {"fidelity", fe::to_string(run.fidelity)},
           {"criterion", criterion},
+          {"pre_puncture_horizon_m", run.horizon_m},
+          {"pre_puncture_step_m", run.first_step_m},
           {"seconds", run.seconds}};
 }
 
 void print_csv(const InsertionRun& run) {
   std::cout << "depth_m,force_N,stage,lateral_force_x_N,lateral_force_y_N,contact_area_m2,"
-               "contact_pressure_Pa,strain_energy_J,alpha_N,beta_N,friction_N,needle\n";
+               "contact_pressure_Pa,section_area_m2,section_pressure_Pa,strain_energy_J,alpha_N,"
+               "beta_N,friction_N,needle\n";
   std::cout << std::setprecision(9);
   auto rows = [](const std::vector<RunPoint>& curve, const std::string& name) {
     for (const RunPoint& p : curve)
       std::cout << p.depth_m << "," << p.force_N << "," << stage_name(p.stage) << ","
                 << p.lateral_force_N[0] << "," << p.lateral_force_N[1] << "," << p.contact_area_m2
-                << "," << p.contact_pressure_Pa << "," << p.strain_energy_J << "," << p.alpha_N
-                << "," << p.beta_N << "," << p.friction_N << "," << name << "\n";
+                << "," << p.contact_pressure_Pa << "," << p.section_area_m2 << ","
+                << p.section_pressure_Pa << "," << p.strain_energy_J << "," << p.alpha_N << ","
+                << p.beta_N << "," << p.friction_N << "," << name << "\n";
   };
   for (const NeedleRun& n : run.needles) rows(n.curve, n.name);
   if (run.needles.size() > 1) rows(run.total_curve, "total");
@@ -177,7 +184,11 @@ void print_table(const InsertionRun& run) {
       std::cout << std::fixed << std::setprecision(1) << "punctures at "
                 << n.puncture->depth_m * 1e6 << " um (" << to_string(n.puncture->criterion)
                 << " criterion), force " << std::setprecision(3) << n.puncture->force_N * 1e3
-                << " mN, then " << n.puncture->post_force_N * 1e3 << " mN post-puncture";
+                << " mN, then " << n.puncture->post_force_N * 1e3 << " mN post-puncture"
+                << (n.puncture->at_first_contact
+                        ? " [at first contact: the criterion is above its threshold at the first "
+                          "depth step, so this depth is the step's, not the tissue's]"
+                        : "");
     else if (run.criterion)
       std::cout << "no puncture within the insertion depth";
     else
@@ -186,7 +197,7 @@ void print_table(const InsertionRun& run) {
               << " mN\n";
     const bool stress = run.criterion == PunctureCriterion::Stress;
     const bool energy = run.criterion == PunctureCriterion::Energy;
-    std::cout << "  depth [um]  stage   force [mN]   pressure [MPa]"
+    std::cout << "  depth [um]  stage   force [mN]   F/A_sec [MPa]"
               << (stress   ? "   tip stress [MPa]"
                   : energy ? "   G [J/m^2]"
                            : "")
@@ -194,7 +205,7 @@ void print_table(const InsertionRun& run) {
     for (const RunPoint& p : n.curve) {
       std::cout << std::setprecision(2) << std::setw(12) << p.depth_m * 1e6 << "  " << std::setw(5)
                 << stage_name(p.stage) << std::setprecision(4) << std::setw(13) << p.force_N * 1e3
-                << std::setw(17) << p.contact_pressure_Pa * 1e-6;
+                << std::setw(16) << p.section_pressure_Pa * 1e-6;
       if (stress && p.stage == Stage::Pre) std::cout << std::setw(19) << p.tip_stress_Pa * 1e-6;
       if (energy && p.stage == Stage::Pre)
         std::cout << std::setw(13) << p.energy_release_rate_J_per_m2;

@@ -53,7 +53,7 @@ Scene design_scene(const Scene& scene, double depth_m) {
   return s;
 }
 
-// Pressure criterion only: how close the run came to puncturing, max contact pressure over the
+// Pressure criterion only: how close the run came to puncturing, max F / A_sec over the
 // threshold. The other criteria's values are not on the curve; 0 then.
 double criterion_ratio(const InsertionRun& run, const NeedleRun& needle) {
   if (!run.criterion || !run.threshold || *run.criterion != PunctureCriterion::Pressure ||
@@ -61,7 +61,7 @@ double criterion_ratio(const InsertionRun& run, const NeedleRun& needle) {
     return 0.0;
   double peak = 0.0;
   for (const RunPoint& p : needle.curve)
-    if (p.stage == Stage::Pre) peak = std::max(peak, p.contact_pressure_Pa);
+    if (p.stage == Stage::Pre) peak = std::max(peak, p.section_pressure_Pa);
   return std::clamp(peak / *run.threshold, 0.0, 1.0);
 }
 
@@ -91,9 +91,19 @@ void add_insertion(DesignEvaluation& e, const TriangleMesh& mesh, const Scene& s
   if (!n.curve.empty()) e.force_at_depth_n = n.curve.back().force_N;
   if (n.puncture && n.puncture->depth_m <= e.depth_m * (1.0 + 1e-9)) {
     e.puncture = PunctureSummary{n.puncture->depth_m, n.puncture->force_N, n.puncture->post_force_N,
-                                 std::string(to_string(n.puncture->criterion))};
-    e.puncture_objective_m = n.puncture->depth_m;
+                                 std::string(to_string(n.puncture->criterion)),
+                                 n.puncture->at_first_contact};
     e.reaches_target = true;
+    if (n.puncture->at_first_contact) {
+      // No depth to optimise: the objective is the flat "no information" value, 2 x the depth.
+      e.puncture_objective_m = 2.0 * e.depth_m;
+      e.notes.push_back("the " + std::string(to_string(n.puncture->criterion)) +
+                        " criterion fires at the first depth step (" +
+                        format_quantity(n.puncture->depth_m, Dimension::Length) +
+                        "): the puncture depth is not resolved for this tip and tissue");
+    } else {
+      e.puncture_objective_m = n.puncture->depth_m;
+    }
   } else {
     e.puncture_objective_m = e.depth_m * (2.0 - criterion_ratio(run, n));
     e.notes.push_back(run.criterion ? "no puncture up to the target depth " +

@@ -182,9 +182,11 @@ json evaluation_json(const DesignEvaluation& e) {
           {"puncture", e.puncture ? json{{"depth_m", e.puncture->depth_m},
                                          {"force_N", e.puncture->force_N},
                                          {"post_force_N", e.puncture->post_force_N},
-                                         {"criterion", e.puncture->criterion}}
+                                         {"criterion", e.puncture->criterion},
+                                         {"at_first_contact", e.puncture->at_first_contact}}
                                   : json(nullptr)},
           {"punctured", e.puncture.has_value()},
+          {"puncture_at_first_contact", e.puncture && e.puncture->at_first_contact},
           {"puncture_depth_m",
            optional_number(e.puncture ? std::optional(e.puncture->depth_m) : std::nullopt)},
           {"puncture_force_N",
@@ -239,6 +241,7 @@ ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::s
     if (e.puncture) {
       row.puncture_depth_m = e.puncture->depth_m;
       row.puncture_force_n = e.puncture->force_N;
+      row.puncture_at_first_contact = e.puncture->at_first_contact;
     }
     row.margin = e.margin;
     row.passes = e.passes;
@@ -273,6 +276,7 @@ ScreeningRow row_from_json(const std::string& line) {
     if (!j.at("puncture_depth_m").is_null()) {
       row.puncture_depth_m = j.at("puncture_depth_m").get<double>();
       row.puncture_force_n = j.at("puncture_force_N").get<double>();
+      row.puncture_at_first_contact = j.value("puncture_at_first_contact", false);
     }
     row.margin = j.at("margin").is_null() ? INFINITY : j.at("margin").get<double>();
     row.passes = j.at("passes").get<bool>();
@@ -313,6 +317,7 @@ constexpr const char* kCsvColumns[] = {"design",
                                        "puncture_force_N",
                                        "post_puncture_force_N",
                                        "puncture_criterion",
+                                       "puncture_at_first_contact",
                                        "target_depth_m",
                                        "reaches_target_depth",
                                        "peak_force_N",
@@ -442,6 +447,9 @@ std::vector<ScreeningRow> rank_rows(std::vector<ScreeningRow> rows) {
     if (!a.ok) return false;
     if (a.puncture_depth_m.has_value() != b.puncture_depth_m.has_value())
       return a.puncture_depth_m.has_value();
+    // A depth that is only the first step's says nothing about the tip: after resolved ones.
+    if (a.puncture_at_first_contact != b.puncture_at_first_contact)
+      return !a.puncture_at_first_contact;
     if (a.puncture_depth_m && *a.puncture_depth_m != *b.puncture_depth_m)
       return *a.puncture_depth_m < *b.puncture_depth_m;
     if (a.puncture_force_n != b.puncture_force_n) return a.puncture_force_n < b.puncture_force_n;

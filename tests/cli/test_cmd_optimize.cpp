@@ -20,6 +20,9 @@ using mneedle::test::run_mneedle;
 
 const std::string kRoot = MNEEDLE_SOURCE_ROOT;
 const std::string kSkin = kRoot + "/designs/scenes/human_skin.toml";
+// Homogeneous silicone where the sharp bevel's F / A_sec rises with depth: the pressure criterion
+// fires at a resolved depth (in skin it fires at first contact or not at all).
+const std::string kSilicone = std::string(MNEEDLE_TEST_ASSETS) + "/scenes/optimize_silicone.toml";
 constexpr double kPi = 3.14159265358979323846;
 
 fs::path temp_dir(const std::string& name) {
@@ -32,7 +35,7 @@ fs::path temp_dir(const std::string& name) {
 // The README's search: no --bound, so the plugin's whole ranges. Their middle is no valid bevel
 // (longer than the needle); the search starts from the plugin's defaults instead.
 TEST(OptimizeCommand, SearchOverThePluginsWholeRangesStartsFromItsDefaults) {
-  const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSkin +
+  const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSilicone +
                                "' --vary bevel_angle,diameter --model analytic --material silicon"
                                " --max-evals 3 --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -44,7 +47,7 @@ TEST(OptimizeCommand, SearchOverThePluginsWholeRangesStartsFromItsDefaults) {
 TEST(OptimizeCommand, PunctureDepthIsTheDefaultObjectiveAndTheSummaryHasItsKeys) {
   const fs::path dir = temp_dir("optimize_depth");
   const auto run =
-      run_mneedle("optimize --plugin sharp_bevel --scene '" + kSkin +
+      run_mneedle("optimize --plugin sharp_bevel --scene '" + kSilicone +
                   "' --vary bevel_angle --bound bevel_angle=15deg:60deg"
                   " --model analytic --material silicon --max-evals 20 --json --out '" +
                   dir.string() + "'");
@@ -57,7 +60,7 @@ TEST(OptimizeCommand, PunctureDepthIsTheDefaultObjectiveAndTheSummaryHasItsKeys)
   const auto& best = j["best"];
   ASSERT_TRUE(best["puncture_depth_m"].is_number()) << j.dump(2);
   const double depth = best["puncture_depth_m"].get<double>();
-  EXPECT_GE(depth, 0.0);  // the analytic model's sharp tip punctures almost at once
+  EXPECT_GT(depth, 0.0);
   EXPECT_LE(depth, best["target_depth_m"].get<double>());
   EXPECT_GT(best["margin"].get<double>(), best["safety_factor"].get<double>());
   EXPECT_TRUE(best["params"].contains("bevel_angle"));
@@ -74,7 +77,7 @@ TEST(OptimizeCommand, PunctureDepthIsTheDefaultObjectiveAndTheSummaryHasItsKeys)
 
 TEST(OptimizeCommand, PeakForceObjectiveReportsTheLowestFeasiblePeakForceOfItsHistory) {
   const fs::path dir = temp_dir("optimize_force");
-  const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSkin +
+  const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSilicone +
                                "' --vary bevel_angle --bound bevel_angle=20deg:60deg"
                                " --objective peak-force --model analytic --material silicon"
                                " --max-evals 25 --json --out '" +
@@ -98,7 +101,8 @@ TEST(OptimizeCommand, PeakForceObjectiveReportsTheLowestFeasiblePeakForceOfItsHi
     ++rows;
   }
   EXPECT_EQ(rows, j["evaluations"].get<int>());
-  EXPECT_NEAR(j["best"]["peak_force_N"].get<double>() / lowest, 1.0, 1e-5);
+  // history.csv is written at full precision: the same number to round-off.
+  EXPECT_NEAR(j["best"]["peak_force_N"].get<double>() / lowest, 1.0, 1e-12);
   fs::remove_all(dir);
 }
 

@@ -48,19 +48,25 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
   }
 }
 
-TEST(ScreenCommand, EqualPunctureDepthsAreRankedByPunctureForce) {
-  // On the analytic model both reach the critical pressure at the first contact (the edge of the
-  // flat punch and the bevel's point are singular); the flat 230 um punch needs newtons there,
-  // the sharp bevel micronewtons, so the bevel ranks first.
+TEST(ScreenCommand, DepthAtFirstContactIsMarkedAndRankedAfterResolvedBeforeNone) {
+  // On the analytic model in skin the flat punch's F / A_sec is above 3 MPa at the first depth
+  // step (its edge is singular): a puncture "at first contact", whose depth is the step's. The
+  // sharp bevel's falls below the threshold (the stratum corneum spreads the load): no puncture.
+  const std::string designs =
+      "'" + kRoot + "/designs/cylinder.stl' '" + kRoot + "/designs/sharp_bevel.stl'";
   const auto run =
-      run_mneedle("screen '" + kRoot + "/designs/cylinder.stl' '" + kRoot +
-                  "/designs/sharp_bevel.stl' --scene '" + kSkin + "' --model analytic --json");
+      run_mneedle("screen " + designs + " --scene '" + kSkin + "' --model analytic --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
   ASSERT_EQ(j["designs"].size(), 2u);
-  EXPECT_EQ(j["designs"][0]["design"], "sharp_bevel") << j.dump(2);
+  EXPECT_EQ(j["designs"][0]["design"], "cylinder") << j.dump(2);
+  EXPECT_TRUE(j["designs"][0]["puncture_at_first_contact"].get<bool>());
+  EXPECT_FALSE(j["designs"][1]["punctured"].get<bool>());
   EXPECT_EQ(j["model"], "analytic");
   for (const auto& d : j["designs"]) EXPECT_EQ(d["models_run"][0], "analytic") << d.dump();
+  const auto table = run_mneedle("screen " + designs + " --scene '" + kSkin + "' --model analytic");
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  EXPECT_NE(table.out.find(" um* "), std::string::npos) << table.out;
 }
 
 TEST(ScreenCommand, BrokenDesignGetsAnErrorRowAndTheOthersAreKept) {

@@ -54,7 +54,9 @@ TEST(CmdSimulate, CsvHasOneRowPerDepth) {
   EXPECT_EQ(header.rfind("depth_m,force_N,", 0), 0u);
   int rows = 0;
   while (std::getline(lines, row)) rows += row.empty() ? 0 : 1;
-  EXPECT_EQ(rows, 10);  // fast fidelity: 10 output depths
+  // fast: 10 steps of 10 um over the first pre-puncture horizon (100 um), 5 of them within the
+  // 50 um asked for.
+  EXPECT_EQ(rows, 5);
 }
 
 TEST(CmdSimulate, AxisymmetricModelRefusesABevelClearly) {
@@ -165,7 +167,7 @@ TEST(CmdSimulate, PaperAArrayRunsAsAQuarterModelAndReportsEveryNeedle) {
   EXPECT_NEAR(j["total_curve"].back()["force_N"].get<double>(), 4.0 * force, 1e-9 * force);
 }
 
-TEST(CmdSimulate, BevelPuncturesOnAHalfModelAndReportsIt) {
+TEST(CmdSimulate, SharpBevelFiresAtFirstContactOnAHalfModelAndSaysSo) {
   const CommandRun run = run_mneedle("simulate '" + scene("puncture_bevel.toml") + "' --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
@@ -174,16 +176,19 @@ TEST(CmdSimulate, BevelPuncturesOnAHalfModelAndReportsIt) {
   EXPECT_TRUE(half) << j["reductions"].dump();
   const auto& p = j["needles"][0]["puncture"];
   ASSERT_TRUE(p.is_object());
-  // The mean pressure at the located puncture is the threshold (interpolated between steps).
+  // A sharp bevel's F / A_sec is largest at the first step (0.49 MPa at 10 um here: the force is
+  // carried by the node at the tip while the section's area starts from zero), above this
+  // scene's 0.1 MPa: the criterion fires on contact, reported at the first step and flagged.
+  EXPECT_TRUE(p["at_first_contact"].get<bool>());
+  EXPECT_DOUBLE_EQ(p["depth_m"].get<double>(), j["pre_puncture_step_m"].get<double>());
   const auto& curve = j["needles"][0]["curve"];
   bool found = false;
   for (const auto& point : curve)
     if (point["stage"] == "pre" && point["depth_m"] == p["depth_m"]) {
       found = true;
-      EXPECT_NEAR(point["contact_pressure_Pa"].get<double>(), 0.1e6, 0.01e6);
+      EXPECT_GE(point["section_pressure_Pa"].get<double>(), 0.1e6);
     }
   EXPECT_TRUE(found);
-  EXPECT_LT(p["depth_m"].get<double>(), 100e-6);
 }
 
 TEST(CmdSimulate, NoReductionsSolvesTheFullBevelModel) {

@@ -189,4 +189,19 @@ TEST_F(Screening, ParallelJobsHoldOpenBlasAtOneThreadEach) {
   EXPECT_EQ(mneedle::blas_threads(), before);
 }
 
+TEST(ScreeningRanking, ResolvedPuncturesComeBeforeOnesAtFirstContact) {
+  std::vector<mneedle::ScreeningRow> rows(3);
+  for (auto& r : rows) r.ok = true;
+  rows[0].design = "at_contact";
+  rows[0].puncture_depth_m = 5e-6;
+  rows[0].puncture_at_first_contact = true;
+  rows[1].design = "none";
+  rows[2].design = "resolved";
+  rows[2].puncture_depth_m = 150e-6;
+  const auto ranked = mneedle::rank_rows(rows);
+  EXPECT_EQ(ranked[0].design, "resolved");
+  EXPECT_EQ(ranked[1].design, "at_contact");
+  EXPECT_EQ(ranked[2].design, "none");
+}
+
 }  // namespace

@@ -6,6 +6,7 @@
 #include "mneedle/geometry/cross_section.h"
 
 #include <CGAL/Polygon_mesh_slicer.h>
+#include <CGAL/convex_hull_2.h>
 
 #include <algorithm>
 #include <cmath>
@@ -70,6 +71,18 @@ int nested_loop_sign(const std::vector<std::vector<Point2>>& polygons, std::size
   return depth % 2 == 0 ? 1 : -1;
 }
 
+double outline_area(const std::vector<std::vector<Point2>>& polygons) {
+  std::vector<CgalKernel::Point_2> points;
+  for (const auto& loop : polygons)
+    for (const Point2& p : loop) points.emplace_back(p[0], p[1]);
+  if (points.size() < 3) return 0.0;
+  std::vector<CgalKernel::Point_2> hull;
+  CGAL::convex_hull_2(points.begin(), points.end(), std::back_inserter(hull));
+  std::vector<Point2> loop;
+  for (const auto& p : hull) loop.push_back({p.x(), p.y()});
+  return std::abs(shoelace_area(loop));
+}
+
 double nested_polygon_area(const std::vector<std::vector<Point2>>& polygons) {
   double area = 0.0;
   for (std::size_t i = 0; i < polygons.size(); ++i)
@@ -102,6 +115,7 @@ CrossSection CrossSectionSlicer::slice(double height_m) const {
     if (loop.size() >= 3) section.polygons.push_back(std::move(loop));
   }
   section.area_m2 = nested_polygon_area(section.polygons);
+  section.outline_area_m2 = outline_area(section.polygons);
   return section;
 }
 

@@ -117,7 +117,7 @@ void merge_deep_layers(RunPlan& plan, double influence) {
                                  ") merged into one substrate with the material of '" +
                                  plan.layers.back().name + "': deeper than " +
                                  std::to_string(static_cast<int>(kInfluenceDepths)) +
-                                 " x (needle radius + insertion depth) = " + um(influence),
+                                 " x (needle radius + pre-puncture horizon) = " + um(influence),
                              std::nullopt});
 }
 
@@ -125,7 +125,7 @@ void merge_deep_layers(RunPlan& plan, double influence) {
 // them (the block stays centred on the scene's origin, so the needles keep their coordinates).
 // run_insertion measures the truncation error and undoes the cut when it is above tolerance.
 void cut_domain(RunPlan& plan, const std::vector<PreparedNeedle>& needles) {
-  const double reach = domain_reach(plan.needle_radius_m, plan.depth_m);
+  const double reach = domain_reach(plan.needle_radius_m, plan.horizon_m);
   double half_x = 0.0, half_y = 0.0;
   for (const PreparedNeedle& n : needles) {
     half_x = std::max(half_x, std::abs(n.x));
@@ -140,7 +140,7 @@ void cut_domain(RunPlan& plan, const std::vector<PreparedNeedle>& needles) {
       {"domain_cut",
        "block " + um(plan.full_block_x_m) + " x " + um(plan.full_block_y_m) + " cut to " +
            um(cut_x) + " x " + um(cut_y) + ": " + std::to_string(static_cast<int>(kDomainReach)) +
-           " x (needle radius + insertion depth) = " + um(reach) + " around the needles",
+           " x (needle radius + pre-puncture horizon) = " + um(reach) + " around the needles",
        std::nullopt});
 }
 
@@ -160,6 +160,17 @@ double reduction_tolerance(fe::Fidelity fidelity) {
       return 0.01;
   }
   return 0.02;
+}
+
+double pre_puncture_horizon(int rung) {
+  return std::ldexp(kFirstHorizon, rung);
+}
+
+int rung_covering(double depth_m) {
+  int rung = 0;
+  // A depth equal to a rung (to round-off) is covered by that rung.
+  while (pre_puncture_horizon(rung) < depth_m * (1.0 - 1e-12) && rung < 60) ++rung;
+  return rung;
 }
 
 double influence_depth(double needle_radius_m, double insertion_depth_m) {
@@ -188,9 +199,10 @@ std::vector<fe::TissueLayer> fe_layers(const Scene& scene) {
 }
 
 RunPlan plan_insertion(const Scene& scene, const std::vector<PreparedNeedle>& needles,
-                       const InsertionRunOptions& options) {
+                       const InsertionRunOptions& options, double horizon_m) {
   RunPlan plan;
   plan.depth_m = scene.insertion.depth;
+  plan.horizon_m = horizon_m;
   plan.layers = fe_layers(scene);
   plan.full_layers = plan.layers;
   plan.block_x_m = scene.tissue.size[0];
@@ -199,7 +211,7 @@ RunPlan plan_insertion(const Scene& scene, const std::vector<PreparedNeedle>& ne
   plan.full_block_y_m = plan.block_y_m;
   plan.vtu_directory = options.vtu_directory;
   for (const PreparedNeedle& n : needles)
-    plan.needle_radius_m = std::max(plan.needle_radius_m, max_radius_below(n.mesh, plan.depth_m));
+    plan.needle_radius_m = std::max(plan.needle_radius_m, max_radius_below(n.mesh, plan.horizon_m));
 
   plan.steps = options.steps > 0                        ? options.steps
                : options.overrides.steps                ? *options.overrides.steps
@@ -229,7 +241,7 @@ RunPlan plan_insertion(const Scene& scene, const std::vector<PreparedNeedle>& ne
   if (plan.pre == PreKind::Analytic) return plan;
 
   if (options.allow_reductions) {
-    merge_deep_layers(plan, influence_depth(plan.needle_radius_m, plan.depth_m));
+    merge_deep_layers(plan, influence_depth(plan.needle_radius_m, plan.horizon_m));
     cut_domain(plan, needles);
     if (plan.pre == PreKind::Full3d) choose_mirror_planes(plan, needles);
   }

@@ -28,9 +28,10 @@ struct RunPlan {
   double full_block_x_m = 0.0;  ///< as the scene gives it (block_x_m after a domain cut)
   double full_block_y_m = 0.0;
   double axisymmetric_radius_m = 0.0;
-  double depth_m = 0.0;
-  int steps = 0;
-  double needle_radius_m = 0.0;  ///< largest needle radius reaching the insertion depth
+  double depth_m = 0.0;    ///< the requested insertion depth: where the curve ends
+  double horizon_m = 0.0;  ///< the pre-puncture model's depth (a rung of pre_puncture_horizon)
+  int steps = 0;           ///< pre-puncture depth steps over the horizon
+  double needle_radius_m = 0.0;  ///< largest needle radius reaching the horizon
   std::string vtu_directory;
   std::vector<Reduction> reductions;
 };
@@ -49,10 +50,20 @@ double domain_reach(double needle_radius_m, double insertion_depth_m);
 
 inline constexpr double kDomainReach = 10.0;
 
+/// The pre-puncture model is built for a depth that depends on neither the requested insertion
+/// depth nor the outputs, so that the puncture is a property of the needle and the tissue
+/// (docs/model.md, "Pre-puncture horizon"): rung k is kFirstHorizon * 2^k. run_insertion climbs
+/// the rungs until the criterion fires or a rung covers the requested depth.
+inline constexpr double kFirstHorizon = 100e-6;
+double pre_puncture_horizon(int rung);
+/// The first rung whose horizon reaches `depth_m`.
+int rung_covering(double depth_m);
+
 /// Scene layers as FE layers; InputError names file:line of a layer with invalid constants.
 std::vector<fe::TissueLayer> fe_layers(const Scene& scene);
 
+/// The plan for one rung: the pre-puncture model to `horizon_m`, the curve to the scene's depth.
 RunPlan plan_insertion(const Scene& scene, const std::vector<PreparedNeedle>& needles,
-                       const InsertionRunOptions& options);
+                       const InsertionRunOptions& options, double horizon_m);
 
 }  // namespace mneedle::detail

@@ -12,6 +12,7 @@
 #include "mneedle/base/error.h"
 #include "mneedle/fe/indentation3d.h"
 #include "mneedle/fe/tissue_mesh.h"
+#include "mneedle/geometry/cross_section.h"
 #include "mneedle/insertion/analytic_indentation.h"
 #include "mneedle/insertion/puncture.h"
 #include "mneedle/insertion/surface_loads.h"
@@ -21,6 +22,25 @@ namespace {
 
 using detail::PreKind;
 using detail::RunPlan;
+
+// The area inside a needle's outer outline at the undeformed surface when its tip is `depth`
+// below it: the pressure criterion's area (docs/model.md, "Criteria"). The slicer is shared so
+// that bisection closures can keep it.
+class SectionArea {
+ public:
+  explicit SectionArea(const TriangleMesh& mesh)
+      : slicer_(std::make_shared<const CrossSectionSlicer>(mesh)) {}
+  double at(double depth) const {
+    return depth > 0.0 ? slicer_->slice(depth).outline_area_m2 : 0.0;
+  }
+
+ private:
+  std::shared_ptr<const CrossSectionSlicer> slicer_;
+};
+
+double pressure_over(double force, double area) {
+  return area > 0.0 ? force / area : 0.0;
+}
 
 // Pre-puncture history of one needle: the curve points and what the criteria read.
 struct PreSeries {
@@ -44,33 +64,43 @@ fe::ContactMode to_fe(Contact c) {
   return c == Contact::Frictionless ? fe::ContactMode::Frictionless : fe::ContactMode::Sticking;
 }
 
-// Tracks the criterion during the FE run so it can stop once every needle has crossed.
+// Tracks the criterion during a pre-puncture run: it stops once every needle has crossed, or
+// at the first step at or beyond the requested depth (the model itself is built for the
+// horizon, so where it stops changes nothing before that step).
 class CrossingWatch {
  public:
-  CrossingWatch(std::size_t needles, const std::optional<PunctureThreshold>& threshold)
-      : crossed_(needles, false), threshold_(threshold) {}
+  CrossingWatch(std::size_t needles, const RunPlan& plan)
+      : crossed_(needles, false), threshold_(plan.threshold), depth_m_(plan.depth_m) {}
   // False once every needle's criterion has reached the threshold.
   bool keep_going(std::size_t needle, const CriterionSample& s) {
+    if (threshold_ && criterion_value(threshold_->criterion, s) >= threshold_->threshold)
+      crossed_[needle] = true;
+    if (s.depth_m >= depth_m_ * (1.0 - 1e-12)) return false;
     if (!threshold_) return true;
-    if (criterion_value(threshold_->criterion, s) >= threshold_->threshold) crossed_[needle] = true;
     return !std::all_of(crossed_.begin(), crossed_.end(), [](bool c) { return c; });
   }
 
  private:
   std::vector<bool> crossed_;
   std::optional<PunctureThreshold> threshold_;
+  double depth_m_ = 0.0;
 };
 
 // The criterion's view of one needle at one depth: a 3-D NeedleStep3d or an axisymmetric
-// InsertionStep, which carry the same fields.
+// InsertionStep, which carry the same fields. The pressure is over the section's outline.
 template <class NeedleState>
-CriterionSample sample_of(double depth, const NeedleState& n) {
+CriterionSample sample_of(double depth, const NeedleState& n, const SectionArea& area) {
   CriterionSample s;
   s.depth_m = depth;
-  s.contact_pressure_Pa = n.contact_pressure_Pa;
+  s.contact_pressure_Pa = pressure_over(n.force_N, area.at(depth));
   s.tip_stress_Pa = n.tip_stress_Pa;
   s.energy_release_rate_J_per_m2 = n.energy_release_rate_J_per_m2;
   return s;
+}
+
+void set_section(RunPoint& p, const SectionArea& area) {
+  p.section_area_m2 = area.at(p.depth_m);
+  p.section_pressure_Pa = pressure_over(p.force_N, p.section_area_m2);
 }
 
 double tip_size_3d(const RunPlan& plan, const InsertionRunOptions& options) {
@@ -81,7 +111,8 @@ double tip_size_3d(const RunPlan& plan, const InsertionRunOptions& options) {
 }
 
 PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles,
-                 const InsertionRunOptions& options, double crack_depth) {
+                 const std::vector<SectionArea>& areas, const InsertionRunOptions& options,
+                 double crack_depth) {
   fe::TissueBlockSpec block;
   block.size_x = plan.block_x_m;
   block.size_y = plan.block_y_m;
@@ -91,7 +122,7 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
   fe::Simulation3dOptions o;
   o.fidelity = options.fidelity;
   o.order = options.overrides.order.value_or(2);
-  o.depth = plan.depth_m;
+  o.depth = plan.horizon_m;
   o.steps = plan.steps;
   o.vtu_directory = plan.vtu_directory;
   o.contact = to_fe(options.contact);
@@ -102,11 +133,11 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
     o.stress_average_length_m = plan.threshold->average_length_m;
   if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
     o.crack_depth_m = crack_depth;
-  CrossingWatch watch(needles.size(), plan.threshold);
+  CrossingWatch watch(needles.size(), plan);
   o.on_step = [&](const fe::Step3d& step) {
     bool more = true;
     for (std::size_t i = 0; i < step.needles.size(); ++i)
-      more = watch.keep_going(i, sample_of(step.depth_m, step.needles[i])) && more;
+      more = watch.keep_going(i, sample_of(step.depth_m, step.needles[i], areas[i])) && more;
     return more;
   };
   const fe::Simulation3dResult r = fe::simulate_3d(block, fe_needles, o);
@@ -125,8 +156,9 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
       p.strain_energy_J = step.strain_energy_J;
       p.tip_stress_Pa = n.tip_stress_Pa;
       p.energy_release_rate_J_per_m2 = n.energy_release_rate_J_per_m2;
+      set_section(p, areas[i]);
       out.needles[i].points.push_back(p);
-      out.needles[i].samples.push_back(sample_of(step.depth_m, n));
+      out.needles[i].samples.push_back(sample_of(step.depth_m, n, areas[i]));
     }
   out.nodes = r.nodes;
   out.elements = r.elements;
@@ -153,12 +185,13 @@ Reduction mirror_reduction(const RunPlan& plan) {
 }
 
 PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
-                           const InsertionRunOptions& options, double crack_depth) {
+                           const SectionArea& area, const InsertionRunOptions& options,
+                           double crack_depth) {
   fe::AxisymmetricProblem p;
   for (const fe::TissueLayer& l : plan.layers) p.layers.push_back({l.thickness, l.material});
   p.radius_m = plan.axisymmetric_radius_m;
   p.needle = *needle.axisymmetric;
-  p.depth_m = plan.depth_m;
+  p.depth_m = plan.horizon_m;
   p.fidelity = options.fidelity;
   p.contact = to_fe(options.contact);
   p.output_steps = plan.steps;
@@ -168,9 +201,9 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
     p.stress_average_length_m = plan.threshold->average_length_m;
   if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
     p.crack_depth_m = crack_depth;
-  CrossingWatch watch(1, plan.threshold);
+  CrossingWatch watch(1, plan);
   p.on_step = [&](const fe::InsertionStep& step) {
-    return watch.keep_going(0, sample_of(step.depth_m, step));
+    return watch.keep_going(0, sample_of(step.depth_m, step, area));
   };
   const fe::InsertionResult r = fe::simulate_axisymmetric(p);
   PreResult out;
@@ -184,8 +217,9 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
     pt.strain_energy_J = st.strain_energy_J;
     pt.tip_stress_Pa = st.tip_stress_Pa;
     pt.energy_release_rate_J_per_m2 = st.energy_release_rate_J_per_m2;
+    set_section(pt, area);
     out.needles[0].points.push_back(pt);
-    out.needles[0].samples.push_back(sample_of(st.depth_m, st));
+    out.needles[0].samples.push_back(sample_of(st.depth_m, st, area));
   }
   out.nodes = static_cast<int>(r.nodes);
   out.elements = static_cast<int>(r.elements);
@@ -198,7 +232,8 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
 // Closed-form path: each needle alone on the layered half-space through its equivalent body of
 // revolution (arrays: no interaction between the needles). Pressure is its only criterion.
 PreResult run_analytic(const RunPlan& plan, const Scene& scene,
-                       const std::vector<PreparedNeedle>& needles) {
+                       const std::vector<PreparedNeedle>& needles,
+                       const std::vector<SectionArea>& areas) {
   if (plan.threshold && plan.threshold->criterion != PunctureCriterion::Pressure)
     throw InputError(
         "simulate: the analytic model gives no stress field or energy release rate; "
@@ -206,30 +241,34 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
         std::string(to_string(plan.threshold->criterion)) +
         " criterion needs --model axisymmetric or 3d");
   std::vector<double> depths;
-  for (int k = 1; k <= plan.steps; ++k) depths.push_back(plan.depth_m * k / plan.steps);
+  for (int k = 1; k <= plan.steps; ++k) depths.push_back(plan.horizon_m * k / plan.steps);
   PreResult out;
-  for (const PreparedNeedle& n : needles) {
+  for (std::size_t i = 0; i < needles.size(); ++i) {
+    const PreparedNeedle& n = needles[i];
     auto profile = std::make_shared<const fe::AxisymmetricNeedle>(
         n.axisymmetric ? *n.axisymmetric
-                       : equivalent_axisymmetric_needle(n.mesh, 1.05 * plan.depth_m));
+                       : equivalent_axisymmetric_needle(n.mesh, 1.05 * plan.horizon_m));
     PreSeries series;
-    CrossingWatch watch(1, plan.threshold);
+    CrossingWatch watch(1, plan);
     for (const AnalyticStep& st : analytic_indentation(scene.tissue, *profile, depths)) {
       RunPoint p;
       p.depth_m = st.depth_m;
       p.force_N = st.force_N;
       p.contact_area_m2 = st.contact_area_m2;
       p.contact_pressure_Pa = st.contact_pressure_Pa;
+      set_section(p, areas[i]);
       CriterionSample c;
       c.depth_m = st.depth_m;
-      c.contact_pressure_Pa = st.contact_pressure_Pa;
+      c.contact_pressure_Pa = p.section_pressure_Pa;
       series.points.push_back(p);
       series.samples.push_back(c);
       if (!watch.keep_going(0, c)) break;
     }
     const Tissue tissue = scene.tissue;
-    series.resolve = [tissue, profile](double depth) {
-      return analytic_indentation(tissue, *profile, {depth}).front().contact_pressure_Pa;
+    const SectionArea area = areas[i];
+    series.resolve = [tissue, profile, area](double depth) {
+      return pressure_over(analytic_indentation(tissue, *profile, {depth}).front().force_N,
+                           area.at(depth));
     };
     out.needles.push_back(std::move(series));
   }
@@ -255,7 +294,7 @@ bool keep_reduction(Reduction& reduction, double f_reduced, double f_full,
 // The axisymmetric model is cheap: where layers were merged, run it once more on the scene's own
 // layers and measure the relative change of the force at the last common step. A merge that
 // changes it by more than the fidelity's tolerance is undone (the full-layer run is used).
-void check_layer_merge(const RunPlan& plan, const PreparedNeedle& needle,
+void check_layer_merge(const RunPlan& plan, const PreparedNeedle& needle, const SectionArea& area,
                        const InsertionRunOptions& options, double crack_depth, PreResult& reduced,
                        std::vector<Reduction>& reductions) {
   auto merge = std::find_if(reductions.begin(), reductions.end(),
@@ -266,15 +305,14 @@ void check_layer_merge(const RunPlan& plan, const PreparedNeedle& needle,
   full.threshold.reset();  // same depth steps, no early stop: compare at the reduced run's end
   full.vtu_directory.clear();
   full.depth_m = reduced.needles[0].points.back().depth_m;
-  full.steps = static_cast<int>(reduced.needles[0].points.size());
-  const PreResult reference = run_axisymmetric(full, needle, options, 0.0);
+  const PreResult reference = run_axisymmetric(full, needle, area, options, 0.0);
   if (keep_reduction(*merge, reduced.needles[0].points.back().force_N,
                      reference.needles[0].points.back().force_N, options,
                      "the scene's own layers were used"))
     return;
   RunPlan unmerged = plan;
   unmerged.layers = plan.full_layers;
-  reduced = run_axisymmetric(unmerged, needle, options, crack_depth);
+  reduced = run_axisymmetric(unmerged, needle, area, options, crack_depth);
 }
 
 // The domain cut's truncation error, measured with the axisymmetric model (the needle itself, or
@@ -282,22 +320,21 @@ void check_layer_merge(const RunPlan& plan, const PreparedNeedle& needle,
 // step on the cut and on the full domain. Above the fidelity's tolerance the cut is undone and
 // the pre-puncture model runs again on the full block.
 void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
-                      const InsertionRunOptions& options, double crack_depth, PreResult& reduced,
-                      std::vector<Reduction>& reductions) {
+                      const std::vector<SectionArea>& areas, const InsertionRunOptions& options,
+                      double crack_depth, PreResult& reduced, std::vector<Reduction>& reductions) {
   auto cut = std::find_if(reductions.begin(), reductions.end(),
                           [](const Reduction& r) { return r.name == "domain_cut"; });
   if (cut == reductions.end() || reduced.needles[0].points.empty()) return;
   PreparedNeedle proxy = needles[0];
   if (!proxy.axisymmetric)
-    proxy.axisymmetric = equivalent_axisymmetric_needle(proxy.mesh, 1.05 * plan.depth_m);
+    proxy.axisymmetric = equivalent_axisymmetric_needle(proxy.mesh, 1.05 * plan.horizon_m);
   auto reference_on = [&](double size_x, double size_y) {
     RunPlan probe = plan;
     probe.axisymmetric_radius_m = fe::equal_area_radius(std::sqrt(size_x * size_y));
     probe.threshold.reset();  // same depth steps, no early stop
     probe.vtu_directory.clear();
     probe.depth_m = reduced.needles[0].points.back().depth_m;
-    probe.steps = static_cast<int>(reduced.needles[0].points.size());
-    return run_axisymmetric(probe, proxy, options, 0.0).needles[0].points.back().force_N;
+    return run_axisymmetric(probe, proxy, areas[0], options, 0.0).needles[0].points.back().force_N;
   };
   const double f_full = reference_on(plan.full_block_x_m, plan.full_block_y_m);
   const double f_cut = plan.pre == PreKind::Axisymmetric
@@ -308,8 +345,8 @@ void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
   plan.block_y_m = plan.full_block_y_m;
   plan.axisymmetric_radius_m = fe::equal_area_radius(std::sqrt(plan.block_x_m * plan.block_y_m));
   reduced = plan.pre == PreKind::Axisymmetric
-                ? run_axisymmetric(plan, needles[0], options, crack_depth)
-                : run_3d(plan, needles, options, crack_depth);
+                ? run_axisymmetric(plan, needles[0], areas[0], options, crack_depth)
+                : run_3d(plan, needles, areas, options, crack_depth);
 }
 
 double axisymmetric_tip_size(const RunPlan& plan, const PreparedNeedle& needle,
@@ -319,7 +356,7 @@ double axisymmetric_tip_size(const RunPlan& plan, const PreparedNeedle& needle,
   for (const fe::TissueLayer& l : plan.layers) p.layers.push_back({l.thickness, l.material});
   p.radius_m = plan.axisymmetric_radius_m;
   p.needle = *needle.axisymmetric;
-  p.depth_m = plan.depth_m;
+  p.depth_m = plan.horizon_m;
   p.fidelity = options.fidelity;
   return fe::mesh_options_for(p).h_m;
 }
@@ -370,7 +407,7 @@ RunPoint interpolated_point(const std::vector<RunPoint>& points, double depth) {
 }
 
 NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const RunPlan& plan,
-                          const SurfaceLoadModel* post) {
+                          const SectionArea& area, const SurfaceLoadModel* post) {
   NeedleRun run;
   run.name = name;
   std::optional<Crossing> crossing;
@@ -380,22 +417,48 @@ NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const R
       depths.push_back(s.depth_m);
       values.push_back(criterion_value(plan.threshold->criterion, s));
     }
-    // Bisection where the criterion is cheap to re-evaluate: the depth is then exact to 1e-4
-    // of a step rather than linear between the steps.
-    const double tolerance = plan.depth_m / std::max(plan.steps, 1) * 1e-4;
-    crossing = first_crossing(depths, values, plan.threshold->threshold, pre.resolve, tolerance);
+    // The pressure is F(d) / A_sec(d) with A_sec exact at any depth: bisect on it with F linear
+    // between the steps, so the depth moves continuously with the design (analytic runs bring
+    // their own exact resolve).
+    std::function<double(double)> resolve = pre.resolve;
+    if (!resolve && plan.threshold->criterion == PunctureCriterion::Pressure) {
+      const std::vector<RunPoint>& points = pre.points;
+      resolve = [&points, &area](double depth) {
+        return pressure_over(interpolated_point(points, depth).force_N, area.at(depth));
+      };
+    }
+    const double tolerance = plan.horizon_m / std::max(plan.steps, 1) * 1e-6;
+    crossing = first_crossing(depths, values, plan.threshold->threshold, resolve, tolerance);
+    if (crossing && crossing->depth_m > plan.depth_m * (1.0 + 1e-12)) crossing.reset();
+    // Above the threshold at the first step: nothing before it was computed, so the crossing
+    // cannot be placed inside the step. It is reported at the step, flagged at_first_contact.
+    if (crossing && crossing->step == 0) {
+      crossing->depth_m = depths.front();
+      crossing->fraction = 1.0;
+    }
   }
   if (!crossing) {
-    run.curve = pre.points;
+    // Up to the requested depth; a last step beyond it is cut there (linear in between).
+    for (const RunPoint& p : pre.points)
+      if (p.depth_m < plan.depth_m * (1.0 - 1e-12)) run.curve.push_back(p);
+    if (!pre.points.empty()) {
+      RunPoint end = pre.points.back().depth_m > plan.depth_m
+                         ? interpolated_point(pre.points, plan.depth_m)
+                         : pre.points.back();
+      set_section(end, area);
+      run.curve.push_back(end);
+    }
   } else {
     for (const RunPoint& p : pre.points)
       if (p.depth_m < crossing->depth_m) run.curve.push_back(p);
-    const RunPoint at = interpolated_point(pre.points, crossing->depth_m);
+    RunPoint at = interpolated_point(pre.points, crossing->depth_m);
+    set_section(at, area);
     run.curve.push_back(at);
     Puncture puncture;
     puncture.depth_m = crossing->depth_m;
     puncture.force_N = at.force_N;
     puncture.criterion = plan.threshold->criterion;
+    puncture.at_first_contact = crossing->step == 0;
     if (post != nullptr) {
       puncture.post_force_N = post->at(crossing->depth_m).force_N;
       if (plan.post_stage) {
@@ -491,16 +554,65 @@ void check_needles(const Scene& scene, const std::vector<PreparedNeedle>& needle
     throw InputError(scene.source_name + ": insertion.depth: must be positive");
 }
 
+// One rung of the pre-puncture model: the FE (or analytic) run for plan.horizon_m, with the
+// planner's reductions checked. Fills the run's mesh summary and crack depth.
+PreResult run_pre(RunPlan& plan, const Scene& scene, const std::vector<PreparedNeedle>& needles,
+                  const std::vector<SectionArea>& areas, const InsertionRunOptions& options,
+                  InsertionRun& run) {
+  PreResult pre;
+  run.crack_depth_m = 0.0;
+  switch (plan.pre) {
+    case PreKind::Full3d:
+      if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
+        run.crack_depth_m = crack_depth_for(plan.needle_radius_m, tip_size_3d(plan, options));
+      pre = run_3d(plan, needles, areas, options, run.crack_depth_m);
+      check_domain_cut(plan, needles, areas, options, run.crack_depth_m, pre, run.reductions);
+      if (plan.half_model || plan.mirror_x) run.reductions.push_back(mirror_reduction(plan));
+      break;
+    case PreKind::Axisymmetric:
+      if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
+        run.crack_depth_m =
+            crack_depth_for(plan.needle_radius_m, axisymmetric_tip_size(plan, needles[0], options));
+      pre = run_axisymmetric(plan, needles[0], areas[0], options, run.crack_depth_m);
+      check_layer_merge(plan, needles[0], areas[0], options, run.crack_depth_m, pre,
+                        run.reductions);
+      check_domain_cut(plan, needles, areas, options, run.crack_depth_m, pre, run.reductions);
+      break;
+    case PreKind::Analytic:
+      pre = run_analytic(plan, scene, needles, areas);
+      break;
+    case PreKind::None:
+      break;
+  }
+  return pre;
+}
+
+// True when every needle's criterion reached its threshold within the requested depth.
+bool every_needle_crossed(const RunPlan& plan, const PreResult& pre) {
+  if (!plan.threshold) return false;
+  return std::all_of(pre.needles.begin(), pre.needles.end(), [&](const PreSeries& s) {
+    return std::any_of(s.samples.begin(), s.samples.end(), [&](const CriterionSample& c) {
+      return c.depth_m <= plan.depth_m * (1.0 + 1e-12) &&
+             criterion_value(plan.threshold->criterion, c) >= plan.threshold->threshold;
+    });
+  });
+}
+
 }  // namespace
 
 InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>& needles,
                            const InsertionRunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   check_needles(scene, needles);
-  RunPlan plan = detail::plan_insertion(scene, needles, options);
+  // The pre-puncture model climbs the horizon ladder (docs/model.md, "Pre-puncture horizon"):
+  // rung k is built for 100 um x 2^k whatever depth was asked, and the first rung on which every
+  // criterion fires (or that covers the requested depth) gives the answer. The same needle and
+  // tissue thus give the same puncture for any requested depth beyond it.
+  const int last_rung = detail::rung_covering(scene.insertion.depth);
+  RunPlan plan =
+      detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(last_rung));
   InsertionRun run;
   run.fidelity = options.fidelity;
-  run.reductions = plan.reductions;
   if (plan.threshold) {
     run.criterion = plan.threshold->criterion;
     run.threshold = plan.threshold->threshold;
@@ -514,33 +626,23 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     for (std::size_t i = 0; i < needles.size(); ++i) post[i].emplace(needles[i].mesh, constants);
 
   if (plan.pre == PreKind::None) {
+    run.reductions = plan.reductions;
     for (std::size_t i = 0; i < needles.size(); ++i)
       run.needles.push_back(post_only_needle(needles[i].name, plan, *post[i]));
     run.models_run.push_back("surface_loads");
   } else {
+    std::vector<SectionArea> areas;
+    for (const PreparedNeedle& n : needles) areas.emplace_back(n.mesh);
     PreResult pre;
-    switch (plan.pre) {
-      case PreKind::Full3d:
-        if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
-          run.crack_depth_m = crack_depth_for(plan.needle_radius_m, tip_size_3d(plan, options));
-        pre = run_3d(plan, needles, options, run.crack_depth_m);
-        check_domain_cut(plan, needles, options, run.crack_depth_m, pre, run.reductions);
-        if (plan.half_model || plan.mirror_x) run.reductions.push_back(mirror_reduction(plan));
-        break;
-      case PreKind::Axisymmetric:
-        if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
-          run.crack_depth_m = crack_depth_for(plan.needle_radius_m,
-                                              axisymmetric_tip_size(plan, needles[0], options));
-        pre = run_axisymmetric(plan, needles[0], options, run.crack_depth_m);
-        check_layer_merge(plan, needles[0], options, run.crack_depth_m, pre, run.reductions);
-        check_domain_cut(plan, needles, options, run.crack_depth_m, pre, run.reductions);
-        break;
-      case PreKind::Analytic:
-        pre = run_analytic(plan, scene, needles);
-        break;
-      case PreKind::None:
-        break;
+    // Without a criterion nothing can fire early: the rung covering the depth is the answer.
+    for (int rung = plan.threshold ? 0 : last_rung; rung <= last_rung; ++rung) {
+      plan = detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(rung));
+      run.reductions = plan.reductions;
+      pre = run_pre(plan, scene, needles, areas, options, run);
+      if (every_needle_crossed(plan, pre)) break;
     }
+    run.horizon_m = plan.horizon_m;
+    run.first_step_m = plan.horizon_m / std::max(plan.steps, 1);
     run.models_run.push_back(pre.model);
     run.nodes = pre.nodes;
     run.elements = pre.elements;
@@ -550,8 +652,8 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     run.max_aspect_ratio = pre.max_aspect_ratio;
     bool any_post = false;
     for (std::size_t i = 0; i < needles.size(); ++i) {
-      run.needles.push_back(
-          assemble_needle(needles[i].name, pre.needles[i], plan, post[i] ? &*post[i] : nullptr));
+      run.needles.push_back(assemble_needle(needles[i].name, pre.needles[i], plan, areas[i],
+                                            post[i] ? &*post[i] : nullptr));
       any_post = any_post || run.needles.back().puncture.has_value();
     }
     if (any_post) run.models_run.push_back("surface_loads");

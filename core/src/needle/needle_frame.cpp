@@ -3,7 +3,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -35,19 +37,30 @@ double size_of(const TriangleMesh& mesh) {
   return (to_eigen(box.max) - to_eigen(box.min)).norm();
 }
 
-// Area centroid of the surface; the fallback for meshes that enclose no volume.
-Vector3d area_centroid(const TriangleMesh& mesh) {
+// Area centroid of the faces `keep` accepts (corners a, b, c); nullopt when they have no area.
+std::optional<Vector3d> area_centroid_of(
+    const TriangleMesh& mesh,
+    const std::function<bool(const Vector3d&, const Vector3d&, const Vector3d&)>& keep) {
   Vector3d weighted = Vector3d::Zero();
   double area = 0.0;
   for (const Triangle& t : mesh.triangles) {
     const Vector3d a = to_eigen(mesh.vertices[t[0]]);
     const Vector3d b = to_eigen(mesh.vertices[t[1]]);
     const Vector3d c = to_eigen(mesh.vertices[t[2]]);
+    if (!keep(a, b, c)) continue;
     const double dA = 0.5 * (b - a).cross(c - a).norm();
     weighted += dA * (a + b + c) / 3.0;
     area += dA;
   }
-  return area > 0.0 ? Vector3d(weighted / area) : to_eigen(mesh.vertices.front());
+  if (!(area > 0.0)) return std::nullopt;
+  return Vector3d(weighted / area);
+}
+
+// Area centroid of the surface; the fallback for meshes that enclose no volume.
+Vector3d area_centroid(const TriangleMesh& mesh) {
+  return area_centroid_of(mesh,
+                          [](const Vector3d&, const Vector3d&, const Vector3d&) { return true; })
+      .value_or(to_eigen(mesh.vertices.front()));
 }
 
 Vector3d centroid(const TriangleMesh& mesh) {
@@ -126,6 +139,24 @@ std::pair<double, double> extent_along(const TriangleMesh& mesh, const Vector3d&
     high = std::max(high, h);
   }
   return {low, high};
+}
+
+// A point of the shaft's axis: the area centroid of the base, the faces at the end farthest
+// from the tip that face away from it (the section of the shaft there, bore excluded, whose
+// centroid is on the axis of a tube however its wall is triangulated). The volume centroid is
+// not on it: a bevel's cut moves it toward the heel. Falls back to `center` without a flat base.
+Vector3d shaft_axis_point(const TriangleMesh& mesh, const Vector3d& center,
+                          const Vector3d& direction) {
+  const auto [low, high] = extent_along(mesh, center, direction);
+  const double level = low + kRelativeTolerance * std::max(high - low, size_of(mesh));
+  auto at_base = [&](const Vector3d& p) { return (p - center).dot(direction) <= level; };
+  return area_centroid_of(mesh,
+                          [&](const Vector3d& a, const Vector3d& b, const Vector3d& c) {
+                            const Vector3d n = (b - a).cross(c - a);
+                            return at_base(a) && at_base(b) && at_base(c) &&
+                                   n.dot(direction) <= -0.999 * n.norm();
+                          })
+      .value_or(center);
 }
 
 std::string format_vector(const Vector3d& v) {
@@ -227,6 +258,11 @@ FrameInfo find_needle_frame(const TriangleMesh& mesh, const AxisChoice& choice) 
   }
   info.axis = to_vec3(direction);
   info.tip = to_vec3(find_tip(mesh, center, direction, info.note));
+  // The shaft axis where it crosses the tip's level: the frame's origin.
+  const Vector3d shaft = shaft_axis_point(mesh, center, direction);
+  const Vector3d tip = to_eigen(info.tip);
+  info.origin = to_vec3(shaft + (tip - shaft).dot(direction) * direction);
+  info.tip_offset_m = (tip - to_eigen(info.origin)).norm();
   return info;
 }
 
@@ -237,8 +273,8 @@ FrameInfo place_in_needle_frame(TriangleMesh& mesh, const AxisChoice& choice) {
   const Matrix3d rotation =
       Eigen::Quaterniond::FromTwoVectors(to_eigen(info.axis), Vector3d(0.0, 0.0, -1.0))
           .toRotationMatrix();
-  const Vector3d tip = to_eigen(info.tip);
-  for (Vec3& p : mesh.vertices) p = to_vec3(rotation * (to_eigen(p) - tip));
+  const Vector3d origin = to_eigen(info.origin);
+  for (Vec3& p : mesh.vertices) p = to_vec3(rotation * (to_eigen(p) - origin));
   return info;
 }
 

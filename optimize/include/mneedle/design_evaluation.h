@@ -35,6 +35,9 @@ struct PunctureSummary {
   double force_N = 0.0;       // pre-puncture force at that depth
   double post_force_N = 0.0;  // post-puncture model's force at that depth
   std::string criterion;      // pressure | energy | stress
+  /// The criterion fired at the first depth step (docs/model.md, "Criteria"): the depth is the
+  /// step's, not the tissue's; ranked after every resolved puncture, never an objective.
+  bool at_first_contact = false;
 };
 
 struct DesignEvaluation {

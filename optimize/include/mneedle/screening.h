@@ -50,6 +50,7 @@ struct ScreeningRow {
   std::string json;
   std::optional<double> puncture_depth_m;  // empty: no puncture up to the target depth
   double puncture_force_n = 0.0;
+  bool puncture_at_first_contact = false;  // the depth is unresolved: ranked after the others
   double peak_force_n = 0.0;
   double margin = 0.0;
   bool passes = false;

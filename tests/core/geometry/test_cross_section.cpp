@@ -38,6 +38,25 @@ TEST(CrossSection, NestedLoopsSubtractTheHole) {
   EXPECT_DOUBLE_EQ(mneedle::nested_polygon_area(loops), 15.0);
 }
 
+TEST(CrossSection, OutlineAreaIsTheConvexHullOfTheLoops) {
+  const std::vector<std::vector<mneedle::Point2>> loops{{{0, 0}, {4, 0}, {4, 4}, {0, 4}},
+                                                        {{1, 1}, {1, 2}, {2, 2}, {2, 1}},
+                                                        {{5, 0}, {6, 0}, {6, 1}, {5, 1}}};
+  EXPECT_DOUBLE_EQ(mneedle::outline_area(loops), 21.0);  // hull (0,0) (6,0) (6,1) (4,4) (0,4)
+}
+
+TEST(CrossSection, HollowBevelOutlineIsTheOuterSegment) {
+  // A hollow sharp bevel's outline at height h is the solid bevel's segment: the bore is filled.
+  ShapeOptions hollow;
+  hollow.bore = 45e-6;
+  const double h = 0.4 * 2.0 * kR / std::tan(kBevel);
+  const auto with_bore = mneedle::cross_section(mneedle::test::sharp_bevel(hollow, kBevel), h);
+  const auto solid = mneedle::cross_section(mneedle::test::sharp_bevel({}, kBevel), h);
+  EXPECT_LT(with_bore.area_m2, solid.area_m2);
+  // Same outer facets in both meshes: equal to round-off.
+  EXPECT_NEAR(with_bore.outline_area_m2, solid.area_m2, 1e-9 * solid.area_m2);
+}
+
 TEST(CrossSection, CylinderSectionIsThePolygonArea) {
   const auto section = mneedle::cross_section(mneedle::test::cylinder({}), 333e-6);
   EXPECT_EQ(section.polygons.size(), 1u);

@@ -65,14 +65,16 @@ TEST(InsertionRun, FlatPunchPuncturesWhereItsLinearPressureReachesTheThreshold) 
   EXPECT_TRUE(run.axisymmetric);
   const NeedleRun& n = run.needles.front();
   ASSERT_TRUE(n.puncture.has_value());
-  // Linear tissue, flat punch: contact area constant, so P = F / A is linear in depth and the
-  // interpolated crossing is exact: P(d_p) = P_c.
+  // Linear tissue, flat punch: the section's outline is the same at every depth, so P = F / A_sec
+  // is linear in depth and the bisected crossing is exact: P(d_p) = P_c (to the bisection's
+  // 1e-6 of a step).
   const RunPoint* last_pre = nullptr;
   for (const RunPoint& p : n.curve)
     if (p.stage == Stage::Pre && p.depth_m < n.puncture->depth_m) last_pre = &p;
   ASSERT_NE(last_pre, nullptr);
-  const double slope = last_pre->contact_pressure_Pa / last_pre->depth_m;
-  EXPECT_NEAR(slope * n.puncture->depth_m, 0.3e6, 0.3e6 * 1e-3);
+  const double slope = last_pre->section_pressure_Pa / last_pre->depth_m;
+  EXPECT_NEAR(slope * n.puncture->depth_m, 0.3e6, 0.3e6 * 1e-5);
+  EXPECT_FALSE(n.puncture->at_first_contact);
   // Boussinesq with the bonded layer: P = 2 E* d / (pi a) (1 + ~10 %) -> d_p ~ 200 um.
   EXPECT_GT(n.puncture->depth_m, 150e-6);
   EXPECT_LT(n.puncture->depth_m, 260e-6);
@@ -129,7 +131,13 @@ TEST(InsertionRun, SceneWithoutPunctureDataRunsThePreStageToFullDepth) {
   const InsertionRun run = run_insertion(scene, {punch("punch", 115e-6)}, fast());
   EXPECT_FALSE(run.criterion.has_value());
   EXPECT_FALSE(run.needles.front().puncture.has_value());
-  EXPECT_EQ(run.needles.front().curve.size(), 10u);  // fast: 10 steps
+  // The rung covering 300 um is 400 um, in 10 steps (fast) of 40 um: seven steps below 300 um
+  // and the curve's end at 300 um.
+  const auto& curve = run.needles.front().curve;
+  ASSERT_EQ(curve.size(), 8u);
+  EXPECT_NEAR(curve[6].depth_m, 280e-6, 1e-15);
+  EXPECT_NEAR(curve.back().depth_m, 300e-6, 1e-15);
+  EXPECT_NEAR(run.horizon_m, 400e-6, 1e-15);
 }
 
 TEST(InsertionRun, ExplicitCriterionWithoutItsDataIsAnInputError) {
@@ -173,10 +181,11 @@ TEST(ScenePlanner, PunctureOnlyStopsTheFiniteElementsAtThePuncture) {
 }
 
 TEST(ScenePlanner, DeepLayersMergeIntoTheSubstrateWithinTheTolerance) {
-  // Influence depth 10 (a + d) = 10 (115 + 50) um = 1650 um: the two layers below 1800 um merge.
+  // Influence depth 10 (a + H) = 10 (115 + 100) um = 2150 um, H the first pre-puncture horizon
+  // (the one covering the 50 um asked for): the two layers below 2300 um merge.
   const std::string layers =
       "thickness = \"400 um\"\n"
-      "[[tissue.layers]]\nname = \"middle\"\nthickness = \"1400 um\"\n"
+      "[[tissue.layers]]\nname = \"middle\"\nthickness = \"1900 um\"\n"
       "material = { model = \"linear\", E = \"0.25 MPa\", nu = 0.45 }\n"
       "[[tissue.layers]]\nname = \"deep\"\nthickness = \"200 um\"\n"
       "material = { model = \"linear\", E = \"0.1 MPa\", nu = 0.45 }\n"
@@ -210,7 +219,7 @@ TEST(ScenePlanner, MergeThatChangesTheForceBeyondTheToleranceIsUndone) {
   // reports the merge as rejected and its result is the full-layer model's.
   const std::string layers =
       "thickness = \"400 um\"\n"
-      "[[tissue.layers]]\nname = \"middle\"\nthickness = \"1400 um\"\n"
+      "[[tissue.layers]]\nname = \"middle\"\nthickness = \"1900 um\"\n"
       "material = { model = \"linear\", E = \"0.25 MPa\", nu = 0.45 }\n"
       "[[tissue.layers]]\nname = \"deep\"\nthickness = \"200 um\"\n"
       "material = { model = \"linear\", E = \"0.1 MPa\", nu = 0.45 }\n"

@@ -11,6 +11,7 @@
 #include "mneedle/base/error.h"
 #include "mneedle/needle/mesh.h"
 #include "mneedle/needle/mesh_io.h"
+#include "needle_shapes.h"
 
 namespace {
 
@@ -180,6 +181,23 @@ TEST(NeedleFrame, ResultIsIndependentOfRigidMotion) {
     mneedle::place_in_needle_frame(automatic, choice);
     expect_same_up_to_roll(automatic, reference, 1e-9);
   }
+}
+
+TEST(NeedleFrame, BevelIsPlacedByItsShaftAxisNotByItsTip) {
+  // A sharp bevel in the plugins' frame (shaft axis = z, tip on the rim at (R, 0, 0)), moved
+  // rigidly: placing it must give back the same heights and distances from the axis, so the tip
+  // stays one radius off the axis (a frame through the tip would put the shaft's axis there).
+  mneedle::test::ShapeOptions o;
+  o.bore = 45e-6;
+  const TriangleMesh reference = mneedle::test::sharp_bevel(o, std::numbers::pi / 6.0);
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  TriangleMesh given = moved(reference, rotation, {1e-3, -2e-3, 5e-4});
+  const Eigen::Vector3d d = rotation * Eigen::Vector3d(0, 0, -1);
+  const FrameInfo info = mneedle::place_in_needle_frame(given, Vec3{d.x(), d.y(), d.z()});
+  // Round-off of metre-sized sums over micrometre features: 1e-12 m.
+  expect_same_up_to_roll(given, reference, 1e-12);
+  EXPECT_NEAR(info.tip_offset_m, o.radius, 1e-12);
 }
 
 TEST(NeedleFrame, ZeroOrNonFiniteDirectionIsAnInputError) {

@@ -16,11 +16,18 @@ struct CrossSection {
   double height_m = 0.0;                      ///< above the tip (the mesh's lowest vertex)
   std::vector<std::vector<Point2>> polygons;  ///< closed loops in (x, y), first point not repeated
   double area_m2 = 0.0;                       ///< outer loops minus the holes they contain (bores)
+  /// Area of the section's convex hull: the needle's outline at this height with the bore (and
+  /// a hollow bevel's crescent) filled, the area the pressure criterion divides by
+  /// (docs/model.md, "Criteria").
+  double outline_area_m2 = 0.0;
 };
 
 /// Net area of nested loops: each loop's |shoelace area| counted + when an even number of the
 /// other loops contain it and - when odd, so a bore inside a shaft is subtracted.
 double nested_polygon_area(const std::vector<std::vector<Point2>>& polygons);
+
+/// Area of the convex hull of every loop's points (holes, crescents and notches filled).
+double outline_area(const std::vector<std::vector<Point2>>& polygons);
 
 /// +1 when loop `i` is material, -1 when it is a hole (inside an odd number of the other loops),
 /// the rule nested_polygon_area applies; 0 for a loop of fewer than three points.

@@ -53,8 +53,13 @@ struct RunPoint {
   Stage stage = Stage::Pre;
   // Pre-puncture (FE or analytic) quantities; zero after puncture.
   double lateral_force_N[2] = {0.0, 0.0};
-  double contact_area_m2 = 0.0;
-  double contact_pressure_Pa = 0.0;
+  double contact_area_m2 = 0.0;      ///< FE: captured surface projected on z = 0 (mesh-bound)
+  double contact_pressure_Pa = 0.0;  ///< force_N / contact_area_m2
+  /// Area inside the needle's outer outline at the undeformed surface (the section at the
+  /// tip's travel below z = 0, bores filled) and force_N over it: the pressure criterion's
+  /// quantity, independent of the mesh (docs/model.md, "Criteria").
+  double section_area_m2 = 0.0;
+  double section_pressure_Pa = 0.0;
   double strain_energy_J = 0.0;
   /// Criterion quantities, computed only for the criterion in use (else 0).
   double tip_stress_Pa = 0.0;                 ///< stress: averaged max principal stress
@@ -70,6 +75,10 @@ struct Puncture {
   double force_N = 0.0;       ///< pre-puncture force at that depth
   double post_force_N = 0.0;  ///< post-puncture model's force at that depth
   PunctureCriterion criterion = PunctureCriterion::Pressure;
+  /// The criterion was already above its threshold at the first depth step: it fires on
+  /// contact for this tip and tissue (a pressure singular at the tip), so the depth reflects
+  /// the step, not the tissue. Never rank or optimise on such a depth.
+  bool at_first_contact = false;
 };
 
 struct NeedleRun {
@@ -97,6 +106,10 @@ struct InsertionRun {
   std::optional<PunctureCriterion> criterion;
   std::optional<double> threshold;  ///< the criterion's threshold (Pa or J/m^2)
   double crack_depth_m = 0.0;       ///< energy criterion: depth of the crack G is computed with
+  /// Depth the pre-puncture model was built for (docs/model.md, "Pre-puncture horizon"): a rung
+  /// of 100 um x 2^k, the first whose run fired the criterion or covered the requested depth.
+  double horizon_m = 0.0;
+  double first_step_m = 0.0;  ///< the pre-puncture model's depth step on that rung
   // Mesh summary of the FE stage (zeros when none ran).
   int nodes = 0;
   int elements = 0;

@@ -34,7 +34,7 @@ PunctureThreshold puncture_threshold(const Scene& scene, PunctureCriterion crite
 /// Quantities of one pre-puncture depth step that the criteria read.
 struct CriterionSample {
   double depth_m = 0.0;
-  double contact_pressure_Pa = 0.0;           ///< mean contact pressure F / A (projected area)
+  double contact_pressure_Pa = 0.0;           ///< F / A_sec: force over the outline area at z = 0
   double tip_stress_Pa = 0.0;                 ///< averaged max principal stress under the tip
   double energy_release_rate_J_per_m2 = 0.0;  ///< G of a crack under the tip
 };

@@ -1,6 +1,8 @@
 #pragma once
-// The needle frame used by everything downstream: tip at the origin, the needle's body along
-// +z, insertion toward -z into tissue whose undeformed surface is the plane z = 0.
+// The needle frame used by everything downstream (the same one tip-shape plugins generate in):
+// the shaft's axis is the z axis, the tip (the lowest point) is at z = 0, the body runs along
+// +z, insertion toward -z into tissue whose undeformed surface is the plane z = 0. A symmetric
+// tip is at the origin; a bevel's tip is on the rim, one radius from it.
 
 #include <optional>
 #include <string>
@@ -10,8 +12,12 @@
 namespace mneedle {
 
 struct FrameInfo {
-  Vec3 axis{};             ///< unit direction the tip points, in the input coordinates
-  Vec3 tip{};              ///< tip point in the input coordinates (metres)
+  Vec3 axis{};  ///< unit direction the tip points, in the input coordinates
+  Vec3 tip{};   ///< tip point in the input coordinates (metres)
+  /// Where the shaft's axis crosses the tip's level, in the input coordinates: the frame's
+  /// origin. The tip lies tip_offset_m from it (a bevel's tip is on the rim, one radius off).
+  Vec3 origin{};
+  double tip_offset_m = 0.0;
   bool auto_axis = false;  ///< axis found by principal-component analysis
   std::string note;        ///< how the tip was found, e.g. which end `auto` chose
 };
@@ -27,9 +33,10 @@ struct AxisChoice {
 /// tip is at the lowest z; a direction names where the tip points. The tip is the single
 /// extreme vertex along the direction; a flat or hollow tip (several extreme vertices apart)
 /// has no tip point, and the tip is then the point of the centroid's axis line in the lowest
-/// cross-section. The axis passes through the volume centroid (area centroid when the mesh
-/// encloses no volume). Throws mneedle::InputError for an empty mesh or a zero or
-/// non-finite direction.
+/// cross-section. The tip direction's line through the volume centroid (area centroid when the
+/// mesh encloses no volume) finds the tip; the frame's axis is the shaft's, through the area
+/// centroid of the quarter of the surface farthest from the tip. Throws mneedle::InputError for
+/// an empty mesh or a zero or non-finite direction.
 FrameInfo place_in_needle_frame(TriangleMesh& mesh, std::optional<Vec3> tip_direction);
 
 /// As above with the automatic choice available: the principal axis of the surface
