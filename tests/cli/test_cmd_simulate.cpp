@@ -17,6 +17,7 @@
 
 namespace {
 
+namespace fs = std::filesystem;
 using mneedle::test::CommandRun;
 using mneedle::test::run_mneedle;
 
@@ -216,6 +217,56 @@ TEST(CmdSimulate, CsvHasAStageColumn) {
   int post = 0;
   while (std::getline(lines, row)) post += row.find(",post,") != std::string::npos ? 1 : 0;
   EXPECT_GT(post, 0);
+}
+
+// The same needle and tissue give the same puncture through every path (docs/model.md,
+// "Pre-puncture horizon"): the plugin or the STL `generate` wrote from the same parameters
+// (within 2 %: the STL stores single-precision millimetres and the tissue grid follows the
+// mesh's vertices), and `simulate` or `screen` on the STL (identical: one evaluation).
+TEST(CmdSimulate, SameNeedleSamePunctureFromPluginStlSimulateAndScreen) {
+  const fs::path dir = fs::temp_directory_path() / ("mneedle_paths_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const CommandRun gen = run_mneedle(
+      "generate sharp_bevel --set diameter=230um --set length=1000um"
+      " --set bevel_angle=30deg -o '" +
+      (dir / "bevel.stl").string() + "'");
+  ASSERT_EQ(gen.exit_code, 0) << gen.err;
+  std::ifstream in(scene("bevel_silicone_3d.toml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string stl_scene = text.str();
+  const std::string plugin_line =
+      "geometry = { plugin = \"sharp_bevel\", diameter = \"230 um\", length = \"1000 um\", "
+      "bevel_angle = \"30 deg\" }";
+  const auto at = stl_scene.find(plugin_line);
+  ASSERT_NE(at, std::string::npos);
+  stl_scene.replace(at, plugin_line.size(), "geometry = { stl = \"bevel.stl\", unit = \"mm\" }");
+  std::ofstream(dir / "stl.toml") << stl_scene;
+
+  auto puncture_of = [](const CommandRun& run) {
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    const auto j = nlohmann::json::parse(run.out);
+    EXPECT_TRUE(j["needles"][0]["puncture"].is_object()) << run.out;
+    return j["needles"][0]["puncture"];
+  };
+  const auto plugin =
+      puncture_of(run_mneedle("simulate '" + scene("bevel_silicone_3d.toml") + "' --json"));
+  const auto stl =
+      puncture_of(run_mneedle("simulate '" + (dir / "stl.toml").string() + "' --json"));
+  ASSERT_TRUE(plugin.is_object() && stl.is_object());
+  EXPECT_FALSE(plugin["at_first_contact"].get<bool>());
+  const double d_plugin = plugin["depth_m"].get<double>();
+  EXPECT_NEAR(stl["depth_m"].get<double>(), d_plugin, 0.02 * d_plugin);
+
+  const CommandRun screened = run_mneedle("screen '" + (dir / "bevel.stl").string() +
+                                          "' --scene '" + (dir / "stl.toml").string() + "' --json");
+  ASSERT_EQ(screened.exit_code, 0) << screened.err;
+  const auto row = nlohmann::json::parse(screened.out)["designs"][0];
+  ASSERT_TRUE(row["punctured"].get<bool>()) << row.dump(2);
+  EXPECT_EQ(row["puncture_depth_m"].get<double>(), stl["depth_m"].get<double>());
+  EXPECT_EQ(row["puncture_force_N"].get<double>(), stl["force_N"].get<double>());
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -140,6 +140,61 @@ TEST(InsertionRun, SceneWithoutPunctureDataRunsThePreStageToFullDepth) {
   EXPECT_NEAR(run.horizon_m, 400e-6, 1e-15);
 }
 
+// The pre-puncture model is built for the horizon ladder, never for the requested depth
+// (docs/model.md, "Pre-puncture horizon"): asking for 300 or 800 um changes nothing before the
+// puncture. Identical to round-off (1e-12): the same model, steps and arithmetic.
+TEST(InsertionRun, PunctureDoesNotDependOnTheRequestedDepthAxisymmetric) {
+  const std::string deep = scene_text("", kFracture, kOnePunch, "[\"puncture\", \"force_curve\"]",
+                                      "[\"3000 um\", \"3000 um\", \"1150 um\"]", "800 um");
+  const InsertionRun a = run_insertion(punch_scene(), {punch("punch", 115e-6)}, fast());
+  const InsertionRun b =
+      run_insertion(parse_scene(deep, "deep.toml"), {punch("punch", 115e-6)}, fast());
+  ASSERT_TRUE(a.needles[0].puncture && b.needles[0].puncture);
+  EXPECT_NEAR(a.needles[0].puncture->depth_m, b.needles[0].puncture->depth_m,
+              1e-12 * b.needles[0].puncture->depth_m);
+  EXPECT_NEAR(a.needles[0].puncture->force_N, b.needles[0].puncture->force_N,
+              1e-12 * b.needles[0].puncture->force_N);
+  EXPECT_EQ(a.horizon_m, b.horizon_m);
+  EXPECT_EQ(a.nodes, b.nodes);
+}
+
+TEST(InsertionRun, PunctureDoesNotDependOnTheRequestedDepth3d) {
+  // A sharp bevel in silicone on the half 3-D model. Its F / A_sec falls from the first step
+  // (0.49 MPa at 10 um: the tip node carries the force) to about 0.2 MPa at 60 um and rises
+  // past it (0.42 MPa at 400 um): 0.5 MPa is crossed on the rising branch, on the 800 um rung.
+  PreparedNeedle bevel;
+  bevel.name = "bevel";
+  bevel.mesh = test::bevel_needle(115e-6, M_PI / 6, 1e-3);
+  bevel.mirror_symmetric_y0 = true;
+  const std::string fracture = "[tissue.fracture]\ntoughness = \"19 J/m^2\"\ncritical_pressure = \"0.5 MPa\"\n";
+  auto at_depth = [&](const std::string& depth) {
+    return run_insertion(
+        parse_scene(scene_text("", fracture, kOnePunch, "[\"puncture\", \"force_curve\"]",
+                               "[\"1500 um\", \"1500 um\", \"1500 um\"]", depth),
+                    "bevel.toml"),
+        {bevel}, fast());
+  };
+  const InsertionRun a = at_depth("600 um");
+  const InsertionRun b = at_depth("900 um");
+  ASSERT_TRUE(a.needles[0].puncture && b.needles[0].puncture);
+  EXPECT_FALSE(a.needles[0].puncture->at_first_contact);
+  EXPECT_NEAR(a.needles[0].puncture->depth_m, b.needles[0].puncture->depth_m,
+              1e-12 * b.needles[0].puncture->depth_m);
+  EXPECT_NEAR(a.needles[0].puncture->force_N, b.needles[0].puncture->force_N,
+              1e-12 * b.needles[0].puncture->force_N);
+}
+
+TEST(InsertionRun, CriterionAboveThresholdAtTheFirstStepIsFlaggedAtFirstContact) {
+  // 1 kPa is below the flat punch's F / A_sec at the first step: fired on contact.
+  const InsertionRun run =
+      run_insertion(punch_scene("[tissue.fracture]\ntoughness = \"19 J/m^2\"\ncritical_pressure = \"1 kPa\"\n"),
+                    {punch("punch", 115e-6)}, fast());
+  const auto& p = run.needles[0].puncture;
+  ASSERT_TRUE(p.has_value());
+  EXPECT_TRUE(p->at_first_contact);
+  EXPECT_DOUBLE_EQ(p->depth_m, run.first_step_m);
+}
+
 TEST(InsertionRun, ExplicitCriterionWithoutItsDataIsAnInputError) {
   const Scene scene = punch_scene();
   InsertionRunOptions o = fast();
