@@ -22,7 +22,7 @@ const std::string kRoot = MNEEDLE_SOURCE_ROOT;
 const std::string kSkin = kRoot + "/designs/scenes/human_skin.toml";
 // Homogeneous silicone where the sharp bevel's F / A_sec rises with depth: the pressure criterion
 // fires at a resolved depth (in skin it fires at first contact or not at all).
-const std::string kSilicone = std::string(MNEEDLE_TEST_ASSETS) + "/scenes/optimize_silicone.toml";
+const std::string kSilicone = kRoot + "/designs/scenes/optimize_silicone.toml";
 constexpr double kPi = 3.14159265358979323846;
 
 fs::path temp_dir(const std::string& name) {
