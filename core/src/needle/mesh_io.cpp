@@ -175,6 +175,11 @@ TriangleMesh collect_triangles(const std::filesystem::path& file, const aiScene&
     for (unsigned f = 0; f < part.mNumFaces; ++f) {
       const aiFace& face = part.mFaces[f];
       if (face.mNumIndices != 3) continue;  // points and lines carry no surface
+      for (unsigned k = 0; k < 3; ++k)
+        if (face.mIndices[k] >= part.mNumVertices)
+          fail(file, "face " + std::to_string(f) + " refers to vertex " +
+                         std::to_string(face.mIndices[k]) + " of " +
+                         std::to_string(part.mNumVertices));
       mesh.triangles.push_back(
           {welded[face.mIndices[0]], welded[face.mIndices[1]], welded[face.mIndices[2]]});
     }
@@ -221,12 +226,17 @@ TriangleMesh load_mesh(const std::filesystem::path& file, double metres_per_unit
   precheck_file(file, extension);
   Assimp::Importer importer;
   // DropNormals: STL gives every triangle its own normal, which would stop the vertex join.
-  const unsigned flags = aiProcess_Triangulate | aiProcess_DropNormals |
-                         aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices;
+  // ValidateDataStructure runs before the other steps and refuses a face that indexes past the
+  // vertex list (a PLY with a bad index otherwise crashes assimp's own post-processing).
+  const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate |
+                         aiProcess_DropNormals | aiProcess_JoinIdenticalVertices |
+                         aiProcess_PreTransformVertices;
   const aiScene* scene = importer.ReadFile(file.string(), flags);
   if (scene == nullptr) {
     const std::string reason = importer.GetErrorString();
-    if (reason.find("No output meshes") != std::string::npos) {
+    if (reason.find("No output meshes") != std::string::npos ||
+        reason.find("contains no vertices") != std::string::npos ||
+        reason.find("contains no faces") != std::string::npos) {
       fail(file, "mesh is empty (no triangles)");
     }
     fail(file, "not a readable mesh (" + reason + ")");

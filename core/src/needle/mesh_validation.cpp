@@ -240,6 +240,36 @@ bool indices_valid(const TriangleMesh& mesh) {
 
 }  // namespace
 
+namespace {
+
+// Number of separate solid bodies: pieces of triangles that share vertices (union-find) whose
+// signed volume is positive. A cavity's inward shell (negative volume) is not a body of its own.
+std::size_t count_bodies(const TriangleMesh& mesh) {
+  std::vector<std::uint32_t> parent(mesh.vertices.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto find = [&parent](std::uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const Triangle& t : mesh.triangles) {
+    parent[find(t[1])] = find(t[0]);
+    parent[find(t[2])] = find(t[0]);
+  }
+  std::map<std::uint32_t, double> six_volume;
+  for (const Triangle& t : mesh.triangles) {
+    const Vec3& a = mesh.vertices[t[0]];
+    const Vec3& b = mesh.vertices[t[1]];
+    const Vec3& c = mesh.vertices[t[2]];
+    six_volume[find(t[0])] += a[0] * (b[1] * c[2] - b[2] * c[1]) -
+                              a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                              a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  return static_cast<std::size_t>(std::count_if(six_volume.begin(), six_volume.end(),
+                                                [](const auto& v) { return v.second > 0.0; }));
+}
+
+}  // namespace
+
 MeshValidation validate_mesh(const TriangleMesh& mesh) {
   MeshValidation result;
   if (mesh.triangles.empty()) {
@@ -257,6 +287,12 @@ MeshValidation validate_mesh(const TriangleMesh& mesh) {
                             counted(result.non_finite_vertices, "vertex", "vertices") +
                             " with non-finite coordinates");
     return result;  // geometric predicates are meaningless on NaN
+  }
+  result.bodies = count_bodies(mesh);
+  if (result.bodies > 1) {
+    result.errors.push_back("mesh holds " + std::to_string(result.bodies) +
+                            " separate bodies; a needle file must hold one (export the needle "
+                            "alone)");
   }
   check_topology(mesh, result);
   const SurfaceMesh surface = to_any_surface_mesh(mesh);

@@ -101,6 +101,17 @@ TEST(MeshIo, MissingFileIsNamed) {
   EXPECT_TRUE(contains(message, "file not found")) << message;
 }
 
+TEST(MeshIo, PlyFaceIndexOutOfRangeIsAnErrorNotACrash) {
+  // assimp's post-processing read past the vertex list on these (SIGSEGV) before its own
+  // validation step was switched on.
+  for (const char* name :
+       {"bad_index_ascii.ply", "negative_index_ascii.ply", "bad_index_binary.ply"}) {
+    const std::string message = load_error(asset(name));
+    EXPECT_TRUE(starts_with(message, asset(name).string() + ": ")) << message;
+    EXPECT_TRUE(contains(message, "out of range")) << message;
+  }
+}
+
 TEST(MeshIo, ZeroByteFileIsEmpty) {
   const std::string message = load_error(asset("zero_bytes.stl"));
   EXPECT_TRUE(starts_with(message, asset("zero_bytes.stl").string() + ": ")) << message;

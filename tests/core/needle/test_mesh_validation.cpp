@@ -165,6 +165,27 @@ TEST(MeshValidation, CavityFacingOutwardIsInsideOut) {
   EXPECT_TRUE(has_error(v, "mesh does not bound a volume (a shell is inside out)")) << joined(v);
 }
 
+TEST(MeshValidation, TwoSeparateBodiesAreAnError) {
+  // Two needles (or a needle and a stray part) in one file: which one is the needle is a guess.
+  TriangleMesh two;
+  add_box(two, {0, 0, 0}, {1, 1, 3}, false);
+  add_box(two, {2, 0, 0}, {3, 1, 3}, false);
+  const MeshValidation v = mneedle::validate_mesh(two);
+  EXPECT_FALSE(v.valid);
+  EXPECT_EQ(v.bodies, 2u);
+  EXPECT_TRUE(has_error(v,
+                        "mesh holds 2 separate bodies; a needle file must hold one (export "
+                        "the needle alone)"))
+      << joined(v);
+}
+
+TEST(MeshValidation, CavityIsNotASecondBody) {
+  TriangleMesh hollow;
+  add_box(hollow, {0, 0, 0}, {3, 3, 3}, false);
+  add_box(hollow, {1, 1, 1}, {2, 2, 2}, true);
+  EXPECT_EQ(mneedle::validate_mesh(hollow).bodies, 1u);
+}
+
 TEST(MeshValidation, RequireValidMeshNamesSourceAndAllDefects) {
   try {
     mneedle::require_valid_mesh(load("open_box.stl"), "open_box.stl");

@@ -22,6 +22,7 @@ struct MeshValidation {
   std::size_t inconsistent_faces = 0;     ///< triangles oriented against their neighbours
   std::size_t self_intersections = 0;     ///< pairs of intersecting non-adjacent triangles
   std::size_t degenerate_faces = 0;       ///< zero-area triangles (collinear or repeated corners)
+  std::size_t bodies = 0;  ///< separate solid pieces (outward shells sharing no vertex)
   bool outward = false;    ///< every shell bounds its volume with normals pointing out
   double volume_m3 = 0.0;  ///< signed volume; positive when outward
 };
