@@ -10,6 +10,7 @@
 
 #include "insertion/insertion_planner.h"
 #include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
 #include "mneedle/fe/indentation3d.h"
 #include "mneedle/fe/tissue_mesh.h"
 #include "mneedle/geometry/cross_section.h"
@@ -552,6 +553,34 @@ void check_needles(const Scene& scene, const std::vector<PreparedNeedle>& needle
                      " in the scene but " + std::to_string(needles.size()) + " prepared");
   if (!(scene.insertion.depth > 0.0))
     throw InputError(scene.source_name + ": insertion.depth: must be positive");
+  // What enters the tissue must fit in the block, and two needles cannot share tissue: a file
+  // read in the wrong unit (mm as m) or a copied `at` otherwise runs and reports nonsense.
+  std::vector<double> radius(needles.size(), 0.0);
+  for (std::size_t i = 0; i < needles.size(); ++i) {
+    for (const Vec3& p : needles[i].mesh.vertices)
+      if (p[2] <= scene.insertion.depth) radius[i] = std::max(radius[i], std::hypot(p[0], p[1]));
+    const NeedleSpec& spec = scene.needles[i];
+    const std::string where =
+        scene.source_name + ":" + std::to_string(spec.line) + ": needle '" + spec.name + "': ";
+    const double half_x = 0.5 * scene.tissue.size[0], half_y = 0.5 * scene.tissue.size[1];
+    if (std::abs(needles[i].x) + radius[i] > half_x || std::abs(needles[i].y) + radius[i] > half_y)
+      throw InputError(where + format_quantity(2.0 * radius[i], Dimension::Length) + " wide at (" +
+                       format_quantity(needles[i].x, Dimension::Length) + ", " +
+                       format_quantity(needles[i].y, Dimension::Length) +
+                       "), it does not fit in the " +
+                       format_quantity(scene.tissue.size[0], Dimension::Length) + " x " +
+                       format_quantity(scene.tissue.size[1], Dimension::Length) +
+                       " block (is the mesh's unit right?)");
+    for (std::size_t j = 0; j < i; ++j)
+      if (std::hypot(needles[i].x - needles[j].x, needles[i].y - needles[j].y) <
+          radius[i] + radius[j])
+        throw InputError(
+            where + "overlaps needle '" + scene.needles[j].name + "' (axes " +
+            format_quantity(std::hypot(needles[i].x - needles[j].x, needles[i].y - needles[j].y),
+                            Dimension::Length) +
+            " apart, radii " + format_quantity(radius[i], Dimension::Length) + " and " +
+            format_quantity(radius[j], Dimension::Length) + ")");
+  }
 }
 
 // One rung of the pre-puncture model: the FE (or analytic) run for plan.horizon_m, with the

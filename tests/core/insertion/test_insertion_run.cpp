@@ -166,7 +166,8 @@ TEST(InsertionRun, PunctureDoesNotDependOnTheRequestedDepth3d) {
   bevel.name = "bevel";
   bevel.mesh = test::bevel_needle(115e-6, M_PI / 6, 1e-3);
   bevel.mirror_symmetric_y0 = true;
-  const std::string fracture = "[tissue.fracture]\ntoughness = \"19 J/m^2\"\ncritical_pressure = \"0.5 MPa\"\n";
+  const std::string fracture =
+      "[tissue.fracture]\ntoughness = \"19 J/m^2\"\ncritical_pressure = \"0.5 MPa\"\n";
   auto at_depth = [&](const std::string& depth) {
     return run_insertion(
         parse_scene(scene_text("", fracture, kOnePunch, "[\"puncture\", \"force_curve\"]",
@@ -186,13 +187,41 @@ TEST(InsertionRun, PunctureDoesNotDependOnTheRequestedDepth3d) {
 
 TEST(InsertionRun, CriterionAboveThresholdAtTheFirstStepIsFlaggedAtFirstContact) {
   // 1 kPa is below the flat punch's F / A_sec at the first step: fired on contact.
-  const InsertionRun run =
-      run_insertion(punch_scene("[tissue.fracture]\ntoughness = \"19 J/m^2\"\ncritical_pressure = \"1 kPa\"\n"),
-                    {punch("punch", 115e-6)}, fast());
+  const InsertionRun run = run_insertion(
+      punch_scene("[tissue.fracture]\ntoughness = \"19 J/m^2\"\ncritical_pressure = \"1 kPa\"\n"),
+      {punch("punch", 115e-6)}, fast());
   const auto& p = run.needles[0].puncture;
   ASSERT_TRUE(p.has_value());
   EXPECT_TRUE(p->at_first_contact);
   EXPECT_DOUBLE_EQ(p->depth_m, run.first_step_m);
+}
+
+std::string error_of(const Scene& scene, const std::vector<PreparedNeedle>& needles) {
+  try {
+    run_insertion(scene, needles, fast());
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(InsertionRun, NeedleWiderThanTheBlockIsAnInputErrorNamingTheUnit) {
+  // A 230 um needle read in mm as if it were m would be 230 mm wide: here 4 mm in a 3 mm block.
+  const std::string message = error_of(punch_scene(), {punch("punch", 2e-3)});
+  EXPECT_NE(message.find("punch.toml:"), std::string::npos) << message;
+  EXPECT_NE(message.find("needle 'punch': 4 mm wide"), std::string::npos) << message;
+  EXPECT_NE(message.find("is the mesh's unit right?"), std::string::npos) << message;
+}
+
+TEST(InsertionRun, OverlappingNeedlesAreAnInputError) {
+  const std::string two = kOnePunch + "at = [\"0 um\", \"0 um\"]\n" +
+                          "[[needles]]\nname = \"twin\"\ngeometry = { plugin = \"cylinder\", "
+                          "diameter = \"230 um\" }\nat = [\"100 um\", \"0 um\"]\n";
+  const Scene scene =
+      parse_scene(scene_text("", kFracture, two, "[\"puncture\", \"force_curve\"]"), "two.toml");
+  const std::string message =
+      error_of(scene, {punch("punch", 115e-6), punch("twin", 115e-6, 100e-6, 0.0)});
+  EXPECT_NE(message.find("needle 'twin': overlaps needle 'punch'"), std::string::npos) << message;
 }
 
 TEST(InsertionRun, ExplicitCriterionWithoutItsDataIsAnInputError) {

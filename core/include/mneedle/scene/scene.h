@@ -91,7 +91,7 @@ struct StlGeometry {
 struct NeedleSpec {
   std::string name;  ///< unique in the scene
   std::variant<PluginGeometry, StlGeometry> geometry;
-  std::array<double, 2> at{};           ///< m, (x, y) of the tip on the surface
+  std::array<double, 2> at{};           ///< m, (x, y) of the needle's axis on the surface
   std::optional<std::string> material;  ///< checked against the material library later
   int line = 0;                         ///< line of the [[needles]] entry
 };
