@@ -252,6 +252,14 @@ double parse_quantity(std::string_view text, Dimension expected) {
 }
 
 double quantity_in(const Quantity& q, Dimension expected, std::string_view what) {
+  // A plain number where a unit is needed is a guess about the unit (was "20" metres or
+  // micrometres?): refused, except 0, which is 0 in every unit.
+  if (q.dimension == Dimension::Dimensionless && expected != Dimension::Dimensionless &&
+      q.value_si != 0.0) {
+    throw InputError(std::string(what) +
+                     " needs a unit: " + std::string(article_for(dimension_name(expected))) + " " +
+                     std::string(dimension_name(expected)) + " (" + unit_list(expected) + ")");
+  }
   if (q.dimension == Dimension::Dimensionless || dimensions_compatible(q.dimension, expected)) {
     return q.value_si;
   }

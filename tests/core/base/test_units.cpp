@@ -96,9 +96,13 @@ TEST(Units, PlainNumberIsDimensionlessSi) {
   EXPECT_DOUBLE_EQ(q.value_si, 1e-3);
 }
 
-TEST(Units, PlainNumberIsTakenAsSiOfTheExpectedDimension) {
-  EXPECT_DOUBLE_EQ(parse_quantity("2.3e-4", Dimension::Length), 2.3e-4);
+TEST(Units, PlainNumberWhereAUnitIsNeededIsAnErrorListingTheUnits) {
+  // "--speed 2" was 2 m/s and "bevel_angle=30" 1718.87 deg: a plain number is refused there.
+  const auto msg = error_of([] { parse_quantity("2.3e-4", Dimension::Length); });
+  EXPECT_NE(msg.find("\"2.3e-4\" needs a unit: a length (nm, um, mm, cm, m)"), std::string::npos)
+      << msg;
   EXPECT_DOUBLE_EQ(parse_quantity("0.4", Dimension::Dimensionless), 0.4);
+  EXPECT_DOUBLE_EQ(parse_quantity("0", Dimension::Length), 0.0);  // 0 in every unit
 }
 
 TEST(Units, SignsAndExponentsParse) {
@@ -148,7 +152,9 @@ TEST(Units, QuantityInConvertsOrNamesTheValue) {
   const mneedle::Quantity diameter{230e-6, Dimension::Length};
   EXPECT_DOUBLE_EQ(mneedle::quantity_in(diameter, Dimension::Length, "diameter"), 230e-6);
   const mneedle::Quantity plain{64, Dimension::Dimensionless};
-  EXPECT_DOUBLE_EQ(mneedle::quantity_in(plain, Dimension::Length, "diameter"), 64.0);
+  const auto unitless =
+      error_of([&] { mneedle::quantity_in(plain, Dimension::Length, "diameter"); });
+  EXPECT_NE(unitless.find("diameter needs a unit: a length"), std::string::npos) << unitless;
   const auto msg =
       error_of([&] { mneedle::quantity_in(diameter, Dimension::Angle, "bevel_angle"); });
   EXPECT_NE(msg.find("bevel_angle is a length; expected an angle"), std::string::npos) << msg;

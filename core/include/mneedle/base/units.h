@@ -44,9 +44,10 @@ struct Quantity {
 /// for an unknown unit, and InputError for an empty text, a missing number, NaN or infinity.
 Quantity parse_quantity(std::string_view text);
 
-/// Same, but the unit must be of dimension `expected` (a plain number is taken as SI in
-/// `expected`). Returns the value in SI. Throws InputError naming the text, the unit's dimension
-/// and the expected one.
+/// Same, but the unit must be of dimension `expected`. A plain number is accepted only where a
+/// plain number is expected (and 0 everywhere): "20" for a length is an InputError that lists
+/// the accepted units. Returns the value in SI. Throws InputError naming the text, the unit's
+/// dimension and the expected one.
 double parse_quantity(std::string_view text, Dimension expected);
 
 /// Converts an already parsed quantity to SI in `expected`, with the same rules and message as
