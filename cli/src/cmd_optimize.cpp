@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -20,6 +21,7 @@
 #include "mneedle/design_evaluation.h"
 #include "mneedle/design_source.h"
 #include "mneedle/fe/tissue_mesh.h"
+#include "mneedle/geometry/cross_section.h"
 #include "mneedle/needle/mesh_io.h"
 #include "mneedle/tip_optimizer.h"
 
@@ -131,9 +133,16 @@ struct Problem {
     return evaluated[n.params] = evaluate_design(n.mesh, scene, material, o);
   }
 
+  // The shaft's thinnest wall, sliced from the generated mesh at 50-90 % of its length (the tip
+  // itself always thins to nothing): no parameter name is assumed, so any plugin works.
   double wall(const NeedleSource& n) const {
-    const double bore = n.params.count("bore") ? n.params.at("bore") : 0.0;
-    return bore > 0 ? (n.params.at("diameter") - bore) / 2.0 : n.params.at("diameter") / 2.0;
+    const BoundingBox box = bounding_box(n.mesh);
+    const double length = box.max[2] - box.min[2];
+    const CrossSectionSlicer slicer(n.mesh);
+    double thinnest = std::numeric_limits<double>::infinity();
+    for (double fraction : {0.5, 0.7, 0.9})
+      thinnest = std::min(thinnest, thinnest_wall(slicer.slice(fraction * length).polygons));
+    return thinnest;
   }
 
   // Objective (m or N) and constraints, each satisfied when <= 0 and scaled to be O(1):

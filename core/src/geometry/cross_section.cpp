@@ -83,6 +83,60 @@ double outline_area(const std::vector<std::vector<Point2>>& polygons) {
   return std::abs(shoelace_area(loop));
 }
 
+namespace {
+
+double segment_distance(const Point2& p, const Point2& a, const Point2& b) {
+  const double ux = b[0] - a[0], uy = b[1] - a[1];
+  const double length2 = ux * ux + uy * uy;
+  double t = length2 > 0.0 ? ((p[0] - a[0]) * ux + (p[1] - a[1]) * uy) / length2 : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  return std::hypot(p[0] - a[0] - t * ux, p[1] - a[1] - t * uy);
+}
+
+// Smallest distance from the points of `from` to the edges of `to`.
+double loop_distance(const std::vector<Point2>& from, const std::vector<Point2>& to) {
+  double d = std::numeric_limits<double>::infinity();
+  for (const Point2& p : from)
+    for (std::size_t i = 0, n = to.size(); i < n; ++i)
+      d = std::min(d, segment_distance(p, to[i], to[(i + 1) % n]));
+  return d;
+}
+
+}  // namespace
+
+double thinnest_wall(const std::vector<std::vector<Point2>>& polygons) {
+  double wall = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < polygons.size(); ++i) {
+    if (nested_loop_sign(polygons, i) != 1) continue;
+    bool hollow = false;
+    for (std::size_t j = 0; j < polygons.size(); ++j) {
+      if (j == i || nested_loop_sign(polygons, j) != -1 ||
+          !contains(polygons[i], polygons[j].front()))
+        continue;
+      hollow = true;
+      wall = std::min(
+          {wall, loop_distance(polygons[j], polygons[i]), loop_distance(polygons[i], polygons[j])});
+    }
+    if (!hollow) {
+      // A solid section: from its area centroid to the nearest edge (the inradius of a convex
+      // section about its centre).
+      const auto& loop = polygons[i];
+      double cx = 0.0, cy = 0.0, twice = 0.0;
+      for (std::size_t k = 0, n = loop.size(); k < n; ++k) {
+        const Point2& p = loop[k];
+        const Point2& q = loop[(k + 1) % n];
+        const double c = p[0] * q[1] - q[0] * p[1];
+        twice += c;
+        cx += (p[0] + q[0]) * c;
+        cy += (p[1] + q[1]) * c;
+      }
+      if (twice == 0.0) continue;
+      wall = std::min(wall, loop_distance({{cx / (3.0 * twice), cy / (3.0 * twice)}}, loop));
+    }
+  }
+  return std::isfinite(wall) ? wall : 0.0;
+}
+
 double nested_polygon_area(const std::vector<std::vector<Point2>>& polygons) {
   double area = 0.0;
   for (std::size_t i = 0; i < polygons.size(); ++i)

@@ -57,6 +57,18 @@ TEST(CrossSection, HollowBevelOutlineIsTheOuterSegment) {
   EXPECT_NEAR(with_bore.outline_area_m2, solid.area_m2, 1e-9 * solid.area_m2);
 }
 
+TEST(CrossSection, ThinnestWallOfATubeIsOuterMinusBoreRadius) {
+  ShapeOptions o;
+  o.bore = 45e-6;
+  o.segments = 256;
+  const auto tube = mneedle::cross_section(mneedle::test::cylinder(o), 500e-6);
+  // Two aligned 256-gons: a bore vertex lies (R - r) cos(pi/256) from the outer edges beside it.
+  EXPECT_NEAR(mneedle::thinnest_wall(tube.polygons), (kR - 45e-6) * std::cos(kPi / 256), 1e-12);
+  const auto solid = mneedle::cross_section(mneedle::test::cylinder({}), 500e-6);
+  EXPECT_NEAR(mneedle::thinnest_wall(solid.polygons), kR * std::cos(kPi / 64), 1e-12);
+  EXPECT_EQ(mneedle::thinnest_wall({}), 0.0);
+}
+
 TEST(CrossSection, CylinderSectionIsThePolygonArea) {
   const auto section = mneedle::cross_section(mneedle::test::cylinder({}), 333e-6);
   EXPECT_EQ(section.polygons.size(), 1u);

@@ -29,6 +29,11 @@ double nested_polygon_area(const std::vector<std::vector<Point2>>& polygons);
 /// Area of the convex hull of every loop's points (holes, crescents and notches filled).
 double outline_area(const std::vector<std::vector<Point2>>& polygons);
 
+/// Thinnest wall of a section (m): for a material loop with holes (a bore) the smallest distance
+/// between the loop and its holes; for a solid loop the distance from its area centroid to its
+/// nearest edge. 0 for an empty section.
+double thinnest_wall(const std::vector<std::vector<Point2>>& polygons);
+
 /// +1 when loop `i` is material, -1 when it is a hole (inside an odd number of the other loops),
 /// the rule nested_polygon_area applies; 0 for a loop of fewer than three points.
 int nested_loop_sign(const std::vector<std::vector<Point2>>& polygons, std::size_t i);
