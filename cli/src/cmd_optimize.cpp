@@ -311,12 +311,27 @@ void run_optimize(const OptimizeArgs& a) {
   std::cout << (r.feasible ? "best design" : "INFEASIBLE: least-violated design") << " of "
             << r.evaluations << " evaluations in " << static_cast<int>(std::round(r.seconds))
             << " s (" << r.algorithm << "; " << r.stop_reason << ")\n";
-  for (const auto& v : vars)
-    std::cout << "  " << v.name << " = " << best.params.at(v.name) << " (SI)\n";
+  for (const auto& v : vars) {
+    // The plugin declares each parameter's SI unit: "m", "rad" or "1".
+    std::string unit = "1";
+    for (const auto& p : shape.parameters)
+      if (p.name == v.name) unit = p.unit;
+    const double value = best.params.at(v.name);
+    std::cout << "  " << v.name << " = "
+              << (unit == "m"     ? format_quantity(value, Dimension::Length)
+                  : unit == "rad" ? format_quantity(value, Dimension::Angle)
+                                  : std::to_string(value))
+              << "\n";
+  }
   std::cout << "  puncture "
-            << (e.puncture ? "at " + format_quantity(e.puncture->depth_m, Dimension::Length) +
-                                 " under " + format_quantity(e.puncture->force_N, Dimension::Force)
-                           : "not reached before " + format_quantity(e.depth_m, Dimension::Length))
+            << (e.puncture
+                    ? "at " + format_quantity(e.puncture->depth_m, Dimension::Length) + " under " +
+                          format_quantity(e.puncture->force_N, Dimension::Force) +
+                          (e.puncture->at_first_contact
+                               ? " (at first contact: the depth is the first step's, not "
+                                 "resolved; docs/model.md, \"Criteria\")"
+                               : "")
+                    : "not reached before " + format_quantity(e.depth_m, Dimension::Length))
             << "\n  peak force " << format_quantity(e.peak_force_n, Dimension::Force)
             << ", strength margin " << e.margin << " (safety factor " << e.safety_factor << ")\n";
 }

@@ -5,6 +5,7 @@
 
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
+#include "mneedle/geometry/cross_section.h"
 #include "mneedle/geometry/surface_groups.h"
 #include "mneedle/strength/section_table.h"
 
@@ -127,6 +128,12 @@ double max_radius_up_to(const TriangleMesh& mesh, double height_m) {
   double r = 0.0;
   for (const auto& v : mesh.vertices)
     if (v[2] <= height_m) r = std::max(r, std::hypot(v[0], v[1]));
+  // The section at the height too: a cone's faces run from its point to a ring far above, so no
+  // vertex but the point lies below a shallow height.
+  const BoundingBox box = bounding_box(mesh);
+  if (height_m > box.min[2] && height_m < box.max[2])
+    for (const auto& loop : cross_section(mesh, height_m - box.min[2]).polygons)
+      for (const Point2& p : loop) r = std::max(r, std::hypot(p[0], p[1]));
   return r;
 }
 

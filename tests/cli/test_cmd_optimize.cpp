@@ -44,6 +44,27 @@ TEST(OptimizeCommand, SearchOverThePluginsWholeRangesStartsFromItsDefaults) {
   EXPECT_TRUE(j["best"]["puncture_depth_m"].is_number()) << j.dump(2);
 }
 
+TEST(OptimizeCommand, ConeWithItsDefaultSharpPointEvaluatesInSkin) {
+  // Failed every evaluation ("tip_size_m must be > 0 m"): no vertex but the point lies below the
+  // target depth, so the tip element size was sized from a zero radius.
+  const auto run = run_mneedle("optimize --plugin cone --scene '" + kSkin +
+                               "' --vary half_angle --max-evals 3 --seed 7 --material silicon"
+                               " --fidelity fast --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_GT(j["tip_element_size_m"].get<double>(), 0.0);
+  EXPECT_EQ(j["evaluations"].get<int>(), 3);
+}
+
+TEST(OptimizeCommand, SummaryPrintsParametersInTheirUnits) {
+  const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSilicone +
+                               "' --vary bevel_angle --bound bevel_angle=15deg:60deg"
+                               " --model analytic --max-evals 5");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find(" deg\n"), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find("(SI)"), std::string::npos) << run.out;
+}
+
 TEST(OptimizeCommand, PunctureDepthIsTheDefaultObjectiveAndTheSummaryHasItsKeys) {
   const fs::path dir = temp_dir("optimize_depth");
   const auto run =
