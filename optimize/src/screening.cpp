@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <iomanip>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -111,10 +112,19 @@ std::vector<DesignInput> read_design_list(const fs::path& file) {
   return out;
 }
 
+// Exact: the name, the file's bytes, and every number at full precision (17 digits), so two
+// designs that differ in anything never share a row.
+std::string exact(double value) {
+  std::ostringstream out;
+  out << std::setprecision(17) << value;
+  return out.str();
+}
+
 std::string design_fingerprint(const DesignInput& d) {
-  if (!d.plugin) return read_bytes(d.file) + "|unit=" + std::to_string(d.metres_per_unit);
-  std::string text = "plugin=" + *d.plugin;
-  for (const auto& [k, q] : d.parameters) text += "|" + k + "=" + std::to_string(q.value_si);
+  const std::string name = "name=" + d.name + "|";
+  if (!d.plugin) return name + read_bytes(d.file) + "|unit=" + exact(d.metres_per_unit);
+  std::string text = name + "plugin=" + *d.plugin;
+  for (const auto& [k, q] : d.parameters) text += "|" + k + "=" + exact(q.value_si);
   return text;
 }
 
@@ -213,8 +223,9 @@ json evaluation_json(const DesignEvaluation& e) {
 // The hash names a design's inputs, so --resume can tell which finished rows still apply.
 std::string row_hash(const DesignInput& d, const std::string& scene_hash,
                      const std::string& fidelity, const std::string& material) {
-  // Version 2 rows carry the puncture; rows of the surface-load-only screening are redone.
-  constexpr const char* kRowVersion = "2";
+  // Version 3 rows hash the design's name and full-precision values and carry
+  // puncture_at_first_contact; older rows are redone.
+  constexpr const char* kRowVersion = "3";
   std::string fingerprint;
   try {
     fingerprint = design_fingerprint(d);
@@ -263,6 +274,16 @@ ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::s
   return row;
 }
 
+ScreeningRow error_row(const DesignInput& d, const std::string& message) {
+  ScreeningRow row;
+  row.design = d.name;
+  row.error = message;
+  row.json =
+      json{{"design", d.name}, {"source", d.file.string()}, {"ok", false}, {"error", message}}
+          .dump();
+  return row;
+}
+
 ScreeningRow row_from_json(const std::string& line) {
   const json j = json::parse(line);
   ScreeningRow row;
@@ -287,8 +308,20 @@ ScreeningRow row_from_json(const std::string& line) {
 }
 
 // Rows finished by an earlier run, by hash; a half-written last line (a killed run) is ignored.
+// A run killed while writing leaves a last line without its newline: cut it off so the next row
+// starts on a line of its own (the design is then evaluated again).
+void truncate_partial_line(const fs::path& file) {
+  std::error_code error;
+  if (!fs::exists(file, error)) return;
+  const std::string bytes = read_bytes(file);
+  if (bytes.empty() || bytes.back() == '\n') return;
+  const auto keep = bytes.rfind('\n');
+  fs::resize_file(file, keep == std::string::npos ? 0 : keep + 1);
+}
+
 std::map<std::string, ScreeningRow> finished_rows(const fs::path& jsonl) {
   std::map<std::string, ScreeningRow> done;
+  truncate_partial_line(jsonl);
   std::ifstream in(jsonl);
   std::string line;
   while (std::getline(in, line)) {
@@ -409,7 +442,10 @@ std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs
   parse_pre_model(options.model);
   const std::string scene_hash = hex(fnv1a(read_bytes(scene_file)));
   std::map<std::string, ScreeningRow> done;
-  if (options.resume && options.out) done = finished_rows(*options.out / "results.jsonl");
+  if (options.resume && options.out) {
+    done = finished_rows(*options.out / "results.jsonl");
+    truncate_partial_line(*options.out / "results.csv");
+  }
   ResultWriter writer(options.out);
 
   std::vector<ScreeningRow> rows(designs.size());
@@ -418,15 +454,27 @@ std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs
   const std::string material = scene_material(scene, options);
   auto worker = [&] {
     for (std::size_t i = next++; i < designs.size(); i = next++) {
-      const std::string hash =
-          row_hash(designs[i], scene_hash, options.fidelity + "|" + options.model, material);
-      const auto previous = done.find(hash);
-      const bool skip = previous != done.end();
-      ScreeningRow row = skip ? previous->second
-                              : evaluate_row(designs[i], scene, hash, material, registry, options);
+      // Nothing may escape a worker thread (that would terminate the process): whatever fails
+      // becomes this design's error row and the others go on.
+      ScreeningRow row;
+      bool skip = false;
+      try {
+        const std::string hash =
+            row_hash(designs[i], scene_hash, options.fidelity + "|" + options.model, material);
+        const auto previous = done.find(hash);
+        skip = previous != done.end();
+        row = skip ? previous->second
+                   : evaluate_row(designs[i], scene, hash, material, registry, options);
+      } catch (const std::exception& e) {
+        row = error_row(designs[i], e.what());
+      }
       std::lock_guard<std::mutex> lock(report);
-      if (!skip) writer.write(row);
-      if (on_row) on_row(row);
+      try {
+        if (!skip) writer.write(row);
+        if (on_row) on_row(row);
+      } catch (const std::exception& e) {
+        row = error_row(designs[i], std::string("reporting the row failed: ") + e.what());
+      }
       rows[i] = std::move(row);
     }
   };

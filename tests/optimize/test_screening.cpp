@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 #include <unistd.h>
+#include <map>
+#include <stdexcept>
 
 #include <filesystem>
 #include <fstream>
@@ -116,6 +118,63 @@ TEST_F(Screening, ResumeRedoesOnlyWhatAKilledRunHadNotFinished) {
     EXPECT_EQ(second[i].hash, first[i].hash);
     EXPECT_DOUBLE_EQ(second[i].peak_force_n, first[i].peak_force_n);
     EXPECT_EQ(second[i].puncture_depth_m, first[i].puncture_depth_m);
+  }
+}
+
+TEST_F(Screening, ResumeAfterAHalfWrittenLineListsEveryDesignOnceOnLinesOfTheirOwn) {
+  mneedle::ScreeningOptions options = analytic();
+  options.out = dir_ / "out";
+  const auto designs = mneedle::collect_designs({dir_ / "in"}, 1e-3);
+  mneedle::screen_designs(designs, scene_, scene_file_, registry_, options);
+  const auto lines = jsonl_lines();
+  ASSERT_EQ(lines.size(), 4u);
+  {
+    std::ofstream out(dir_ / "out" / "results.jsonl", std::ios::trunc);
+    out << lines[0] << "\n" << lines[1].substr(0, lines[1].size() / 2);
+  }
+  options.resume = true;
+  mneedle::screen_designs(designs, scene_, scene_file_, registry_, options);
+  mneedle::screen_designs(designs, scene_, scene_file_, registry_, options);  // resumed again
+  std::map<std::string, int> seen;
+  for (const auto& line : jsonl_lines()) {
+    const auto j = nlohmann::json::parse(line);  // a glued line would not parse
+    ++seen[j["design"].get<std::string>()];
+  }
+  EXPECT_EQ(seen.size(), 4u);
+  for (const auto& [design, count] : seen) EXPECT_EQ(count, 1) << design;
+}
+
+TEST_F(Screening, IdenticalMeshesUnderTwoNamesAreTwoRows) {
+  fs::copy_file(dir_ / "in" / "cone.stl", dir_ / "in" / "cone_copy.stl");
+  mneedle::ScreeningOptions options = analytic();
+  options.out = dir_ / "out";
+  const auto designs =
+      mneedle::collect_designs({dir_ / "in" / "cone.stl", dir_ / "in" / "cone_copy.stl"}, 1e-3);
+  const auto first = mneedle::screen_designs(designs, scene_, scene_file_, registry_, options);
+  EXPECT_NE(first[0].hash, first[1].hash);
+  options.resume = true;
+  const auto again = mneedle::screen_designs(designs, scene_, scene_file_, registry_, options);
+  EXPECT_EQ(again[0].design, "cone");
+  EXPECT_EQ(again[1].design, "cone_copy");
+  EXPECT_TRUE(again[0].resumed && again[1].resumed);
+}
+
+TEST_F(Screening, ExceptionInTheRowCallbackOfAWorkerBecomesThatDesignsErrorRow) {
+  // Thrown in a worker thread this terminated the process; now the design gets an error row.
+  mneedle::ScreeningOptions options = analytic();
+  options.jobs = 2;
+  const auto designs = mneedle::collect_designs({dir_ / "in"}, 1e-3);
+  const auto rows = mneedle::screen_designs(designs, scene_, scene_file_, registry_, options,
+                                            [](const mneedle::ScreeningRow& row) {
+                                              if (row.design == "cone")
+                                                throw std::runtime_error("printer on fire");
+                                            });
+  ASSERT_EQ(rows.size(), 4u);
+  for (const auto& row : rows) {
+    if (row.design == "cone") {
+      EXPECT_FALSE(row.ok);
+      EXPECT_NE(row.error.find("printer on fire"), std::string::npos) << row.error;
+    }
   }
 }
 
