@@ -29,6 +29,7 @@ namespace mneedle::cli {
 namespace {
 
 struct OptimizeArgs {
+  std::vector<std::string> plugin_dirs;
   std::string plugin;
   std::string scene;
   std::string vary;
@@ -227,7 +228,7 @@ double fixed_tip_size(const Problem& p, const std::vector<DesignVariable>& vars,
 
 void run_optimize(const OptimizeArgs& a) {
   const Scene scene = load_scene(a.scene);
-  const auto registry = PluginRegistry::discover();
+  const auto registry = PluginRegistry::discover({a.plugin_dirs.begin(), a.plugin_dirs.end()});
   const PluginShapeInfo& shape = registry.shape(a.plugin);
   Problem problem{scene,      registry,
                   a,          parse_parameter_settings(shape, a.settings),
@@ -380,6 +381,7 @@ void add_optimize_command(CLI::App& app) {
   cmd->add_option("--max-time", a->max_time, "Wall-time budget with a unit, e.g. 300s");
   cmd->add_option("--seed", a->seed, "Seed of the scattered starts, ISRES and MLSL")
       ->capture_default_str();
+  cmd->add_option("--plugin-dir", a->plugin_dirs, "Extra plugin folder (repeatable)");
   cmd->add_option("--min-feature", a->min_feature, "Smallest manufacturable wall")
       ->capture_default_str();
   cmd->add_option("--out", a->out, "Folder for best.stl (mm), history.csv and summary.json");

@@ -35,6 +35,7 @@ struct SimulateOptions {
   bool json = false;
   bool no_reductions = false;
   bool csv = false;
+  std::vector<std::string> plugin_dirs;
 };
 
 fe::Fidelity to_fe(Fidelity f) {
@@ -217,7 +218,8 @@ void print_table(const InsertionRun& run) {
 
 void run(const SimulateOptions& o) {
   const Scene scene = load_scene(o.scene);
-  const PluginRegistry registry = PluginRegistry::discover();
+  const PluginRegistry registry =
+      PluginRegistry::discover({o.plugin_dirs.begin(), o.plugin_dirs.end()});
   const InsertionRun result =
       run_insertion(scene, prepare_needles(registry, scene), run_options(scene, o));
   // Every format prints the numbers of this tree: check them once, before anything is printed.
@@ -255,6 +257,7 @@ void add_simulate_command(CLI::App& app) {
       "Examples:\n  mneedle simulate designs/scenes/silicone_phantom.toml --fidelity fast\n"
       "  mneedle simulate designs/scenes/human_skin.toml --criterion stress --json\n"
       "  mneedle simulate tests/assets/scenes/axisymmetric_punch.toml --csv");
+  cmd->add_option("--plugin-dir", options->plugin_dirs, "Extra plugin folder (repeatable)");
   cmd->add_flag("--no-reductions", options->no_reductions,
                 "solve the whole scene: no half model, layer merge or domain cut (to check them)");
   auto* json = cmd->add_flag("--json", options->json, "print the run as JSON");

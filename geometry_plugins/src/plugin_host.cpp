@@ -228,6 +228,7 @@ struct PluginRegistry::Impl {
   std::vector<PluginShapeInfo> infos;
   std::vector<ShapeEntry> entries;  // parallel to infos
   std::vector<std::string> warnings;
+  std::vector<std::string> searched;  // the folders discover() looked in, in order
 
   std::size_t index_of(std::string_view name) const {
     for (std::size_t i = 0; i < infos.size(); ++i) {
@@ -238,6 +239,9 @@ struct PluginRegistry::Impl {
     std::string message = "unknown tip shape '" + std::string(name) +
                           "' (known: " + (known.empty() ? std::string("none") : join(known, ", ")) +
                           ")";
+    if (!searched.empty())
+      message += "; looked in " + join(searched, ", ") +
+                 " (add a folder with --plugin-dir DIR or MNEEDLE_PLUGIN_PATH)";
     if (!warnings.empty()) message += "; plugin problems: " + join(warnings, "; ");
     throw InputError(message);
   }
@@ -290,6 +294,7 @@ PluginRegistry PluginRegistry::discover(const std::vector<fs::path>& extra_dirs)
     dirs.push_back(dir);
   }
   for (const auto& dir : dirs) {
+    registry.impl_->searched.push_back(dir.string());
     if (!fs::is_directory(dir)) {
       warnings.push_back("plugin folder '" + dir.string() + "' not found");
       continue;

@@ -125,6 +125,10 @@ TEST(PluginHost, UnknownShapeErrorListsKnownShapesAndBrokenPlugins) {
   EXPECT_TRUE(contains(message, "unknown tip shape 'pyramid'")) << message;
   EXPECT_TRUE(contains(message, "sharp_bevel")) << message;
   EXPECT_TRUE(contains(message, "wrong_abi.so")) << message;
+  // Where it looked, and the two ways to add a folder.
+  EXPECT_TRUE(contains(message, "looked in ")) << message;
+  EXPECT_TRUE(contains(message, kBrokenDir)) << message;
+  EXPECT_TRUE(contains(message, "--plugin-dir DIR or MNEEDLE_PLUGIN_PATH")) << message;
 }
 
 TEST(PluginHost, MissingExtraFolderIsAnInputError) {
