@@ -224,6 +224,41 @@ TEST(InsertionRun, OverlappingNeedlesAreAnInputError) {
   EXPECT_NE(message.find("needle 'twin': overlaps needle 'punch'"), std::string::npos) << message;
 }
 
+TEST(InsertionRun, PunctureDepthMovesContinuouslyWithTheBevelAngle) {
+  // Bevel angle 15..45 deg in 2 deg steps on the closed-form model in silicone (P_c 0.15 MPa,
+  // crossed on the rising branch of F / A_sec; the depths run 29 -> 230 um, crossing the 100 and
+  // 200 um rungs). Every angle has its own depth (no ties, as when the crossing sat on the step
+  // grid), and the depth has no jump: from one 2 deg step to the next its increment changes by
+  // at most 5 um (3.4 um measured), a quarter of the smallest step a jump to the grid would show
+  // (20 um, the 200 um rung at fast).
+  const std::string fracture =
+      "[tissue.fracture]\ntoughness = \"19 J/m^2\"\ncritical_pressure = \"0.15 MPa\"\n";
+  const Scene scene =
+      parse_scene(scene_text("", fracture, kOnePunch, "[\"puncture\", \"force_curve\"]",
+                             "[\"3000 um\", \"3000 um\", \"2000 um\"]", "400 um"),
+                  "angles.toml");
+  InsertionRunOptions o = fast();
+  o.model = PreModel::Analytic;
+  std::vector<double> depths;
+  for (int degrees = 15; degrees <= 45; degrees += 2) {
+    PreparedNeedle bevel;
+    bevel.name = "punch";
+    bevel.mesh = test::bevel_needle(115e-6, degrees * M_PI / 180.0, 1e-3);
+    const InsertionRun run = run_insertion(scene, {bevel}, o);
+    ASSERT_TRUE(run.needles[0].puncture.has_value()) << degrees << " deg";
+    EXPECT_FALSE(run.needles[0].puncture->at_first_contact) << degrees << " deg";
+    depths.push_back(run.needles[0].puncture->depth_m);
+  }
+  for (std::size_t i = 1; i < depths.size(); ++i) {
+    EXPECT_GT(std::abs(depths[i] - depths[i - 1]), 1e-9 * depths[i]) << "tie at " << 15 + 2 * i;
+  }
+  for (std::size_t i = 2; i < depths.size(); ++i) {
+    const double change = (depths[i] - depths[i - 1]) - (depths[i - 1] - depths[i - 2]);
+    EXPECT_LT(std::abs(change), 5e-6) << "jump at " << 15 + 2 * i << " deg: " << depths[i - 2]
+                                      << ", " << depths[i - 1] << ", " << depths[i];
+  }
+}
+
 TEST(InsertionRun, ExplicitCriterionWithoutItsDataIsAnInputError) {
   const Scene scene = punch_scene();
   InsertionRunOptions o = fast();
