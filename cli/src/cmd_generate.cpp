@@ -75,7 +75,8 @@ void run_generate(const GenerateOptions& options) {
                        context);
   }
   const double volume = require_finite(signed_volume(mesh), "volume_m3", context);
-  write_stl_binary(mesh, options.output, metres_per_unit, "mneedle generate " + shape.name);
+  write_stl_binary(mesh, options.output, metres_per_unit,
+                   "mneedle generate " + shape.name + " unit=" + options.unit);
   std::cout << "wrote " << options.output.string() << " (" << shape.name << ", "
             << mesh.triangles.size() << " triangles, volume " << volume << " m^3, unit "
             << options.unit << ")\n";

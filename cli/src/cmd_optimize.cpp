@@ -171,7 +171,7 @@ void write_outputs(const std::filesystem::path& dir, const OptimizerResult& r,
                    const std::vector<DesignVariable>& vars, const TriangleMesh& best_mesh,
                    const nlohmann::json& summary, const std::string& objective_key) {
   std::filesystem::create_directories(dir);
-  write_stl_binary(best_mesh, dir / "best.stl", 1e-3, "mneedle optimize best design (mm)");
+  write_stl_binary(best_mesh, dir / "best.stl", 1e-3, "mneedle optimize best design unit=mm");
   std::ofstream csv(dir / "history.csv");
   // Full precision: a history that rounds cannot be compared with the summary it produced.
   csv << std::setprecision(17);

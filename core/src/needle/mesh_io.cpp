@@ -246,6 +246,22 @@ TriangleMesh load_mesh(const std::filesystem::path& file, double metres_per_unit
   return mesh;
 }
 
+std::optional<std::string> declared_length_unit(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string head(kStlHeaderBytes, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  head = head.substr(0, head.find('\n'));  // ASCII: the `solid` line only
+  for (const char* unit : {"um", "mm", "m"}) {
+    const std::string token = std::string("unit=") + unit;
+    const auto at = head.find(token);
+    if (at == std::string::npos) continue;
+    const std::size_t end = at + token.size();
+    if (end == head.size() || !std::isalnum(static_cast<unsigned char>(head[end]))) return unit;
+  }
+  return std::nullopt;
+}
+
 void write_stl_binary(const TriangleMesh& mesh, const std::filesystem::path& file,
                       double metres_per_unit, std::string_view header) {
   check_unit_scale(file, metres_per_unit);

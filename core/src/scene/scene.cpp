@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "mneedle/base/error.h"
+#include "mneedle/needle/mesh_io.h"
 
 namespace mneedle {
 namespace {
@@ -539,7 +540,14 @@ StlGeometry read_stl_geometry(Table& g, NeedleDraft& draft, const std::filesyste
     g.fail_key("stl", "no such file: " + stl.path.string() + " (relative paths start at the " +
                           "scene file's folder)");
   }
-  stl.unit = g.optional_string("unit").value_or("mm");
+  // No unit and none in the file: a guess (CAD tools write mm, others um or m) is refused.
+  const auto declared = declared_length_unit(stl.path);
+  const auto given_unit = g.optional_string("unit");
+  if (!given_unit && !declared)
+    g.fail_key("unit", "missing: " + stl.path.filename().string() +
+                           " does not say its length unit; add unit = \"mm\" (what CAD tools "
+                           "export), \"um\" or \"m\"");
+  stl.unit = given_unit.value_or(declared.value_or("mm"));
   try {
     stl.unit_scale = length_unit_scale(stl.unit);
   } catch (const InputError& e) {

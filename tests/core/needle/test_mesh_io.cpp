@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -110,6 +112,19 @@ TEST(MeshIo, PlyFaceIndexOutOfRangeIsAnErrorNotACrash) {
     EXPECT_TRUE(starts_with(message, asset(name).string() + ": ")) << message;
     EXPECT_TRUE(contains(message, "out of range")) << message;
   }
+}
+
+TEST(MeshIo, DeclaredUnitIsReadFromTheHeaderOrSolidLine) {
+  const auto file = temporary_file("declared_unit.stl");
+  mneedle::write_stl_binary(mneedle::load_mesh(asset("pyramid_binary.stl"), kMillimetre), file,
+                            1e-6, "mneedle generate cone unit=um");
+  EXPECT_EQ(mneedle::declared_length_unit(file), std::optional<std::string>("um"));
+  EXPECT_NEAR(mneedle::bounding_box(mneedle::load_mesh(file, 1e-6)).max[2], 4e-3, 1e-9);
+  std::filesystem::remove(file);
+  EXPECT_EQ(mneedle::declared_length_unit(std::filesystem::path(MNEEDLE_TEST_ASSETS) / "scenes" /
+                                          "tiny_needle.stl"),
+            std::optional<std::string>("mm"));
+  EXPECT_FALSE(mneedle::declared_length_unit(asset("pyramid_ascii.stl")).has_value());
 }
 
 TEST(MeshIo, ZeroByteFileIsEmpty) {

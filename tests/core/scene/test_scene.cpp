@@ -1,6 +1,7 @@
 #include "mneedle/scene/scene.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -456,6 +457,30 @@ TEST(SceneErrors, MissingStlFile) {
                     "bevel_angle = \"30 deg\"",
                     "stl = \"absent.stl\", unit = \"um\""),
                {"test.toml:20:", "needles[0].geometry.stl", "no such file"});
+}
+
+TEST(SceneErrors, StlWithoutUnitThatDoesNotDeclareOneIsRefused) {
+  // A 180 um needle exported in um and read as mm ran as a 180 mm needle: no more guessing.
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("mneedle_unit_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(kAssets.parent_path() / "meshes" / "pyramid_ascii.stl", dir / "n.stl",
+                             std::filesystem::copy_options::overwrite_existing);
+  const std::string toml =
+      "[tissue]\nsize = [\"2 mm\", \"2 mm\", \"1 mm\"]\n"
+      "[[tissue.layers]]\nname = \"gel\"\n"
+      "material = { model = \"linear\", E = \"7 kPa\", nu = 0.45 }\n"
+      "[[needles]]\ngeometry = { stl = \"n.stl\" }\n"
+      "[insertion]\ndepth = \"0.5 mm\"\n";
+  try {
+    mneedle::parse_scene(toml, (dir / "s.toml").string());
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("needles[0].geometry.unit"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("n.stl does not say its length unit"), std::string::npos) << msg;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(SceneErrors, UnknownStlUnit) {
