@@ -28,6 +28,7 @@ struct ForceOptions {
   bool json = false;
   bool csv = false;
   std::string step = "10um";
+  long max_points = 1'000'000;
   std::vector<std::filesystem::path> plugin_dirs;
 };
 
@@ -37,7 +38,15 @@ struct NeedleCurve {
 };
 
 // 0, step, 2 step, ... up to the scene's insertion depth, which is always the last point.
-std::vector<double> depth_grid(double max_depth, double step) {
+std::vector<double> depth_grid(double max_depth, double step, double max_points) {
+  // Checked before any point is made: --step 1e-15m once asked for 10^11 points.
+  if (!(max_depth / step <= max_points))
+    throw InputError("--step " + format_quantity(step, Dimension::Length) + " over " +
+                     format_quantity(max_depth, Dimension::Length) + " is " +
+                     std::to_string(static_cast<long double>(max_depth / step)).substr(0, 12) +
+                     " points, above the limit of " +
+                     std::to_string(static_cast<long>(max_points)) +
+                     " (raise it with --max-points)");
   std::vector<double> depths;
   const auto count = static_cast<long>(std::floor(max_depth / step * (1.0 + 1e-12)));
   for (long i = 0; i <= count; ++i) depths.push_back(static_cast<double>(i) * step);
@@ -59,7 +68,8 @@ std::vector<NeedleCurve> compute(const ForceOptions& options) {
   if (!(scene.insertion.depth > 0.0)) {
     throw InputError(scene.source_name + ": insertion.depth must be positive for a force curve");
   }
-  const std::vector<double> depths = depth_grid(scene.insertion.depth, step);
+  const std::vector<double> depths =
+      depth_grid(scene.insertion.depth, step, static_cast<double>(options.max_points));
   const LoadConstants constants = load_constants(scene);
   // Plugins are searched only when a needle needs one, so STL-only scenes run without them.
   const PluginRegistry registry =
@@ -122,6 +132,8 @@ void add_force_command(CLI::App& app) {
                 "Print CSV: needle,depth_m,force_N,alpha_N,beta_N,friction_N")
       ->excludes(json);
   cmd->add_option("--step", options->step, "Depth step with a unit (default 10um)");
+  cmd->add_option("--max-points", options->max_points,
+                  "Largest number of depths a curve may have (default 1000000)");
   cmd->add_option("--plugin-dir", options->plugin_dirs, "Extra folder to search for plugins");
   cmd->callback([options] {
     const std::vector<NeedleCurve> curves = compute(*options);

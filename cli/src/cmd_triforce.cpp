@@ -251,6 +251,7 @@ struct PredictArgs {
   std::string step = "0.05s";
   std::string amplitude = "0m";
   double frequency_Hz = 1000.0;
+  std::size_t max_samples = 20'000'000;
   std::string compare;
   CurveArgs curve;
   bool csv = false;
@@ -319,6 +320,7 @@ void run_predict(const PredictArgs& args) {
   protocol.conditions.perturbation_frequency_Hz = args.frequency_Hz;
   protocol.hold_s = parse_quantity(args.hold, Dimension::Time);
   protocol.time_step_s = parse_quantity(args.step, Dimension::Time);
+  protocol.max_samples = args.max_samples;
   if (!args.retract_speed.empty()) {
     protocol.retraction_speed_m_per_s = parse_quantity(args.retract_speed, Dimension::Speed);
   }
@@ -507,6 +509,9 @@ void add_predict_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--depth", args->depth, "Insertion depth (travel from contact)");
   cmd->add_option("--hold", args->hold, "Hold at depth before retraction")->capture_default_str();
+  cmd->add_option("--max-samples", args->max_samples,
+                  "Largest number of time samples a prediction may have")
+      ->capture_default_str();
   cmd->add_option("--retract-speed", args->retract_speed, "Retraction speed (default: --speed)");
   cmd->add_option("--step", args->step, "Output time step")->capture_default_str();
   cmd->add_option("--perturb-amplitude", args->amplitude, "Lateral vibration amplitude A")

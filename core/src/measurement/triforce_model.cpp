@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
 
 namespace mneedle {
 namespace {
@@ -195,6 +196,14 @@ std::vector<ProtocolSample> TriforceModel::simulate(const InsertionProtocol& p) 
   const double lambda = params_.relaxation_time_s;
   const double back_speed =
       p.retraction_speed_m_per_s > 0.0 ? p.retraction_speed_m_per_s : c.speed_m_per_s;
+  const double duration = p.max_depth_m / c.speed_m_per_s + p.hold_s + p.max_depth_m / back_speed;
+  const double needed = duration / p.time_step_s;
+  if (!(needed <= static_cast<double>(p.max_samples)))
+    throw InputError("insertion protocol: " + format_quantity(duration, Dimension::Time) +
+                     " in steps of " + format_quantity(p.time_step_s, Dimension::Time) + " is " +
+                     std::to_string(static_cast<long double>(needed)).substr(0, 12) +
+                     " samples, above the limit of " + std::to_string(p.max_samples) +
+                     " (raise it with --max-samples)");
   std::vector<ProtocolSample> out;
   const double t_in = p.max_depth_m / c.speed_m_per_s;
   for (double t = 0.0;; t += p.time_step_s) {

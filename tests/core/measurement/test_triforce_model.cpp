@@ -118,6 +118,26 @@ TEST(TriforceModel, MaxwellBranchMakesFasterInsertionStiffer) {
   EXPECT_GT(f_fast.total_N(), f_slow.total_N());
 }
 
+TEST(TriforceModel, ProtocolAboveTheSampleLimitIsRefusedBeforeAnyWork) {
+  // --hold 1e9s once ran into bad_alloc; paper C's 86 mm at 1 mm/s (17 200 samples) stays in.
+  const mneedle::TriforceModel m(liver_like());
+  mneedle::InsertionProtocol protocol;
+  protocol.conditions = {1e-3, kPerpendicular};
+  protocol.max_depth_m = 86e-3;
+  protocol.time_step_s = 0.01;
+  EXPECT_NO_THROW(m.simulate(protocol));
+  protocol.hold_s = 1e9;
+  try {
+    m.simulate(protocol);
+    FAIL() << "expected an InputError";
+  } catch (const mneedle::InputError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("above the limit of 20000000 (raise it with --max-samples)"),
+        std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(TriforceModel, HoldRelaxesAndRetractionReversesFriction) {
   auto p = liver_like();
   p.viscosity_Ns = 5.0;
