@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "mneedle/base/error.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"mneedle: evaluate microneedle designs before fabrication"};
@@ -22,13 +23,25 @@ int main(int argc, char** argv) {
   mneedle::cli::add_stats_command(app);
   mneedle::cli::add_simulate_command(app);
   mneedle::cli::add_toughness_command(app);
+  // Exit statuses (docs/cli.md, "Exit status"): 0 success, 1 bad input, 2 bad command line,
+  // 3 a solver that could not deliver, 4 an internal error (a bug: please report it).
   try {
     app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help, --version
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  } catch (const std::exception& e) {
+    std::cerr << "mneedle: error: " << e.what() << " (see mneedle --help)\n";
+    return 2;
+  } catch (const mneedle::InputError& e) {
     std::cerr << "mneedle: error: " << e.what() << "\n";
     return 1;
+  } catch (const mneedle::SolverError& e) {
+    std::cerr << "mneedle: error: " << e.what() << "\n";
+    return 3;
+  } catch (const std::exception& e) {
+    std::cerr << "mneedle: internal error: " << e.what()
+              << " (a bug in mneedle: please report it)\n";
+    return 4;
   }
   return 0;
 }
