@@ -57,7 +57,7 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
     }
     const auto j = nlohmann::json::parse(row.json);
     const std::string margin =
-        j["margin"].is_null() ? "inf" : std::to_string(row.margin).substr(0, 6);
+        j["margin"].is_null() ? "no load" : std::to_string(row.margin).substr(0, 6);
     std::string models;
     for (const auto& m : j["models_run"])
       models += (models.empty() ? "" : "+") + m.get<std::string>();

@@ -36,6 +36,7 @@ struct SimulateOptions {
   bool no_reductions = false;
   bool csv = false;
   std::vector<std::string> plugin_dirs;
+  std::size_t max_needles = 16;
 };
 
 fe::Fidelity to_fe(Fidelity f) {
@@ -62,6 +63,7 @@ InsertionRunOptions run_options(const Scene& scene, const SimulateOptions& o) {
             : o.model == "3d"           ? PreModel::Full3d
                                         : PreModel::Auto;
   r.vtu_directory = o.vtu;
+  r.max_fe_needles = o.max_needles;
   r.allow_reductions = !o.no_reductions;
   if (r.vtu_directory.empty() && scene.model.wants(Output::Fields)) {
     // The scene asks for fields: write them beside the working directory, named after it.
@@ -258,6 +260,9 @@ void add_simulate_command(CLI::App& app) {
       "  mneedle simulate designs/scenes/human_skin.toml --criterion stress --json\n"
       "  mneedle simulate tests/assets/scenes/axisymmetric_punch.toml --csv");
   cmd->add_option("--plugin-dir", options->plugin_dirs, "Extra plugin folder (repeatable)");
+  cmd->add_option("--max-needles", options->max_needles,
+                  "Most needles one finite element model may hold")
+      ->capture_default_str();
   cmd->add_flag("--no-reductions", options->no_reductions,
                 "solve the whole scene: no half model, layer merge or domain cut (to check them)");
   auto* json = cmd->add_flag("--json", options->json, "print the run as JSON");

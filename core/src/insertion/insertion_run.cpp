@@ -654,6 +654,12 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
   if (need_post)
     for (std::size_t i = 0; i < needles.size(); ++i) post[i].emplace(needles[i].mesh, constants);
 
+  if ((plan.pre == PreKind::Full3d || plan.pre == PreKind::Axisymmetric) &&
+      needles.size() > options.max_fe_needles)
+    throw InputError(scene.source_name + ": needles: " + std::to_string(needles.size()) +
+                     " needles in one finite element model, above the limit of " +
+                     std::to_string(options.max_fe_needles) +
+                     " (raise it with --max-needles; a symmetric array is solved on its quarter)");
   if (plan.pre == PreKind::None) {
     run.reductions = plan.reductions;
     for (std::size_t i = 0; i < needles.size(); ++i)

@@ -543,5 +543,22 @@ TEST(Arrays, EachNeedlePuncturesOnItsOwnAndTheTotalIsTheirSum) {
   EXPECT_GE(compared, 3);
 }
 
+TEST(InsertionRun, MoreNeedlesThanTheFiniteElementLimitIsRefusedBeforeAnyWork) {
+  InsertionRunOptions o = fast();
+  o.max_fe_needles = 3;
+  const Scene scene = parse_scene(
+      scene_text("", kFracture, two_by_two_punches(), "[\"puncture\", \"force_curve\"]"),
+      "array.toml");
+  try {
+    run_insertion(scene, two_by_two(), o);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("4 needles in one finite element model, above the limit "
+                                         "of 3 (raise it with --max-needles"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace mneedle
