@@ -8,6 +8,7 @@
 #include <limits>
 #include <memory>
 
+#include "fe/needle_shape.h"
 #include "insertion/insertion_planner.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
@@ -555,10 +556,11 @@ void check_needles(const Scene& scene, const std::vector<PreparedNeedle>& needle
     throw InputError(scene.source_name + ": insertion.depth: must be positive");
   // What enters the tissue must fit in the block, and two needles cannot share tissue: a file
   // read in the wrong unit (mm as m) or a copied `at` otherwise runs and reports nonsense.
+  // The same radius the planner sizes the model from: every face reaching below the depth counts
+  // whole, so a coarse mesh whose next vertex ring lies above the depth is not read as radius 0.
   std::vector<double> radius(needles.size(), 0.0);
   for (std::size_t i = 0; i < needles.size(); ++i) {
-    for (const Vec3& p : needles[i].mesh.vertices)
-      if (p[2] <= scene.insertion.depth) radius[i] = std::max(radius[i], std::hypot(p[0], p[1]));
+    radius[i] = fe::NeedleShape(needles[i].mesh).max_radius_up_to(scene.insertion.depth);
     const NeedleSpec& spec = scene.needles[i];
     const std::string where =
         scene.source_name + ":" + std::to_string(spec.line) + ": needle '" + spec.name + "': ";

@@ -41,7 +41,7 @@ struct InsertionRunOptions {
   /// Largest relative force change a measured reduction may cause; empty: from the fidelity
   /// (fast 5 %, standard 2 %, fine 1 %).
   std::optional<double> reduction_tolerance;
-  int steps = 0;              ///< output depth steps; 0: from the fidelity
+  int steps = 0;  ///< output depth steps; 0: from the fidelity
   /// Work limit checked before any FE is built: more needles in one FE model than this is an
   /// InputError (a 10 x 10 array needs GBs of memory and tens of minutes at fast).
   std::size_t max_fe_needles = 16;

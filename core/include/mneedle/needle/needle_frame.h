@@ -35,8 +35,9 @@ struct AxisChoice {
 /// has no tip point, and the tip is then the point of the centroid's axis line in the lowest
 /// cross-section. The tip direction's line through the volume centroid (area centroid when the
 /// mesh encloses no volume) finds the tip; the frame's axis is the shaft's, through the area
-/// centroid of the quarter of the surface farthest from the tip. Throws mneedle::InputError for
-/// an empty mesh or a zero or non-finite direction.
+/// centroid of the base (the faces at the end farthest from the tip that face away from it; the
+/// volume centroid when there is no such flat base). Throws mneedle::InputError for an empty
+/// mesh or a zero or non-finite direction.
 FrameInfo place_in_needle_frame(TriangleMesh& mesh, std::optional<Vec3> tip_direction);
 
 /// As above with the automatic choice available: the principal axis of the surface
