@@ -11,7 +11,10 @@ namespace {
 
 mneedle::LoadConstants silicone() {
   mneedle::LoadConstants c;
-  c.layers = {{0.0, 0.2e6, 0.48}};
+  mneedle::LoadLayer layer;
+  layer.youngs_modulus_Pa = 0.2e6;
+  layer.poisson_ratio = 0.48;
+  c.layers = {layer};
   return c;
 }
 

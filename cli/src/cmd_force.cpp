@@ -13,6 +13,7 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "loads_json.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
@@ -35,6 +36,12 @@ struct ForceOptions {
 struct NeedleCurve {
   std::string name;
   std::vector<LoadSample> curve;
+  double beta_length_m = 0.0;
+};
+
+struct ForceResult {
+  Scene scene;
+  std::vector<NeedleCurve> curves;
 };
 
 // 0, step, 2 step, ... up to the scene's insertion depth, which is always the last point.
@@ -61,8 +68,9 @@ bool needs_plugins(const Scene& scene) {
   return false;
 }
 
-std::vector<NeedleCurve> compute(const ForceOptions& options) {
-  const Scene scene = load_scene(options.scene);
+ForceResult compute(const ForceOptions& options) {
+  ForceResult result{load_scene(options.scene), {}};
+  const Scene& scene = result.scene;
   const double step = parse_quantity(options.step, Dimension::Length);
   if (!(step > 0.0)) throw InputError("--step " + options.step + ": must be a positive length");
   if (!(scene.insertion.depth > 0.0)) {
@@ -74,18 +82,17 @@ std::vector<NeedleCurve> compute(const ForceOptions& options) {
   // Plugins are searched only when a needle needs one, so STL-only scenes run without them.
   const PluginRegistry registry =
       needs_plugins(scene) ? PluginRegistry::discover(options.plugin_dirs) : PluginRegistry();
-  std::vector<NeedleCurve> curves;
   for (const NeedleSpec& spec : scene.needles) {
     const NeedleSource needle = needle_from_scene(registry, spec);
     const SurfaceLoadModel model(needle.mesh, constants);
-    curves.push_back({spec.name, model.curve(depths)});
+    result.curves.push_back({spec.name, model.curve(depths), model.beta_length_m()});
   }
-  return curves;
+  return result;
 }
 
-nlohmann::json to_json(const std::vector<NeedleCurve>& curves) {
+nlohmann::json to_json(const ForceResult& result) {
   nlohmann::json needles = nlohmann::json::array();
-  for (const NeedleCurve& c : curves) {
+  for (const NeedleCurve& c : result.curves) {
     nlohmann::json points = nlohmann::json::array();
     for (const LoadSample& s : c.curve) {
       points.push_back({{"depth_m", s.depth_m},
@@ -94,9 +101,9 @@ nlohmann::json to_json(const std::vector<NeedleCurve>& curves) {
                         {"beta_N", s.beta_N},
                         {"friction_N", s.friction_N}});
     }
-    needles.push_back({{"name", c.name}, {"curve", points}});
+    needles.push_back({{"name", c.name}, {"beta_length_m", c.beta_length_m}, {"curve", points}});
   }
-  return nlohmann::json{{"needles", needles}};
+  return nlohmann::json{{"loads", resolved_loads_json(result.scene)}, {"needles", needles}};
 }
 
 void print_csv(const std::vector<NeedleCurve>& curves) {
@@ -109,9 +116,12 @@ void print_csv(const std::vector<NeedleCurve>& curves) {
   }
 }
 
-void print_table(const std::vector<NeedleCurve>& curves) {
-  for (const NeedleCurve& c : curves) {
-    std::cout << c.name << "\n  depth_um    force_mN    alpha_mN     beta_mN  friction_mN\n";
+void print_table(const ForceResult& result) {
+  std::cout << "pressure scale per layer (docs/model.md, \"Pressure scale\"):\n"
+            << resolved_loads_text(result.scene);
+  for (const NeedleCurve& c : result.curves) {
+    std::cout << c.name << " (beta length " << format_quantity(c.beta_length_m, Dimension::Length)
+              << ")\n  depth_um    force_mN    alpha_mN     beta_mN  friction_mN\n";
     for (const LoadSample& s : c.curve) {
       std::cout << std::fixed << std::setprecision(4) << std::setw(10) << s.depth_m * 1e6
                 << std::setw(12) << s.force_N * 1e3 << std::setw(12) << s.alpha_N * 1e3
@@ -136,16 +146,16 @@ void add_force_command(CLI::App& app) {
                   "Largest number of depths a curve may have (default 1000000)");
   cmd->add_option("--plugin-dir", options->plugin_dirs, "Extra folder to search for plugins");
   cmd->callback([options] {
-    const std::vector<NeedleCurve> curves = compute(*options);
+    const ForceResult result = compute(*options);
     // Every format prints the same numbers: one check of the tree covers the CSV and table too.
-    const nlohmann::json tree = to_json(curves);
+    const nlohmann::json tree = to_json(result);
     require_finite_json(tree, "force");
     if (options->json) {
       std::cout << tree.dump(2) << "\n";
     } else if (options->csv) {
-      print_csv(curves);
+      print_csv(result.curves);
     } else {
-      print_table(curves);
+      print_table(result);
     }
   });
 }

@@ -10,6 +10,7 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "loads_json.h"
 #include "mneedle/base/units.h"
 #include "mneedle/scene/scene.h"
 
@@ -107,10 +108,16 @@ Json needle_json(const NeedleSpec& n) {
               {"material", optional_json(n.material)}};
 }
 
-Json loads_json(const Loads& l) {
+Json loads_json(const Scene& s) {
+  const Loads& l = s.loads;
   Json j{{"scale", l.scale},
          {"stiffness_Pa", optional_json(l.stiffness)},
          {"friction", to_string(l.friction)}};
+  if (l.mode == LoadMode::PaperAFig17) {
+    j["specimen_diameter_m"] = *l.specimen_diameter;
+    j["specimen_height_m"] = *l.specimen_height;
+  }
+  j["resolved"] = resolved_loads_json(s);
   if (l.friction == FrictionLaw::Coulomb) j["friction_coefficient"] = l.friction_coefficient;
   if (l.friction == FrictionLaw::LinearGrowth) {
     j["friction_max_force_N"] = l.friction_max_force;
@@ -145,7 +152,7 @@ Json scene_to_json(const Scene& s) {
                 {"outputs", outputs},
                 {"criterion", to_string(s.model.criterion)},
                 {"contact", to_string(s.model.contact)}}},
-              {"loads", loads_json(s.loads)},
+              {"loads", loads_json(s)},
               {"requirements",
                {{"target_depth_m", optional_json(s.requirements.target_depth)},
                 {"safety_factor", s.requirements.safety_factor}}},
@@ -228,7 +235,8 @@ void print_summary(std::ostream& out, const Scene& s) {
     out << " (F_max " << q(s.loads.friction_max_force, Dimension::Force) << " reached at "
         << q(s.loads.friction_saturation_depth, Dimension::Length) << ")";
   }
-  out << "\nrequirements: target depth "
+  out << "\n" << resolved_loads_text(s);
+  out << "requirements: target depth "
       << (s.requirements.target_depth ? q(*s.requirements.target_depth, Dimension::Length)
                                       : std::string("none"))
       << ", safety factor " << s.requirements.safety_factor << "\n";

@@ -15,6 +15,7 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "loads_json.h"
 #include "mneedle/base/error.h"
 #include "mneedle/design_source.h"
 #include "mneedle/fe/tissue_mesh.h"
@@ -106,7 +107,7 @@ nlohmann::json curve_json(const std::vector<RunPoint>& curve,
   return c;
 }
 
-nlohmann::json to_json(const InsertionRun& run) {
+nlohmann::json to_json(const InsertionRun& run, const Scene& scene) {
   nlohmann::json needles = nlohmann::json::array();
   for (const NeedleRun& n : run.needles) {
     nlohmann::json puncture = nullptr;
@@ -147,6 +148,7 @@ nlohmann::json to_json(const InsertionRun& run) {
           {"reductions", reductions},
           {"fidelity", fe::to_string(run.fidelity)},
           {"criterion", criterion},
+          {"loads", resolved_loads_json(scene)},
           {"pre_puncture_horizon_m", run.horizon_m},
           {"pre_puncture_step_m", run.first_step_m},
           {"seconds", run.seconds}};
@@ -225,7 +227,7 @@ void run(const SimulateOptions& o) {
   const InsertionRun result =
       run_insertion(scene, prepare_needles(registry, scene), run_options(scene, o));
   // Every format prints the numbers of this tree: check them once, before anything is printed.
-  const nlohmann::json tree = to_json(result);
+  const nlohmann::json tree = to_json(result, scene);
   require_finite_json(tree, o.scene.string());
   if (o.json)
     std::cout << tree.dump(2) << "\n";

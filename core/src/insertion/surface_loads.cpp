@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <sstream>
 #include <string>
 
 #include "mneedle/base/error.h"
@@ -35,6 +36,18 @@ void check_constants(const LoadConstants& c) {
                 std::isfinite(*c.friction_saturation_depth_m),
             "friction = linear_growth needs friction_saturation_depth > 0");
   }
+  require(!c.beta_length_m || (*c.beta_length_m > 0.0 && std::isfinite(*c.beta_length_m)),
+          "beta_length must be a positive length");
+  if (c.mode == LoadModelMode::paper_a_fig17) {
+    require(!c.stiffness_Pa && !c.beta_length_m,
+            "mode paper_a_fig17 sets K and beta_length itself; give neither");
+    for (const auto& [value, name] : {std::pair{c.specimen_diameter_m, "specimen_diameter"},
+                                      std::pair{c.specimen_height_m, "specimen_height"}}) {
+      require(value && *value > 0.0 && std::isfinite(*value),
+              std::string("mode paper_a_fig17 needs a positive ") + name);
+    }
+    require(!c.layers.empty(), "mode paper_a_fig17 needs the tissue layers (their E)");
+  }
   require(c.stiffness_Pa || !c.layers.empty(),
           "stiffness not given and no tissue layers to derive it from");
   for (std::size_t i = 0; i < c.layers.size(); ++i) {
@@ -46,6 +59,14 @@ void check_constants(const LoadConstants& c) {
             where + "Poisson ratio must lie in (-1, 0.5)");
     require(i + 1 == c.layers.size() || layer.thickness_m > 0.0,
             where + "thickness must be positive");
+    require(!layer.pressure_scale_Pa ||
+                (*layer.pressure_scale_Pa > 0.0 && std::isfinite(*layer.pressure_scale_Pa)),
+            where + "pressure_scale must be a positive pressure");
+    require(!layer.pressure_scale_Pa || !layer.pressure_scale_source.empty(),
+            where + "pressure_scale needs its source");
+    require(!layer.tensile_strength_Pa ||
+                (*layer.tensile_strength_Pa > 0.0 && !std::isnan(*layer.tensile_strength_Pa)),
+            where + "strength must be a positive pressure");
   }
 }
 
@@ -159,8 +180,13 @@ void mark_bore_walls(const std::vector<SideFace>& sides, const Vec3& d, std::vec
 
 LoadConstants load_constants(const Scene& scene) {
   LoadConstants c;
+  c.mode = scene.loads.mode == LoadMode::PaperAFig17 ? LoadModelMode::paper_a_fig17
+                                                     : LoadModelMode::distributed;
   c.scale = scene.loads.scale;
   c.stiffness_Pa = scene.loads.stiffness;
+  c.beta_length_m = scene.loads.beta_length;
+  c.specimen_diameter_m = scene.loads.specimen_diameter;
+  c.specimen_height_m = scene.loads.specimen_height;
   c.friction_coefficient = scene.loads.friction_coefficient;
   switch (scene.loads.friction) {
     case FrictionLaw::Coulomb:
@@ -176,14 +202,53 @@ LoadConstants load_constants(const Scene& scene) {
       break;
   }
   for (const TissueLayer& layer : scene.tissue.layers) {
-    c.layers.push_back(
-        {layer.thickness, layer.material.youngs_modulus, layer.material.poisson_ratio});
+    LoadLayer l{layer.thickness,      layer.material.youngs_modulus, layer.material.poisson_ratio,
+                layer.pressure_scale, layer.pressure_scale_source,   std::nullopt};
+    if (layer.strength) l.tensile_strength_Pa = layer.strength->strength;
+    c.layers.push_back(l);
   }
   return c;
 }
 
 double layer_stiffness(const LoadLayer& layer) {
   return layer.youngs_modulus_Pa / (1.0 - layer.poisson_ratio * layer.poisson_ratio);
+}
+
+std::vector<LayerPressure> layer_pressures(const LoadConstants& c) {
+  check_constants(c);
+  std::ostringstream scale_text;
+  scale_text << "S = " << c.scale;
+  const std::string s = scale_text.str();
+  std::vector<LayerPressure> out;
+  if (c.layers.empty()) {
+    out.push_back({*c.stiffness_Pa * c.scale, kInfinity, "[loads] stiffness K times " + s});
+    return out;
+  }
+  for (const LoadLayer& layer : c.layers) {
+    LayerPressure p;
+    p.wall_pressure_cap_Pa = kInfinity;
+    if (c.mode == LoadModelMode::paper_a_fig17) {
+      // Paper A's "tissue toughness" K of Fig. 17 is E D / (4 H) of its phantom (docs/model.md).
+      p.pressure_scale_Pa =
+          c.scale * layer.youngs_modulus_Pa * *c.specimen_diameter_m / (4.0 * *c.specimen_height_m);
+      p.source = "paper A Fig. 17: S E D / (4 H), " + s;
+      out.push_back(p);
+      continue;
+    }
+    if (layer.pressure_scale_Pa) {
+      p.pressure_scale_Pa = *layer.pressure_scale_Pa;
+      p.source = layer.pressure_scale_source;
+    } else if (c.stiffness_Pa) {
+      p.pressure_scale_Pa = *c.stiffness_Pa * c.scale;
+      p.source = "[loads] stiffness K times " + s;
+    } else {
+      p.pressure_scale_Pa = layer_stiffness(layer) * c.scale;
+      p.source = "derived: S E / (1 - nu^2), " + s + " (not fitted to this tissue)";
+    }
+    if (layer.tensile_strength_Pa) p.wall_pressure_cap_Pa = *layer.tensile_strength_Pa;
+    out.push_back(p);
+  }
+  return out;
 }
 
 double pentahedron_load(const std::array<Vec3, 3>& triangle,
@@ -239,48 +304,67 @@ SurfaceLoadModel::SurfaceLoadModel(const TriangleMesh& mesh, const LoadConstants
   mark_bore_walls(sides, d, faces_);
   require(frontal_area_m2_ > 0.0, "the needle mesh has no face looking along the insertion axis");
   reference_radius_m_ = std::sqrt(frontal_area_m2_ / std::numbers::pi);
-  if (constants_.stiffness_Pa) {
+  beta_length_m_ = constants_.mode == LoadModelMode::paper_a_fig17
+                       ? kPaperAFig17BetaLength_m
+                       : constants_.beta_length_m.value_or(reference_radius_m_);
+  layers_ = layer_pressures(constants_);
+  if (constants_.layers.empty()) {
     layer_bottom_m_ = {kInfinity};
-    layer_k_Pa_ = {*constants_.stiffness_Pa};
   } else {
     double bottom = 0.0;
     for (std::size_t i = 0; i < constants_.layers.size(); ++i) {
       const bool last = i + 1 == constants_.layers.size();
       bottom = last ? kInfinity : bottom + constants_.layers[i].thickness_m;
       layer_bottom_m_.push_back(bottom);
-      layer_k_Pa_.push_back(layer_stiffness(constants_.layers[i]));
     }
   }
 }
 
-void SurfaceLoadModel::add_piece(const Face& face, const std::vector<Vertex>& polygon, double k_Pa,
-                                 LoadSample& sample) const {
-  const double pressure = k_Pa * constants_.scale;
+// The beta load of one face piece: f = q h tan(theta) / l, rising from the tip, capped at the
+// layer's wall-pressure cap. The cap is reached at one height on a planar face (f is linear in
+// h there), so clipping at that height keeps the resultant exact: linear below, uniform above.
+void SurfaceLoadModel::add_beta(const Face& face, const std::vector<Vertex>& polygon,
+                                const LayerPressure& layer, LoadSample& sample) const {
+  const double per_height = layer.pressure_scale_Pa * face.tan_theta / beta_length_m_;
+  const double cap = layer.wall_pressure_cap_Pa;
+  const double cap_height = per_height > 0.0 ? cap / per_height : kInfinity;
+  std::vector<Vertex> below = polygon;
+  std::vector<Vertex> above;
+  double highest = -kInfinity;
+  for (const Vertex& v : polygon) highest = std::max(highest, v.height);
+  if (highest > cap_height) {
+    below = clip_height(polygon, cap_height, +1.0);
+    above = clip_height(polygon, cap_height, -1.0);
+  }
+  for (std::size_t i = 1; i + 1 < below.size(); ++i) {
+    const Vertex& a = below[0];
+    const Vertex& b = below[i];
+    const Vertex& c = below[i + 1];
+    const double resultant =
+        pentahedron_load({Vec3{a.u, a.v, 0.0}, Vec3{b.u, b.v, 0.0}, Vec3{c.u, c.v, 0.0}},
+                         {per_height * a.height, per_height * b.height, per_height * c.height});
+    sample.beta_N += resultant * face.along;
+  }
+  for (std::size_t i = 1; i + 1 < above.size(); ++i) {
+    sample.beta_N += cap * std::abs(signed_area(above[0], above[i], above[i + 1])) * face.along;
+  }
+}
+
+void SurfaceLoadModel::add_piece(const Face& face, const std::vector<Vertex>& polygon,
+                                 const LayerPressure& layer, LoadSample& sample) const {
+  if (face.group == SurfaceGroup::beta) {
+    add_beta(face, polygon, layer, sample);
+    return;
+  }
+  // The shaft is pressed by the opened hole's wall: q, unless the layer splits first.
+  const double wall = std::min(layer.pressure_scale_Pa, layer.wall_pressure_cap_Pa);
   for (std::size_t i = 1; i + 1 < polygon.size(); ++i) {
-    const Vertex& a = polygon[0];
-    const Vertex& b = polygon[i];
-    const Vertex& c = polygon[i + 1];
-    const double area = std::abs(signed_area(a, b, c));
-    switch (face.group) {
-      case SurfaceGroup::alpha:
-        sample.alpha_N += pressure * area;  // eq. 18
-        break;
-      case SurfaceGroup::beta: {
-        // Vertex load: K S times the lateral opening h tan(theta), per reference radius.
-        const double per_height = pressure * face.tan_theta / reference_radius_m_;
-        const double resultant =
-            pentahedron_load({Vec3{a.u, a.v, 0.0}, Vec3{b.u, b.v, 0.0}, Vec3{c.u, c.v, 0.0}},
-                             {per_height * a.height, per_height * b.height, per_height * c.height});
-        sample.beta_N += resultant * face.along;
-        break;
-      }
-      case SurfaceGroup::side:
-        if (constants_.friction == ShaftFriction::coulomb && !face.in_bore) {
-          sample.friction_N += constants_.friction_coefficient * pressure * area;
-        }
-        break;
-      case SurfaceGroup::back:
-        break;
+    const double area = std::abs(signed_area(polygon[0], polygon[i], polygon[i + 1]));
+    if (face.group == SurfaceGroup::alpha) {
+      sample.alpha_N += layer.pressure_scale_Pa * area;  // eq. 18
+    } else if (face.group == SurfaceGroup::side && !face.in_bore &&
+               constants_.friction == ShaftFriction::coulomb) {
+      sample.friction_N += constants_.friction_coefficient * wall * area;
     }
   }
 }
@@ -294,7 +378,7 @@ void SurfaceLoadModel::add_face(const Face& face, double depth_m, LoadSample& sa
     layer_top = layer_bottom_m_[j];
     if (face.lowest >= high || face.highest <= low) continue;
     const std::vector<Vertex> polygon = clip_to_slab(face, low, high);
-    if (polygon.size() >= 3) add_piece(face, polygon, layer_k_Pa_[j], sample);
+    if (polygon.size() >= 3) add_piece(face, polygon, layers_[j], sample);
   }
 }
 

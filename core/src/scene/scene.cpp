@@ -391,6 +391,18 @@ LayerDraft read_layer(Table t, bool is_last) {
   d.layer.fracture = read_fracture(t);
   d.layer.fracture_is_own = d.layer.fracture.has_value();
   d.layer.strength = read_layer_strength(t);
+  d.layer.pressure_scale = t.optional_positive("pressure_scale", Dimension::Pressure);
+  if (const auto source = t.optional_string("pressure_scale_source")) {
+    if (!d.layer.pressure_scale) {
+      t.fail_key("pressure_scale_source", "given without pressure_scale");
+    }
+    d.layer.pressure_scale_source = *source;
+  }
+  if (d.layer.pressure_scale && d.layer.pressure_scale_source.empty()) {
+    t.fail_missing("pressure_scale_source",
+                   "where pressure_scale comes from, such as \"fitted by mneedle calibrate to "
+                   "curve.csv\"");
+  }
   t.finish();
   return d;
 }
@@ -718,8 +730,31 @@ ModelOptions read_model(std::optional<Table> t, const Tissue& tissue) {
 Loads read_loads(std::optional<Table> t) {
   Loads l;
   if (!t) return l;
+  l.mode = t->optional_choice<LoadMode>("mode", {{"distributed", LoadMode::Distributed},
+                                                 {"paper_a_fig17", LoadMode::PaperAFig17}})
+               .value_or(l.mode);
   l.scale = t->optional_positive("scale", Dimension::Dimensionless).value_or(l.scale);
   l.stiffness = t->optional_positive("stiffness", Dimension::Pressure);
+  l.beta_length = t->optional_positive("beta_length", Dimension::Length);
+  l.specimen_diameter = t->optional_positive("specimen_diameter", Dimension::Length);
+  l.specimen_height = t->optional_positive("specimen_height", Dimension::Length);
+  if (l.mode == LoadMode::PaperAFig17) {
+    for (const auto* key : {"stiffness", "beta_length"}) {
+      if (t->get(key)) {
+        t->fail_key(key, "paper_a_fig17 sets it (K = E D / (4 H), beta_length = 1 um)");
+      }
+    }
+    if (!l.specimen_diameter) {
+      t->fail_missing("specimen_diameter", "the phantom's diameter, paper A: \"44.107 mm\"");
+    }
+    if (!l.specimen_height) {
+      t->fail_missing("specimen_height", "the phantom's height, paper A: \"21.145 mm\"");
+    }
+  } else {
+    for (const auto* key : {"specimen_diameter", "specimen_height"}) {
+      if (t->get(key)) t->fail_key(key, "applies only to mode = \"paper_a_fig17\"");
+    }
+  }
   l.friction =
       t->optional_choice<FrictionLaw>("friction", {{"coulomb", FrictionLaw::Coulomb},
                                                    {"linear_growth", FrictionLaw::LinearGrowth},

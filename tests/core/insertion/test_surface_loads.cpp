@@ -25,6 +25,14 @@ LoadConstants fixed_k() {
   return c;
 }
 
+mneedle::LoadLayer layer(double thickness, double youngs_modulus, double poisson_ratio) {
+  mneedle::LoadLayer l;
+  l.thickness_m = thickness;
+  l.youngs_modulus_Pa = youngs_modulus;
+  l.poisson_ratio = poisson_ratio;
+  return l;
+}
+
 double polygon_area(int n, double r) {
   return 0.5 * n * r * r * std::sin(2.0 * kPi / n);
 }
@@ -149,11 +157,108 @@ TEST(SurfaceLoads, TenTimesFinerTessellationChangesForceByLessThanOnePercent) {
 TEST(SurfaceLoads, EachLayerLoadsWithItsOwnStiffness) {
   LoadConstants c;
   c.friction = mneedle::ShaftFriction::none;
-  c.layers = {{100e-6, 1e6, 0.0}, {0.0, 0.2e6, 0.4}};
+  c.layers = {layer(100e-6, 1e6, 0.0), layer(0.0, 0.2e6, 0.4)};
   const SurfaceLoadModel model(mneedle::test::cylinder({}), c);
   const double end = polygon_area(64, kR);
   EXPECT_NEAR(model.at(50e-6).alpha_N, 1e6 * kS * end, 1e-12);
   EXPECT_NEAR(model.at(150e-6).alpha_N, 0.2e6 / (1 - 0.16) * kS * end, 1e-12);
+}
+
+TEST(SurfaceLoads, AGivenPressureScaleReplacesTheDerivedOneAndKeepsItsSource) {
+  LoadConstants c;
+  c.friction = mneedle::ShaftFriction::none;
+  c.layers = {layer(100e-6, 1e6, 0.0), layer(0.0, 0.2e6, 0.4)};
+  c.layers[1].pressure_scale_Pa = 5e4;
+  c.layers[1].pressure_scale_source = "fitted to curve.csv";
+  const SurfaceLoadModel model(mneedle::test::cylinder({}), c);
+  EXPECT_DOUBLE_EQ(model.layers()[0].pressure_scale_Pa, 1e6 * kS);
+  EXPECT_NE(model.layers()[0].source.find("derived"), std::string::npos);
+  EXPECT_EQ(model.layers()[1].source, "fitted to curve.csv");
+  EXPECT_NEAR(model.at(150e-6).alpha_N, 5e4 * polygon_area(64, kR), 1e-12);
+}
+
+TEST(SurfaceLoads, APressureScaleWithoutItsSourceIsAnInputError) {
+  LoadConstants c;
+  c.layers = {layer(0.0, 0.2e6, 0.4)};
+  c.layers[0].pressure_scale_Pa = 5e4;
+  EXPECT_THROW(SurfaceLoadModel(mneedle::test::cylinder({}), c), mneedle::InputError);
+}
+
+// Lame: the hoop stress at a pressurised hole equals the wall pressure, so a layer presses on
+// the shaft with at most its tensile strength (docs/model.md, "Wall pressure cap").
+TEST(SurfaceLoads, FrictionNormalStressIsCappedAtTheLayerStrength) {
+  const ShapeOptions o;
+  LoadConstants c;
+  c.layers = {layer(0.0, 1e9, 0.4)};
+  c.layers[0].tensile_strength_Pa = 21.6e6;
+  const SurfaceLoadModel model(mneedle::test::cylinder(o), c);
+  const double depth = 300e-6;
+  const auto s = model.at(depth);
+  const double perimeter = o.segments * 2.0 * kR * std::sin(kPi / o.segments);
+  EXPECT_NEAR(s.friction_N, 0.2 * 21.6e6 * perimeter * depth, 1e-12 * s.friction_N);
+  // The flat end is not a hole wall: it keeps q.
+  EXPECT_NEAR(s.alpha_N, 1e9 / (1 - 0.16) * kS * polygon_area(o.segments, kR), 1e-12 * s.alpha_N);
+}
+
+// A cone of half-angle a: f = q r / l with r = h tan a. Below r_c = cap l / q it is linear,
+// above it uniform: F = (2/3) pi q r_c^3 / l + cap pi (R^2 - r_c^2). Tolerance as for the
+// uncapped cone: 1 % for 128 facets around.
+TEST(SurfaceLoads, BetaLoadAboveTheCapIsUniformAndTheResultantStaysClosedForm) {
+  ShapeOptions o;
+  o.segments = 128;
+  const double half = kPi / 12.0;
+  LoadConstants c = fixed_k();
+  c.friction = mneedle::ShaftFriction::none;
+  c.stiffness_Pa.reset();
+  c.layers = {layer(0.0, kK * (1 - 0.16), 0.4)};
+  const double q = kK * kS;
+  const double cap = 0.5 * q;
+  c.layers[0].tensile_strength_Pa = cap;
+  const SurfaceLoadModel model(mneedle::test::cone(o, half, 16), c);
+  const double l = model.beta_length_m();
+  EXPECT_NEAR(l, std::sqrt(polygon_area(128, kR) / kPi), 1e-15);
+  const double rc = cap * l / q;
+  const double expected = 2.0 / 3.0 * kPi * q * rc * rc * rc / l + cap * kPi * (kR * kR - rc * rc);
+  EXPECT_NEAR(model.at(kR / std::tan(half) + 10e-6).beta_N, expected, 0.01 * expected);
+}
+
+TEST(SurfaceLoads, HalvingTheBetaLengthDoublesTheBetaLoad) {
+  ShapeOptions o;
+  o.segments = 128;
+  const double half = kPi / 12.0;
+  LoadConstants c = fixed_k();
+  c.friction = mneedle::ShaftFriction::none;
+  const auto mesh = mneedle::test::cone(o, half, 16);
+  const SurfaceLoadModel reference(mesh, c);
+  c.beta_length_m = 0.5 * reference.beta_length_m();
+  const SurfaceLoadModel halved(mesh, c);
+  const double depth = 0.6 * kR / std::tan(half);
+  EXPECT_NEAR(halved.at(depth).beta_N, 2.0 * reference.at(depth).beta_N,
+              1e-12 * reference.at(depth).beta_N);
+}
+
+// Paper A, paragraph on Fig. 17: "tissue toughness" 1.043e-7 and 2.607e-7 (N/um^2) for E = 0.2
+// and 0.5 MPa on a phantom 44.107 mm across and 21.145 mm high. K = E D / (4 H) gives both to
+// the four digits printed (half a unit of the last digit: 5e-4 relative).
+TEST(SurfaceLoads, PaperAFig17ModeTakesKFromThePhantomAndAOneMicrometreBetaLength) {
+  for (const auto& [modulus, paper_k] : {std::pair{0.2e6, 1.043e-7}, std::pair{0.5e6, 2.607e-7}}) {
+    LoadConstants c;
+    c.mode = mneedle::LoadModelMode::paper_a_fig17;
+    c.specimen_diameter_m = 44.107e-3;
+    c.specimen_height_m = 21.145e-3;
+    c.layers = {layer(0.0, modulus, 0.49)};
+    const SurfaceLoadModel model(mneedle::test::cylinder({}), c);
+    const double k_N_per_um2 = model.layers()[0].pressure_scale_Pa / kS * 1e-12;
+    EXPECT_NEAR(k_N_per_um2, paper_k, 5e-4 * paper_k) << "E = " << modulus;
+    EXPECT_DOUBLE_EQ(model.beta_length_m(), 1e-6);
+  }
+}
+
+TEST(SurfaceLoads, PaperAFig17ModeWithoutThePhantomSizeIsAnInputError) {
+  LoadConstants c;
+  c.mode = mneedle::LoadModelMode::paper_a_fig17;
+  c.layers = {layer(0.0, 0.2e6, 0.49)};
+  EXPECT_THROW(SurfaceLoadModel(mneedle::test::cylinder({}), c), mneedle::InputError);
 }
 
 TEST(SurfaceLoads, LinearGrowthFrictionSaturatesAtItsDepth) {

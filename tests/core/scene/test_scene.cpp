@@ -559,6 +559,33 @@ TEST(SceneErrors, LinearGrowthFrictionNeedsBothConstants) {
   expect_error(std::string(kBase) + "\n[loads]\nscale = -0.1\n", {"loads.scale", "positive"});
 }
 
+TEST(Scene, LayerPressureScaleIsReadWithItsSource) {
+  const Scene s = parse(with(R"(thickness = "1130 um")",
+                             "thickness = \"1130 um\"\npressure_scale = \"45 kPa\"\n"
+                             "pressure_scale_source = \"fitted to my_curve.csv\""));
+  ASSERT_TRUE(s.tissue.layers[1].pressure_scale.has_value());
+  EXPECT_DOUBLE_EQ(*s.tissue.layers[1].pressure_scale, 45e3);
+  EXPECT_EQ(s.tissue.layers[1].pressure_scale_source, "fitted to my_curve.csv");
+  EXPECT_FALSE(s.tissue.layers[0].pressure_scale.has_value());
+}
+
+TEST(SceneErrors, PressureScaleNeedsItsSource) {
+  expect_error(
+      with(R"(thickness = "1130 um")", "thickness = \"1130 um\"\npressure_scale = \"45 kPa\""),
+      {"tissue.layers[1].pressure_scale_source", "missing"});
+}
+
+TEST(SceneErrors, PaperAFig17ModeNeedsThePhantomAndOnlyIt) {
+  expect_error(std::string(kBase) + "\n[loads]\nmode = \"paper_a_fig17\"\n",
+               {"loads.specimen_diameter", "missing"});
+  expect_error(std::string(kBase) +
+                   "\n[loads]\nmode = \"paper_a_fig17\"\nspecimen_diameter = \"44.107 mm\"\n"
+                   "specimen_height = \"21.145 mm\"\nbeta_length = \"5 um\"\n",
+               {"loads.beta_length", "paper_a_fig17 sets it"});
+  expect_error(std::string(kBase) + "\n[loads]\nspecimen_height = \"21.145 mm\"\n",
+               {"loads.specimen_height", "only to mode"});
+}
+
 TEST(SceneErrors, RequirementsAreChecked) {
   expect_error(std::string(kBase) + "\n[requirements]\ntarget_depth = \"900 um\"\n",
                {"test.toml:34:", "requirements.target_depth", "deeper than insertion.depth"});

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "mneedle/geometry/surface_groups.h"
@@ -17,17 +18,38 @@ struct Scene;
 
 enum class ShaftFriction { none, coulomb, linear_growth };
 
+/// distributed: each layer's pressure scale q is given or S E / (1 - nu^2), and the beta load
+/// rises over the length l (default R_ref). paper_a_fig17: paper A's Fig. 17 as published,
+/// K = E D / (4 H) of its cylindrical phantom and l = 1 um (docs/model.md, "Pressure scale").
+enum class LoadModelMode { distributed, paper_a_fig17 };
+
 /// One tissue layer, listed from the surface down; the last one extends without end.
 struct LoadLayer {
   double thickness_m = 0.0;
   double youngs_modulus_Pa = 0.0;
   double poisson_ratio = 0.0;
+  std::optional<double> pressure_scale_Pa;  ///< q of this layer when given (a fit)
+  std::string pressure_scale_source;        ///< its provenance, required with it
+  /// Caps the lateral wall pressure (beta faces, shaft): a hole pressed wider than the layer's
+  /// tensile strength splits it (hoop stress = wall pressure, Lame). Empty: no cap.
+  std::optional<double> tensile_strength_Pa;
+};
+
+/// A layer's resolved pressure scale, the cap on its wall pressure, and where q comes from.
+struct LayerPressure {
+  double pressure_scale_Pa = 0.0;     ///< q = K S, Pa
+  double wall_pressure_cap_Pa = 0.0;  ///< min(q, strength) applies to friction; +inf: none
+  std::string source;
 };
 
 /// The constants of the model, independent of the scene file (Scene's [loads] maps onto this).
 struct LoadConstants {
-  double scale = 0.168;                ///< S, paper A Fig. 22 (its sharp bevel in silicone)
-  std::optional<double> stiffness_Pa;  ///< K for every layer; derived per layer when absent
+  LoadModelMode mode = LoadModelMode::distributed;
+  double scale = 0.168;                 ///< S, paper A Fig. 22 (its sharp bevel in silicone)
+  std::optional<double> stiffness_Pa;   ///< K for every layer; derived per layer when absent
+  std::optional<double> beta_length_m;  ///< l of the beta load; empty: R_ref (distributed mode)
+  std::optional<double> specimen_diameter_m;  ///< D, paper_a_fig17 only
+  std::optional<double> specimen_height_m;    ///< H, paper_a_fig17 only
   ShaftFriction friction = ShaftFriction::coulomb;
   double friction_coefficient = 0.2;                  ///< mu, paper B (needle on liver)
   std::optional<double> friction_max_force_N;         ///< F_max of the linear-growth law
@@ -41,6 +63,13 @@ LoadConstants load_constants(const Scene& scene);
 
 /// K of a layer: its plane-strain modulus E / (1 - nu^2), in Pa (derivation in docs/model.md).
 double layer_stiffness(const LoadLayer& layer);
+
+/// The pressure scale of every layer (one entry per layer; one entry when there are no layers
+/// and `stiffness_Pa` is given), with its provenance. Throws InputError for invalid constants.
+std::vector<LayerPressure> layer_pressures(const LoadConstants& constants);
+
+/// The beta-load length l of paper_a_fig17 mode: paper A's numbers are in micrometres.
+inline constexpr double kPaperAFig17BetaLength_m = 1e-6;
 
 /// One point of the post-puncture curve; forces along the insertion direction, in N.
 struct LoadSample {
@@ -76,8 +105,11 @@ class SurfaceLoadModel {
 
   /// Sum of forward faces' areas projected on the plane normal to the axis, m^2.
   double frontal_area_m2() const { return frontal_area_m2_; }
-  /// sqrt(frontal area / pi): the length over which a beta face's load rises to K S.
+  /// sqrt(frontal area / pi): the default beta length l.
   double reference_radius_m() const { return reference_radius_m_; }
+  /// l: the height above the tip (times tan theta) over which a beta face's load rises to q.
+  double beta_length_m() const { return beta_length_m_; }
+  const std::vector<LayerPressure>& layers() const { return layers_; }
 
   struct Vertex {
     double u, v;    ///< in the face's own plane, m
@@ -94,15 +126,18 @@ class SurfaceLoadModel {
 
  private:
   void add_face(const Face& face, double depth_m, LoadSample& sample) const;
-  void add_piece(const Face& face, const std::vector<Vertex>& polygon, double k_Pa,
+  void add_piece(const Face& face, const std::vector<Vertex>& polygon, const LayerPressure& layer,
                  LoadSample& sample) const;
+  void add_beta(const Face& face, const std::vector<Vertex>& polygon, const LayerPressure& layer,
+                LoadSample& sample) const;
 
   LoadConstants constants_;
   std::vector<Face> faces_;
   std::vector<double> layer_bottom_m_;  ///< depth below the surface of each layer's bottom
-  std::vector<double> layer_k_Pa_;
+  std::vector<LayerPressure> layers_;
   double frontal_area_m2_ = 0.0;
   double reference_radius_m_ = 0.0;
+  double beta_length_m_ = 0.0;
 };
 
 /// One-off evaluation at a single depth (see SurfaceLoadModel).

@@ -57,6 +57,10 @@ struct TissueLayer {
   std::optional<Fracture> fracture;
   bool fracture_is_own = false;
   std::optional<LayerStrength> strength;
+  /// q, Pa: the post-puncture pressure scale of this layer (docs/model.md, "Pressure scale");
+  /// absent = derived from [loads]. Given only with its provenance.
+  std::optional<double> pressure_scale;
+  std::string pressure_scale_source;  ///< where q comes from (a fit, a paper), free text
   int line = 0;  ///< line of the layer in the scene file, for later error messages
 };
 
@@ -118,10 +122,20 @@ struct ModelOptions {
 
 enum class FrictionLaw { Coulomb, LinearGrowth, None };
 
+/// How the layer pressure scales of the post-puncture model are obtained (docs/model.md).
+enum class LoadMode {
+  Distributed,  ///< q per layer: given, or S E / (1 - nu^2); beta length from the needle
+  PaperAFig17,  ///< paper A Fig. 17: K = E D / (4 H) of its phantom, beta length 1 um
+};
+
 /// Constants of paper A's post-puncture distributed-load model (provenance in docs/scene.md).
 struct Loads {
-  double scale = 0.168;             ///< S, paper A Fig. 22 (sharp bevel in silicone)
-  std::optional<double> stiffness;  ///< K, Pa; absent = derived from the layer modulus
+  LoadMode mode = LoadMode::Distributed;
+  double scale = 0.168;                     ///< S, paper A Fig. 22 (sharp bevel in silicone)
+  std::optional<double> stiffness;          ///< K, Pa; absent = derived from the layer modulus
+  std::optional<double> beta_length;        ///< l, m; absent = the needle's R_ref
+  std::optional<double> specimen_diameter;  ///< m, paper_a_fig17 only (paper A: 44.107 mm)
+  std::optional<double> specimen_height;    ///< m, paper_a_fig17 only (paper A: 21.145 mm)
   FrictionLaw friction = FrictionLaw::Coulomb;
   double friction_coefficient = 0.2;       ///< mu, paper B (needle-tissue)
   double friction_max_force = 0.0;         ///< N, linear_growth only (paper C eq. 2, F_max)
