@@ -50,6 +50,8 @@ void check_constants(const LoadConstants& c) {
   }
   require(c.stiffness_Pa || !c.layers.empty(),
           "stiffness not given and no tissue layers to derive it from");
+  require(!c.tissue_depth_m || (*c.tissue_depth_m > 0.0 && !std::isnan(*c.tissue_depth_m)),
+          "the tissue depth must be positive");
   for (std::size_t i = 0; i < c.layers.size(); ++i) {
     const LoadLayer& layer = c.layers[i];
     const std::string where = "layer " + std::to_string(i + 1) + ": ";
@@ -201,6 +203,7 @@ LoadConstants load_constants(const Scene& scene) {
       c.friction = ShaftFriction::none;
       break;
   }
+  c.tissue_depth_m = scene.tissue.depth();
   for (const TissueLayer& layer : scene.tissue.layers) {
     LoadLayer l{layer.thickness,      layer.material.youngs_modulus, layer.material.poisson_ratio,
                 layer.pressure_scale, layer.pressure_scale_source,   std::nullopt};
@@ -308,13 +311,14 @@ SurfaceLoadModel::SurfaceLoadModel(const TriangleMesh& mesh, const LoadConstants
                        ? kPaperAFig17BetaLength_m
                        : constants_.beta_length_m.value_or(reference_radius_m_);
   layers_ = layer_pressures(constants_);
+  const double floor = constants_.tissue_depth_m.value_or(kInfinity);
   if (constants_.layers.empty()) {
-    layer_bottom_m_ = {kInfinity};
+    layer_bottom_m_ = {floor};
   } else {
     double bottom = 0.0;
     for (std::size_t i = 0; i < constants_.layers.size(); ++i) {
       const bool last = i + 1 == constants_.layers.size();
-      bottom = last ? kInfinity : bottom + constants_.layers[i].thickness_m;
+      bottom = last ? floor : std::min(floor, bottom + constants_.layers[i].thickness_m);
       layer_bottom_m_.push_back(bottom);
     }
   }

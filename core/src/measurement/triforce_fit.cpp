@@ -9,34 +9,19 @@
 #include <random>
 #include <set>
 
+#include "measurement/bounded_transform.h"
 #include "measurement/levenberg_marquardt.h"
 #include "mneedle/base/error.h"
 
 namespace mneedle {
 namespace {
 
+using detail::Bound;
+using detail::standard_errors;
+using detail::to_external;
+using detail::to_internal;
+
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-
-// A parameter's admissible interval; `log` parameters span decades and are searched in log space.
-struct Bound {
-  double lo = 0.0;
-  double hi = 1.0;
-  bool log = false;
-};
-
-double to_internal(double value, const Bound& b) {
-  const double q = b.log ? std::log(value) : value;
-  const double lo = b.log ? std::log(b.lo) : b.lo;
-  const double hi = b.log ? std::log(b.hi) : b.hi;
-  const double t = std::clamp((q - lo) / (hi - lo), 1e-9, 1.0 - 1e-9);
-  return std::log(t / (1.0 - t));
-}
-
-double to_external(double u, const Bound& b) {
-  const double t = 1.0 / (1.0 + std::exp(-u));
-  if (b.log) return std::exp(std::log(b.lo) + t * (std::log(b.hi) - std::log(b.lo)));
-  return b.lo + t * (b.hi - b.lo);
-}
 
 // Scales of the data that set the parameter bounds and the first start.
 struct DataScale {
@@ -193,58 +178,6 @@ void check_curves(const std::vector<FitCurve>& curves) {
   }
 }
 
-// Derivative of the residuals with respect to the physical parameters; one-sided at a bound.
-Eigen::MatrixXd physical_jacobian(const Problem& problem, const Eigen::VectorXd& x,
-                                  const std::vector<Bound>& bounds) {
-  const Eigen::VectorXd r0 = problem.residuals(x);
-  Eigen::MatrixXd jac(r0.size(), x.size());
-  for (Eigen::Index j = 0; j < x.size(); ++j) {
-    const auto& b = bounds[static_cast<std::size_t>(j)];
-    const double h = 1e-6 * std::max(std::abs(x[j]), 1e-3 * (b.hi - b.lo));
-    Eigen::VectorXd up = x, down = x;
-    up[j] += h;
-    down[j] -= h;
-    if (down[j] < b.lo) {
-      jac.col(j) = (problem.residuals(up) - r0) / h;
-    } else if (up[j] > b.hi) {
-      jac.col(j) = (r0 - problem.residuals(down)) / h;
-    } else {
-      jac.col(j) = (problem.residuals(up) - problem.residuals(down)) / (2.0 * h);
-    }
-  }
-  return jac;
-}
-
-// sqrt(diag(s^2 (J^T J)^-1)); directions the data cannot see give infinite errors.
-Eigen::VectorXd standard_errors(const Eigen::MatrixXd& jac, double variance) {
-  const Eigen::Index p = jac.cols();
-  Eigen::VectorXd scale = jac.colwise().norm().transpose();
-  for (Eigen::Index j = 0; j < p; ++j) scale[j] = scale[j] > 0.0 ? 1.0 / scale[j] : 0.0;
-  const Eigen::MatrixXd scaled = jac * scale.asDiagonal();
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled.transpose() * scaled);
-  const Eigen::VectorXd& lambda = eig.eigenvalues();
-  const Eigen::MatrixXd& v = eig.eigenvectors();
-  const double floor = 1e-13 * std::max(lambda.maxCoeff(), 1e-300);
-  Eigen::VectorXd out = Eigen::VectorXd::Zero(p);
-  for (Eigen::Index j = 0; j < p; ++j) {
-    if (scale[j] == 0.0) {
-      out[j] = kInfinity;
-      continue;
-    }
-    double var = 0.0;
-    for (Eigen::Index k = 0; k < p; ++k) {
-      const double weight = v(j, k) * v(j, k);
-      if (lambda[k] <= floor) {
-        if (weight > 1e-12) var = kInfinity;
-      } else {
-        var += weight / lambda[k];
-      }
-    }
-    out[j] = std::isfinite(var) ? std::sqrt(variance * var) * scale[j] : kInfinity;
-  }
-  return out;
-}
-
 }  // namespace
 
 std::vector<double> predict_loading(const TriforceModel& model, const FitCurve& curve,
@@ -323,7 +256,10 @@ TriforceFit fit_triforce(const std::vector<FitCurve>& curves, const TriforceFitO
   fit.converged = best.converged;
   const double variance = best.cost / static_cast<double>(n - p);
   fit.residual_sd_N = std::sqrt(variance);
-  const Eigen::VectorXd errors = standard_errors(physical_jacobian(problem, x, bounds), variance);
+  const Eigen::VectorXd errors = standard_errors(
+      detail::physical_jacobian([&](const Eigen::VectorXd& y) { return problem.residuals(y); }, x,
+                                bounds),
+      variance);
 
   for (const auto& [name, value] : named_parameters(fit.params)) {
     FitParameter fp{name, value, 0.0, false};

@@ -261,6 +261,20 @@ TEST(SurfaceLoads, PaperAFig17ModeWithoutThePhantomSizeIsAnInputError) {
   EXPECT_THROW(SurfaceLoadModel(mneedle::test::cylinder({}), c), mneedle::InputError);
 }
 
+// Past the tissue's bottom the tip is out of the sample: the end carries nothing and friction
+// stops growing at the wetted length of the whole thickness.
+TEST(SurfaceLoads, ANeedleThroughTheSampleLosesItsTipLoadAndKeepsFrictionOfTheThickness) {
+  const ShapeOptions o;
+  LoadConstants c = fixed_k();
+  c.tissue_depth_m = 400e-6;
+  const SurfaceLoadModel model(mneedle::test::cylinder(o), c);
+  const auto through = model.at(600e-6);
+  EXPECT_DOUBLE_EQ(through.alpha_N, 0.0);
+  const double perimeter = o.segments * 2.0 * kR * std::sin(kPi / o.segments);
+  EXPECT_NEAR(through.friction_N, 0.2 * kK * kS * perimeter * 400e-6, 1e-12);
+  EXPECT_NEAR(model.at(300e-6).alpha_N, kK * kS * polygon_area(o.segments, kR), 1e-12);
+}
+
 TEST(SurfaceLoads, LinearGrowthFrictionSaturatesAtItsDepth) {
   LoadConstants c = fixed_k();
   c.friction = mneedle::ShaftFriction::linear_growth;

@@ -23,7 +23,8 @@ enum class ShaftFriction { none, coulomb, linear_growth };
 /// K = E D / (4 H) of its cylindrical phantom and l = 1 um (docs/model.md, "Pressure scale").
 enum class LoadModelMode { distributed, paper_a_fig17 };
 
-/// One tissue layer, listed from the surface down; the last one extends without end.
+/// One tissue layer, listed from the surface down; the last one reaches the tissue's bottom
+/// (LoadConstants::tissue_depth_m) or, without one, extends without end.
 struct LoadLayer {
   double thickness_m = 0.0;
   double youngs_modulus_Pa = 0.0;
@@ -55,6 +56,9 @@ struct LoadConstants {
   std::optional<double> friction_max_force_N;         ///< F_max of the linear-growth law
   std::optional<double> friction_saturation_depth_m;  ///< d of the linear-growth law
   std::vector<LoadLayer> layers;                      ///< from the surface down
+  /// Depth of the tissue's bottom face: below it the needle is out of the tissue and carries
+  /// no load (a needle passing through a sample). Empty: the last layer extends without end.
+  std::optional<double> tissue_depth_m;
 };
 
 /// The scene's [loads] table and tissue layers as load constants (friction_max_force and

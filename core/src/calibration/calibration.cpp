@@ -1,0 +1,420 @@
+#include "mneedle/calibration/calibration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "mneedle/base/error.h"
+#include "mneedle/insertion/puncture.h"
+#include "mneedle/insertion/surface_loads.h"
+#include "mneedle/measurement/bounded_least_squares.h"
+
+namespace mneedle {
+namespace {
+
+constexpr double kNeverFires = 1e300;    // a finite threshold no pre-puncture model reaches
+constexpr double kFirstRung_m = 100e-6;  // the ladder's first horizon (insertion_planner.cpp)
+
+void fail(const std::string& problem) {
+  throw InputError("calibrate: " + problem);
+}
+
+// The recording from contact to its deepest point, depth below the undeformed surface.
+struct Samples {
+  std::vector<double> travel_m, depth_m, force_N;
+  double contact_travel_m = 0.0;
+};
+
+Samples samples_from(const ForceCurve& measured, std::optional<double> contact_travel_m) {
+  Samples s;
+  if (contact_travel_m) {
+    s.contact_travel_m = *contact_travel_m;
+    double deepest = -std::numeric_limits<double>::infinity();
+    for (double t : measured.depth_m) deepest = std::max(deepest, t);
+    for (std::size_t i = 0; i < measured.depth_m.size(); ++i) {
+      const double depth = measured.depth_m[i] - *contact_travel_m;
+      if (depth >= 0.0) {
+        s.travel_m.push_back(measured.depth_m[i]);
+        s.depth_m.push_back(depth);
+        s.force_N.push_back(measured.force_N[i]);
+      }
+      if (measured.depth_m[i] == deepest) break;  // the hold and the retraction are not insertion
+    }
+  } else {
+    const LoadingBranch branch = extract_loading_branch(measured);
+    s.contact_travel_m = branch.contact_travel_m;
+    s.depth_m = branch.curve.depth_m;
+    s.force_N = branch.curve.force_N;
+    for (double d : s.depth_m) s.travel_m.push_back(d + branch.contact_travel_m);
+  }
+  return s;
+}
+
+struct PreCurve {
+  std::vector<double> depth_m, force_N, criterion;
+};
+
+// One pre-puncture run for one rung of the horizon ladder (docs/model.md, "Pre-puncture
+// horizon") with a threshold it never reaches, so every step carries the criterion's quantity
+// and any threshold's crossing can be read off it on the same mesh run_insertion would use.
+PreCurve pre_puncture_curve(Scene scene, const PreparedNeedle& needle, double depth_m,
+                            const InsertionRunOptions& run_options) {
+  scene.insertion.depth = depth_m;
+  scene.requirements.target_depth.reset();
+  scene.model.outputs = {Output::Puncture, Output::ForceCurve};
+  TissueLayer& top = scene.tissue.layers.front();
+  Fracture f = top.fracture.value_or(Fracture{});
+  f.toughness = kNeverFires;
+  f.critical_pressure = kNeverFires;
+  top.fracture = f;
+  InsertionRunOptions options = run_options;
+  options.vtu_directory.clear();
+  const InsertionRun run = run_insertion(scene, {needle}, options);
+  PreCurve pre;
+  for (const RunPoint& p : run.needles.front().curve) {
+    if (p.stage != Stage::Pre || !(p.depth_m > 0.0)) continue;
+    pre.depth_m.push_back(p.depth_m);
+    pre.force_N.push_back(p.force_N);
+    const CriterionSample c{p.depth_m, p.section_pressure_Pa, p.tip_stress_Pa,
+                            p.energy_release_rate_J_per_m2};
+    pre.criterion.push_back(criterion_value(options.criterion, c));
+  }
+  if (pre.depth_m.empty()) throw SolverError("calibrate: the pre-puncture run gave no steps");
+  return pre;
+}
+
+struct Line {
+  double slope = 0.0, intercept = 0.0;
+};
+
+Line least_squares_line(const std::vector<double>& x, const std::vector<double>& y) {
+  const double n = static_cast<double>(x.size());
+  double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    sx += x[i];
+    sy += y[i];
+    sxx += x[i] * x[i];
+    sxy += x[i] * y[i];
+  }
+  const double det = n * sxx - sx * sx;
+  if (!(det > 0.0)) return {0.0, sy / n};
+  return {(n * sxy - sx * sy) / det, (sy * sxx - sx * sxy) / det};
+}
+
+}  // namespace
+
+CalibratedConstant calibrated_constant(const std::string& name) {
+  if (name == "scale") return CalibratedConstant::scale;
+  if (name == "friction_coefficient") return CalibratedConstant::friction_coefficient;
+  if (name == "critical_pressure") return CalibratedConstant::critical_pressure;
+  if (name == "toughness") return CalibratedConstant::toughness;
+  fail("--fit " + name +
+       ": unknown constant (scale, friction_coefficient, critical_pressure, toughness)");
+  return CalibratedConstant::scale;
+}
+
+std::string to_string(CalibratedConstant c) {
+  switch (c) {
+    case CalibratedConstant::scale:
+      return "scale";
+    case CalibratedConstant::friction_coefficient:
+      return "friction_coefficient";
+    case CalibratedConstant::critical_pressure:
+      return "critical_pressure";
+    case CalibratedConstant::toughness:
+      return "toughness";
+  }
+  return "?";
+}
+
+Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const ForceCurve& measured,
+                      const CalibrationOptions& options) {
+  // ---- setup: what is fitted, and on which samples --------------------------------------------
+  if (options.fit.empty()) fail("nothing to fit (--fit scale,friction_coefficient,...)");
+  const std::set<CalibratedConstant> chosen(options.fit.begin(), options.fit.end());
+  if (chosen.size() != options.fit.size()) fail("a constant is listed twice in --fit");
+  const bool fits_pc = chosen.count(CalibratedConstant::critical_pressure) > 0;
+  const bool fits_gamma = chosen.count(CalibratedConstant::toughness) > 0;
+  if (fits_pc && fits_gamma) {
+    fail(
+        "critical_pressure and toughness together: one curve has one puncture, which fixes "
+        "one of them, not both");
+  }
+  if ((fits_pc || fits_gamma) && options.puncture_travel_m) {
+    fail("a criterion constant cannot be fitted when the puncture is given (--puncture-at)");
+  }
+  const PunctureCriterion criterion = options.run.criterion;
+  if (fits_pc && criterion != PunctureCriterion::Pressure) {
+    fail("critical_pressure is the pressure criterion's; the run uses another criterion");
+  }
+  if (fits_gamma && criterion != PunctureCriterion::Energy) {
+    fail("toughness is the energy criterion's; the run uses another criterion");
+  }
+  LoadConstants base = load_constants(scene);
+  if (chosen.count(CalibratedConstant::friction_coefficient) &&
+      base.friction != ShaftFriction::coulomb) {
+    fail("friction_coefficient needs [loads] friction = \"coulomb\"");
+  }
+  const std::vector<LayerPressure> base_q = layer_pressures(base);
+
+  const Samples all = samples_from(measured, options.contact_travel_m);
+  std::optional<double> given_puncture_depth;
+  if (options.puncture_travel_m)
+    given_puncture_depth = *options.puncture_travel_m - all.contact_travel_m;
+  std::vector<std::size_t> used;  // samples the model covers
+  for (std::size_t i = 0; i < all.depth_m.size(); ++i) {
+    if (given_puncture_depth && all.depth_m[i] < *given_puncture_depth) continue;
+    used.push_back(i);
+  }
+  if (used.size() < options.fit.size() + 2) {
+    fail(measured.source + ": " + std::to_string(used.size()) + " samples for " +
+         std::to_string(options.fit.size()) + " constants");
+  }
+  const auto in_fit = [&](std::size_t i) {
+    const double t = all.travel_m[i];
+    return (!options.fit_from_travel_m || t >= *options.fit_from_travel_m) &&
+           (!options.fit_to_travel_m || t <= *options.fit_to_travel_m);
+  };
+  std::vector<std::size_t> fitted;
+  for (std::size_t i : used) {
+    if (in_fit(i)) fitted.push_back(i);
+  }
+  if (fitted.size() <= options.fit.size()) {
+    fail(measured.source + ": " + std::to_string(fitted.size()) +
+         " samples in the fit interval for " + std::to_string(options.fit.size()) + " constants");
+  }
+
+  // ---- the model: pre-puncture run once, post-puncture loads per evaluation
+  // ---------------------- Rungs 100 um x 2^k up to the one covering the deepest sample, as
+  // run_insertion climbs them: a threshold's puncture is read on the first rung that reaches it.
+  std::vector<PreCurve> rungs;
+  double scene_threshold = 0.0;
+  if (!given_puncture_depth) {
+    double deepest = 0.0;
+    for (std::size_t i : used) deepest = std::max(deepest, all.depth_m[i]);
+    for (double horizon = kFirstRung_m;; horizon *= 2.0) {
+      rungs.push_back(pre_puncture_curve(scene, needle, horizon, options.run));
+      if (horizon >= deepest * (1.0 - 1e-12)) break;
+    }
+    if (!fits_pc && !fits_gamma) scene_threshold = puncture_threshold(scene, criterion).threshold;
+  }
+  const PreCurve* last_rung = rungs.empty() ? nullptr : &rungs.back();
+
+  struct Values {
+    double scale = 1.0, mu = 0.0;
+  };
+  // Where the model punctures and which pre-puncture curve it follows until then.
+  struct Split {
+    std::optional<double> depth;
+    const PreCurve* pre = nullptr;
+  };
+  const auto split_for_threshold = [&](double threshold) {
+    Split split{given_puncture_depth, last_rung};
+    for (const PreCurve& rung : rungs) {
+      if (const auto crossing = first_crossing(rung.depth_m, rung.criterion, threshold)) {
+        split = {crossing->depth_m, &rung};
+        break;
+      }
+    }
+    return split;
+  };
+  const auto rung_for_depth = [&](double depth) {
+    for (const PreCurve& rung : rungs) {
+      if (rung.depth_m.back() >= depth * (1.0 - 1e-12)) return &rung;
+    }
+    return last_rung;
+  };
+  const auto model_at = [&](const Values& v, const Split& split,
+                            const std::vector<std::size_t>& which) {
+    LoadConstants c = base;
+    c.friction_coefficient = v.mu;
+    for (std::size_t j = 0; j < c.layers.size(); ++j) {
+      c.layers[j].pressure_scale_Pa = v.scale * base_q[j].pressure_scale_Pa;
+      c.layers[j].pressure_scale_source = "calibrate";
+    }
+    if (c.layers.empty()) c.stiffness_Pa = *base.stiffness_Pa * v.scale;
+    const SurfaceLoadModel post(needle.mesh, c);
+    std::vector<double> out;
+    for (std::size_t i : which) {
+      const double z = all.depth_m[i];
+      const bool after = split.depth && z >= *split.depth;
+      out.push_back(after ? post.at(z).force_N
+                          : interpolate_at(split.pre->depth_m, split.pre->force_N, z));
+    }
+    return out;
+  };
+
+  // The constants a derivative can move (scale, mu); the criterion's constant only decides
+  // between which two samples the model punctures, so it is searched over those gaps.
+  std::vector<std::size_t> smooth;  // indices into options.fit
+  std::vector<ParameterBound> bounds;
+  std::vector<double> x0;
+  for (std::size_t j = 0; j < options.fit.size(); ++j) {
+    if (options.fit[j] == CalibratedConstant::scale) {
+      smooth.push_back(j);
+      bounds.push_back({1e-4, 1e4, true});
+      x0.push_back(1.0);
+    } else if (options.fit[j] == CalibratedConstant::friction_coefficient) {
+      smooth.push_back(j);
+      // Needle-tissue friction coefficients are reported from about 0.05 to 0.5 (paper B: 0.2);
+      // 1 bounds them with room to spare.
+      bounds.push_back({0.0, 1.0, false});
+      x0.push_back(std::clamp(base.friction_coefficient, 0.01, 0.99));
+    }
+  }
+  const auto values_of = [&](const std::vector<double>& x) {
+    Values v{1.0, base.friction_coefficient};
+    for (std::size_t k = 0; k < smooth.size(); ++k) {
+      if (options.fit[smooth[k]] == CalibratedConstant::scale) v.scale = x[k];
+      if (options.fit[smooth[k]] == CalibratedConstant::friction_coefficient) v.mu = x[k];
+    }
+    return v;
+  };
+  const auto residuals_for = [&](const Split& split) -> ResidualVector {
+    return [&, split](const std::vector<double>& x) {
+      const std::vector<double> model = model_at(values_of(x), split, fitted);
+      std::vector<double> r(model.size());
+      for (std::size_t k = 0; k < fitted.size(); ++k) r[k] = all.force_N[fitted[k]] - model[k];
+      return r;
+    };
+  };
+  const auto cost_of = [](const std::vector<double>& r) {
+    double sum = 0.0;
+    for (double v : r) sum += v * v;
+    return sum;
+  };
+
+  // ---- solve
+  // -------------------------------------------------------------------------------------
+  Split best_split;
+  BoundedFit fit;
+  std::optional<double> threshold, threshold_error;
+  if (!fits_pc && !fits_gamma) {
+    best_split = given_puncture_depth ? Split{given_puncture_depth, nullptr}
+                                      : split_for_threshold(scene_threshold);
+    fit = fit_bounded(residuals_for(best_split), x0, bounds, {});
+  } else {
+    // Gaps between consecutive fitted depths that the pre-puncture run covers; the puncture in
+    // the middle of a gap stands for the whole gap (the residuals are the same anywhere in it).
+    std::vector<double> depths;
+    for (std::size_t i : fitted) depths.push_back(all.depth_m[i]);
+    std::sort(depths.begin(), depths.end());
+    depths.erase(std::unique(depths.begin(), depths.end()), depths.end());
+    std::vector<std::pair<double, double>> gaps;
+    for (std::size_t k = 0; k + 1 < depths.size(); ++k) {
+      if (depths[k + 1] <= last_rung->depth_m.back()) gaps.push_back({depths[k], depths[k + 1]});
+    }
+    if (gaps.empty()) fail("no two fitted samples lie within the pre-puncture run's depth");
+    const auto gap_cost = [&](std::size_t g, std::vector<double>& x, int starts) {
+      const double d = 0.5 * (gaps[g].first + gaps[g].second);
+      const Split split{d, rung_for_depth(d)};
+      if (smooth.empty()) return cost_of(residuals_for(split)(x));
+      BoundedFitOptions o;
+      o.starts = starts;
+      o.max_iterations = 60;
+      const BoundedFit f = fit_bounded(residuals_for(split), x, bounds, o);
+      x = f.x;
+      return f.cost;
+    };
+    // Every gap when there are few, else every k-th and then the neighbours of the best.
+    const std::size_t stride = std::max<std::size_t>(1, gaps.size() / 40);
+    std::size_t best_gap = 0;
+    double best_cost = std::numeric_limits<double>::infinity();
+    std::vector<double> x_start = x0;
+    const auto consider = [&](std::size_t g) {
+      std::vector<double> x = x_start;
+      const double c = gap_cost(g, x, 1);
+      if (c < best_cost) {
+        best_cost = c;
+        best_gap = g;
+        x_start = x;
+      }
+    };
+    for (std::size_t g = 0; g < gaps.size(); g += stride) consider(g);
+    if (stride > 1) {
+      const std::size_t centre = best_gap;
+      for (std::size_t g = centre > stride ? centre - stride : 0;
+           g < std::min(gaps.size(), centre + stride + 1); ++g) {
+        consider(g);
+      }
+    }
+    const double d = 0.5 * (gaps[best_gap].first + gaps[best_gap].second);
+    best_split = {d, rung_for_depth(d)};
+    if (!smooth.empty()) fit = fit_bounded(residuals_for(best_split), x_start, bounds, {});
+    const PreCurve& rung = *best_split.pre;
+    const double lo = interpolate_at(rung.depth_m, rung.criterion, gaps[best_gap].first);
+    const double hi = interpolate_at(rung.depth_m, rung.criterion, gaps[best_gap].second);
+    threshold = interpolate_at(rung.depth_m, rung.criterion, d);
+    // Anywhere in the gap fits as well: a uniform spread over it.
+    threshold_error = std::abs(hi - lo) / std::sqrt(12.0);
+  }
+
+  // ---- output
+  // ------------------------------------------------------------------------------------
+  Calibration out;
+  out.contact_travel_m = all.contact_travel_m;
+  out.converged = smooth.empty() || fit.converged;
+  out.iterations = fit.iterations;
+  const std::size_t p = options.fit.size();
+  out.correlation.assign(p, std::vector<double>(p, 0.0));
+  for (std::size_t j = 0; j < p; ++j) out.correlation[j][j] = 1.0;
+  for (std::size_t a = 0; a < smooth.size(); ++a) {
+    for (std::size_t b = 0; b < smooth.size(); ++b) {
+      out.correlation[smooth[a]][smooth[b]] = fit.correlation[a][b];
+    }
+  }
+  for (std::size_t j = 0; j < p; ++j) {
+    CalibratedParameter param;
+    param.constant = options.fit[j];
+    const auto k = std::find(smooth.begin(), smooth.end(), j);
+    if (k != smooth.end()) {
+      const auto n = static_cast<std::size_t>(k - smooth.begin());
+      param.initial = x0[n];
+      param.value = fit.x[n];
+      param.standard_error = fit.standard_error[n];
+      param.at_bound = fit.at_bound[n];
+      if (param.constant == CalibratedConstant::scale) param.initial = 1.0;
+    } else {
+      const auto own = scene.tissue.layers.front().fracture;
+      param.initial = own ? (fits_pc ? own->critical_pressure : own->toughness) : 0.0;
+      param.value = *threshold;
+      param.standard_error = *threshold_error;
+    }
+    out.parameters.push_back(param);
+  }
+  const Values best = values_of(smooth.empty() ? std::vector<double>{} : fit.x);
+  out.puncture_depth_m = best_split.depth;
+  const std::vector<double> model = model_at(best, best_split, used);
+  std::vector<double> fit_measured, fit_model, fit_depth, out_measured, out_model, out_depth;
+  for (std::size_t k = 0; k < used.size(); ++k) {
+    const std::size_t i = used[k];
+    out.depth_m.push_back(all.depth_m[i]);
+    out.measured_N.push_back(all.force_N[i]);
+    out.model_N.push_back(model[k]);
+    out.fitted.push_back(in_fit(i));
+    auto& m = in_fit(i) ? fit_measured : out_measured;
+    auto& p = in_fit(i) ? fit_model : out_model;
+    auto& d = in_fit(i) ? fit_depth : out_depth;
+    m.push_back(all.force_N[i]);
+    p.push_back(model[k]);
+    d.push_back(all.depth_m[i]);
+  }
+  out.fit = compare_curves(fit_measured, fit_model);
+  if (!out_measured.empty()) {
+    out.held_out = compare_curves(out_measured, out_model);
+    const Line line = least_squares_line(fit_depth, fit_measured);
+    std::vector<double> line_model;
+    for (double z : out_depth) line_model.push_back(line.intercept + line.slope * z);
+    out.straight_line_held_out = compare_curves(out_measured, line_model);
+  }
+  for (const LayerPressure& q : base_q)
+    out.layer_pressure_scale_Pa.push_back(best.scale * q.pressure_scale_Pa);
+  out.friction_coefficient = best.mu;
+  if (fits_pc) out.critical_pressure_Pa = threshold;
+  if (fits_gamma) out.toughness_J_per_m2 = threshold;
+  return out;
+}
+
+}  // namespace mneedle
