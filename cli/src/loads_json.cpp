@@ -20,6 +20,9 @@ nlohmann::json resolved_loads_json(const Scene& scene) {
          {"wall_pressure_cap_Pa", std::isfinite(p.wall_pressure_cap_Pa)
                                       ? nlohmann::json(p.wall_pressure_cap_Pa)
                                       : nlohmann::json(nullptr)},
+         {"cutting_pressure_cap_Pa", std::isfinite(p.cutting_pressure_cap_Pa)
+                                         ? nlohmann::json(p.cutting_pressure_cap_Pa)
+                                         : nlohmann::json(nullptr)},
          {"source", p.source}});
   }
   nlohmann::json beta_length = nullptr;
@@ -44,6 +47,10 @@ std::string resolved_loads_text(const Scene& scene) {
     if (std::isfinite(p.wall_pressure_cap_Pa)) {
       out << " (wall pressure capped at "
           << format_quantity(p.wall_pressure_cap_Pa, Dimension::Pressure) << ")";
+    }
+    if (std::isfinite(p.cutting_pressure_cap_Pa)) {
+      out << " (alpha pressure capped at "
+          << format_quantity(p.cutting_pressure_cap_Pa, Dimension::Pressure) << ")";
     }
     out << ": " << p.source << "\n";
   }

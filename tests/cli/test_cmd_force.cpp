@@ -79,6 +79,60 @@ TEST_F(ForceCommand, PluginBevelInSiliconeLoadsBetaAndFrictionOnly) {
   EXPECT_GT(last["friction_N"].get<double>(), 0.0);
 }
 
+// Force at `depth_um` of the first needle of a scene (10 um steps, so the depth is a sample).
+double force_at(const std::string& scene, double depth_um) {
+  const CommandRun run = run_mneedle("force '" + scene + "' --json --step 10um");
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  if (run.exit_code != 0) return NAN;
+  const nlohmann::json out = nlohmann::json::parse(run.out);
+  for (const auto& p : out["needles"][0]["curve"]) {
+    if (std::abs(p["depth_m"].get<double>() * 1e6 - depth_um) < 1e-6) return p["force_N"];
+  }
+  ADD_FAILURE() << "no sample at " << depth_um << " um";
+  return NAN;
+}
+
+// Paper A, paragraph on Fig. 17: a blunt bevel that must pass 300 um into the E = 0.5 MPa phantom
+// "must withstand 0.14 N". Our reconstruction of the vertex law (its cos term is lost) gives
+// 121.65 mN there: pinned to 0.1 mN (the model is closed form; any move is a change to explain),
+// 13 % below the paper's figure (docs/validation.md, "Paper A's figures"), and K linear in E.
+TEST_F(ForceCommand, PaperAFig17BluntBevelAt300UmIsWithinItsDocumentedMissOfThePaper) {
+  const std::string scene = design("paper_a_fig17_blunt_bevel.toml");
+  const double at_05 = force_at(scene, 300.0);
+  EXPECT_NEAR(at_05, 0.12165, 1e-4);
+  EXPECT_LT(std::abs(at_05 - 0.14) / 0.14, 0.14);
+  std::ifstream in(scene);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string soft = text.str();
+  soft.replace(soft.find("E = \"0.5 MPa\""), 13, "E = \"0.2 MPa\"");
+  const auto copy = std::filesystem::temp_directory_path() /
+                    ("fig17_soft_" + std::to_string(::getpid()) + ".toml");
+  std::ofstream(copy) << soft;
+  EXPECT_NEAR(force_at(copy.string(), 300.0), at_05 * 0.2 / 0.5, 1e-12);
+  std::filesystem::remove(copy);
+}
+
+// The shipped silicone scenes carry q = 570 kPa, fitted so that paper A's sharp bevel carries its
+// measured 14 mN at 0.23 mm (docs/validation.md). The blunt bevel at its measured puncture
+// (1.226 mm, 217 mN in paper A) and the cylinder at 2 mm are predictions: pinned here, misses
+// reported there.
+TEST_F(ForceCommand, SiliconePressureScaleReproducesItsFitPointAndPinsThePredictions) {
+  EXPECT_NEAR(force_at(design("paper_a_silicone_sharp_bevel.toml"), 230.0), 0.014, 0.0001);
+  EXPECT_NEAR(force_at(design("paper_a_silicone_blunt_bevel.toml"), 1230.0), 0.10768, 0.0005);
+  EXPECT_NEAR(force_at(design("paper_a_silicone_cylinder.toml"), 2000.0), 0.1847, 0.0005);
+}
+
+TEST_F(ForceCommand, ForceJsonNamesEachLayersPressureScaleAndItsSource) {
+  const CommandRun run = run_mneedle("force '" + design("human_skin.toml") + "' --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto layers = nlohmann::json::parse(run.out)["loads"]["layers"];
+  ASSERT_EQ(layers.size(), 3u);
+  EXPECT_EQ(layers[0]["name"], "stratum_corneum");
+  EXPECT_NEAR(layers[0]["wall_pressure_cap_Pa"].get<double>(), 21.6e6, 1.0);
+  EXPECT_NE(layers[1]["source"].get<std::string>().find("not fitted"), std::string::npos);
+}
+
 TEST_F(ForceCommand, NonPositiveStepIsAnErrorNamingTheOption) {
   const CommandRun run = run_mneedle("force '" + scene_asset("stl_needle.toml") + "' --step 0um");
   EXPECT_EQ(run.exit_code, 1);

@@ -206,8 +206,10 @@ LoadConstants load_constants(const Scene& scene) {
   c.tissue_depth_m = scene.tissue.depth();
   for (const TissueLayer& layer : scene.tissue.layers) {
     LoadLayer l{layer.thickness,      layer.material.youngs_modulus, layer.material.poisson_ratio,
-                layer.pressure_scale, layer.pressure_scale_source,   std::nullopt};
+                layer.pressure_scale, layer.pressure_scale_source,   std::nullopt,
+                std::nullopt};
     if (layer.strength) l.tensile_strength_Pa = layer.strength->strength;
+    if (layer.fracture) l.critical_pressure_Pa = layer.fracture->critical_pressure;
     c.layers.push_back(l);
   }
   return c;
@@ -224,12 +226,14 @@ std::vector<LayerPressure> layer_pressures(const LoadConstants& c) {
   const std::string s = scale_text.str();
   std::vector<LayerPressure> out;
   if (c.layers.empty()) {
-    out.push_back({*c.stiffness_Pa * c.scale, kInfinity, "[loads] stiffness K times " + s});
+    out.push_back(
+        {*c.stiffness_Pa * c.scale, kInfinity, kInfinity, "[loads] stiffness K times " + s});
     return out;
   }
   for (const LoadLayer& layer : c.layers) {
     LayerPressure p;
     p.wall_pressure_cap_Pa = kInfinity;
+    p.cutting_pressure_cap_Pa = kInfinity;
     if (c.mode == LoadModelMode::paper_a_fig17) {
       // Paper A's "tissue toughness" K of Fig. 17 is E D / (4 H) of its phantom (docs/model.md).
       p.pressure_scale_Pa =
@@ -249,6 +253,7 @@ std::vector<LayerPressure> layer_pressures(const LoadConstants& c) {
       p.source = "derived: S E / (1 - nu^2), " + s + " (not fitted to this tissue)";
     }
     if (layer.tensile_strength_Pa) p.wall_pressure_cap_Pa = *layer.tensile_strength_Pa;
+    if (layer.critical_pressure_Pa) p.cutting_pressure_cap_Pa = *layer.critical_pressure_Pa;
     out.push_back(p);
   }
   return out;
@@ -365,7 +370,8 @@ void SurfaceLoadModel::add_piece(const Face& face, const std::vector<Vertex>& po
   for (std::size_t i = 1; i + 1 < polygon.size(); ++i) {
     const double area = std::abs(signed_area(polygon[0], polygon[i], polygon[i + 1]));
     if (face.group == SurfaceGroup::alpha) {
-      sample.alpha_N += layer.pressure_scale_Pa * area;  // eq. 18
+      // Eq. 18, with the tissue ahead cutting at its critical pressure (docs/model.md).
+      sample.alpha_N += std::min(layer.pressure_scale_Pa, layer.cutting_pressure_cap_Pa) * area;
     } else if (face.group == SurfaceGroup::side && !face.in_bore &&
                constants_.friction == ShaftFriction::coulomb) {
       sample.friction_N += constants_.friction_coefficient * wall * area;

@@ -34,12 +34,16 @@ struct LoadLayer {
   /// Caps the lateral wall pressure (beta faces, shaft): a hole pressed wider than the layer's
   /// tensile strength splits it (hoop stress = wall pressure, Lame). Empty: no cap.
   std::optional<double> tensile_strength_Pa;
+  /// Caps the pressure on alpha faces (ahead of the tip): the tissue there cuts at its critical
+  /// pressure, the pressure criterion's threshold. Empty: no cap.
+  std::optional<double> critical_pressure_Pa;
 };
 
 /// A layer's resolved pressure scale, the cap on its wall pressure, and where q comes from.
 struct LayerPressure {
-  double pressure_scale_Pa = 0.0;     ///< q = K S, Pa
-  double wall_pressure_cap_Pa = 0.0;  ///< min(q, strength) applies to friction; +inf: none
+  double pressure_scale_Pa = 0.0;        ///< q = K S, Pa
+  double wall_pressure_cap_Pa = 0.0;     ///< strength: caps beta loads and friction; +inf: none
+  double cutting_pressure_cap_Pa = 0.0;  ///< P_c: caps alpha loads; +inf: none
   std::string source;
 };
 
