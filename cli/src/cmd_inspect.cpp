@@ -43,31 +43,13 @@ struct InspectResult {
   TriangleMesh framed;  // the mesh moved into the needle frame, for the surface analysis
 };
 
-double parse_component(const std::string& text, const std::string& whole) {
-  double value = 0.0;
-  const char* begin = text.data();
-  const char* end = begin + text.size();
-  const auto [rest, error] = std::from_chars(begin, end, value);
-  if (error != std::errc() || rest != end || !std::isfinite(value)) {
-    throw InputError("--axis: expected x,y,z or auto, got '" + whole + "'");
-  }
-  return value;
-}
-
 AxisChoice parse_axis(const std::string& text) {
-  AxisChoice choice;
-  if (text.empty()) return choice;
-  if (text == "auto") {
-    choice.kind = AxisChoice::Kind::automatic;
-    return choice;
+  if (text.empty()) return AxisChoice{};
+  try {
+    return parse_axis_choice(text);
+  } catch (const InputError& e) {
+    throw InputError(std::string("--axis: ") + e.what());
   }
-  std::vector<std::string> parts;
-  std::stringstream stream(text);
-  for (std::string part; std::getline(stream, part, ',');) parts.push_back(part);
-  if (parts.size() != 3) throw InputError("--axis: expected x,y,z or auto, got '" + text + "'");
-  choice.kind = AxisChoice::Kind::given;
-  for (std::size_t k = 0; k < 3; ++k) choice.tip_direction[k] = parse_component(parts[k], text);
-  return choice;
 }
 
 bool frame_computable(const InspectResult& result) {

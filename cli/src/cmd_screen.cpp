@@ -9,6 +9,7 @@
 #include "json_output.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
+#include "mneedle/needle/needle_frame.h"
 #include "mneedle/screening.h"
 
 namespace mneedle::cli {
@@ -21,6 +22,7 @@ struct ScreenArgs {
   std::string material;
   std::string fidelity = "fast";
   std::string model = "auto";
+  std::string axis = "auto";
   int jobs = 1;
   std::string out;
   bool json = false;
@@ -90,11 +92,16 @@ void run_screen(const ScreenArgs& args) {
   options.resume = args.resume;
   options.fidelity = args.fidelity;
   options.model = args.model;
+  options.axis = args.axis;
+  parse_axis_choice(args.axis);  // a bad --axis is a usage error before any design runs
   if (options.resume && !options.out) throw InputError("screen: --resume needs --out DIR");
 
   const auto rows = rank_rows(
       screen_designs(designs, scene, args.scene, registry, options, [&](const ScreeningRow& row) {
-        if (!args.json) std::cerr << (row.resumed ? "resumed " : "done    ") << row.design << "\n";
+        if (!args.json) {
+          std::cerr << (row.resumed ? "resumed " : "done    ") << row.design
+                    << (row.frame_note.empty() ? "" : " (" + row.frame_note + ")") << "\n";
+        }
       }));
   std::size_t failed = 0;
   for (const auto& r : rows) failed += r.ok ? 0 : 1;
@@ -143,6 +150,10 @@ void add_screen_command(CLI::App& app) {
                   "FE mesh level of the pre-puncture stage: fast, standard or fine")
       ->capture_default_str()
       ->check(CLI::IsMember({"fast", "standard", "fine"}));
+  cmd->add_option("--axis", args->axis,
+                  "Needle axis in the mesh files: auto (principal axis, tip at the narrower end), "
+                  "x, y, z, or a tip direction a,b,c; a holder the needle stands on is cut off")
+      ->capture_default_str();
   cmd->add_option("--model", args->model,
                   "Pre-puncture model: auto (axisymmetric for cylinders and cones on the axis, "
                   "else 3-D), analytic, axisymmetric or 3d")

@@ -20,6 +20,7 @@
 #include "mneedle/design_source.h"
 #include "mneedle/fe/tissue_mesh.h"
 #include "mneedle/insertion/insertion_run.h"
+#include "mneedle/needle/needle_frame.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
 
@@ -32,6 +33,7 @@ struct SimulateOptions {
   std::string contact;
   std::string criterion;
   std::string model = "auto";
+  std::string axis;  // overrides the scene's STL needles' axis when given
   std::string vtu;
   bool json = false;
   bool no_reductions = false;
@@ -221,11 +223,21 @@ void print_table(const InsertionRun& run) {
 }
 
 void run(const SimulateOptions& o) {
-  const Scene scene = load_scene(o.scene);
+  Scene scene = load_scene(o.scene);
+  if (!o.axis.empty()) {
+    parse_axis_choice(o.axis);
+    for (NeedleSpec& n : scene.needles) {
+      if (auto* stl = std::get_if<StlGeometry>(&n.geometry)) stl->axis = o.axis;
+    }
+  }
   const PluginRegistry registry =
       PluginRegistry::discover({o.plugin_dirs.begin(), o.plugin_dirs.end()});
-  const InsertionRun result =
-      run_insertion(scene, prepare_needles(registry, scene), run_options(scene, o));
+  const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene);
+  for (const PreparedNeedle& n : needles) {
+    if (!n.frame_note.empty())
+      std::cerr << "mneedle: needle " << n.name << ": " << n.frame_note << "\n";
+  }
+  const InsertionRun result = run_insertion(scene, needles, run_options(scene, o));
   // Every format prints the numbers of this tree: check them once, before anything is printed.
   const nlohmann::json tree = to_json(result, scene);
   require_finite_json(tree, o.scene.string());
@@ -252,6 +264,9 @@ void add_simulate_command(CLI::App& app) {
       ->check(CLI::IsMember({"sticking", "frictionless"}));
   cmd->add_option("--criterion", options->criterion, "puncture criterion (default: the scene's)")
       ->check(CLI::IsMember({"pressure", "energy", "stress"}));
+  cmd->add_option("--axis", options->axis,
+                  "Axis of the scene's STL needles (overrides their axis key): auto, x, y, z or "
+                  "a tip direction a,b,c");
   cmd->add_option("--model", options->model,
                   "pre-puncture model: auto (the planner decides), analytic, axisymmetric or 3d")
       ->check(CLI::IsMember({"auto", "analytic", "axisymmetric", "3d"}))

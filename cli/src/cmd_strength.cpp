@@ -11,6 +11,7 @@
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
+#include "mneedle/needle/needle_frame.h"
 #include "mneedle/strength/needle_strength.h"
 #include "mneedle/strength/section_table.h"
 
@@ -22,6 +23,7 @@ struct StrengthArgs {
   std::string plugin;
   std::vector<std::string> settings;
   std::string unit = "mm";
+  std::string axis = "auto";
   std::string material;
   std::string end = "fixed-pinned";
   std::string depth;
@@ -59,7 +61,9 @@ void run_strength(const StrengthArgs& args) {
       args.file.empty()
           ? needle_from_plugin(registry, args.plugin,
                                parse_parameter_settings(registry.shape(args.plugin), args.settings))
-          : needle_from_file(args.file, length_unit_scale(args.unit));
+          : needle_from_file(args.file, length_unit_scale(args.unit), parse_axis_choice(args.axis));
+  if (!needle.frame_note.empty())
+    std::cerr << "mneedle: " << args.file << ": " << needle.frame_note << "\n";
   const NeedleMaterial material = find_needle_material(args.material);
   const SectionTable table = section_table(registry, needle);
 
@@ -119,6 +123,10 @@ void add_strength_command(CLI::App& app) {
   cmd->add_option("file", args->file, "Needle mesh (STL, OBJ, PLY, OFF)");
   cmd->add_option("--plugin", args->plugin, "Tip-shape plugin instead of a file");
   cmd->add_option("--set", args->settings, "Plugin parameter, key=value with unit (repeatable)");
+  cmd->add_option("--axis", args->axis,
+                  "Needle axis in the mesh file: auto, x, y, z or a tip direction a,b,c; a holder "
+                  "the needle stands on is cut off")
+      ->capture_default_str();
   cmd->add_option("--unit", args->unit, "Length unit of the mesh file: um, mm, m")
       ->capture_default_str();
   cmd->add_option("--material", args->material, "Needle material (see docs/materials.md)")

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
+#include "mneedle/geometry/holder.h"
 #include "mneedle/needle/mesh_io.h"
 #include "mneedle/needle/mesh_validation.h"
 #include "mneedle/needle/needle_frame.h"
@@ -58,12 +61,27 @@ std::map<std::string, double> scene_parameters(const PluginShapeInfo& shape,
   return si;
 }
 
-NeedleSource needle_from_file(const std::filesystem::path& file, double metres_per_unit) {
+NeedleSource needle_from_file(const std::filesystem::path& file, double metres_per_unit,
+                              const AxisChoice& axis) {
   NeedleSource n;
   n.name = file.stem().string();
   n.mesh = load_mesh(file, metres_per_unit);
   require_valid_mesh(n.mesh, file.string());
-  place_in_needle_frame(n.mesh, std::nullopt);
+  const FrameInfo frame = place_in_needle_frame(n.mesh, axis);
+  const bool input_z = std::abs(frame.axis[2] + 1.0) < 1e-9;
+  if (!input_z) n.frame_note = frame.note;
+  if (const auto jump = find_holder_jump(n.mesh)) {
+    // Cut a hair below the holder's face, so the cut never runs along it.
+    const double cut = jump->height_m - 1e-6 * jump->total_height_m;
+    n.mesh = cut_above(n.mesh, cut);
+    place_in_needle_frame(n.mesh, std::optional<Vec3>(Vec3{0.0, 0.0, -1.0}));
+    std::ostringstream note;
+    note << (n.frame_note.empty() ? "" : n.frame_note + "; ") << "a holder begins "
+         << format_quantity(jump->height_m, Dimension::Length) << " above the tip (its outline "
+         << std::setprecision(3) << jump->holder_outline_m2 / jump->needle_outline_m2
+         << "x the needle's): the needle is the part below it";
+    n.frame_note = note.str();
+  }
   return n;
 }
 
@@ -82,7 +100,7 @@ NeedleSource needle_from_plugin(const PluginRegistry& registry, const std::strin
 
 NeedleSource needle_from_scene(const PluginRegistry& registry, const NeedleSpec& spec) {
   if (const auto* stl = std::get_if<StlGeometry>(&spec.geometry)) {
-    NeedleSource n = needle_from_file(stl->path, stl->unit_scale);
+    NeedleSource n = needle_from_file(stl->path, stl->unit_scale, parse_axis_choice(stl->axis));
     n.name = spec.name;
     return n;
   }
@@ -168,6 +186,7 @@ std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, cons
     n.axisymmetric = axisymmetric_profile(registry, source, where);
     n.mirror_symmetric_y0 = n.axisymmetric.has_value() || mirror_symmetric_y0(source.mesh);
     n.mirror_symmetric_x0 = mirror_symmetric_x0(source.mesh);
+    n.frame_note = source.frame_note;
     n.mesh = std::move(source.mesh);
     prepared.push_back(std::move(n));
   }

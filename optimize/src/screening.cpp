@@ -133,6 +133,7 @@ std::string design_fingerprint(const DesignInput& d) {
 struct ScreenedNeedle {
   TriangleMesh mesh;
   EvaluationOptions options;
+  std::string frame_note;  // how a mesh file's axis, tip and holder were found
 };
 
 ScreenedNeedle design_needle(const DesignInput& d, const PluginRegistry& registry,
@@ -142,8 +143,9 @@ ScreenedNeedle design_needle(const DesignInput& d, const PluginRegistry& registr
       d.plugin
           ? needle_from_plugin(registry, *d.plugin,
                                scene_parameters(registry.shape(*d.plugin), d.parameters, where))
-          : needle_from_file(d.file, d.metres_per_unit);
+          : needle_from_file(d.file, d.metres_per_unit, parse_axis_choice(o.axis));
   ScreenedNeedle n;
+  n.frame_note = source.frame_note;
   n.options.fidelity = parse_fidelity(o.fidelity);
   n.options.model = parse_pre_model(o.model);
   n.options.axisymmetric = axisymmetric_profile(registry, source, where);
@@ -246,6 +248,8 @@ ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::s
   json j = {{"design", d.name}, {"source", d.file.string()}};
   try {
     const ScreenedNeedle needle = design_needle(d, registry, o);
+    row.frame_note = needle.frame_note;
+    if (!needle.frame_note.empty()) j["frame_note"] = needle.frame_note;
     const DesignEvaluation e = evaluate_design(needle.mesh, scene, material, needle.options);
     row.ok = true;
     row.peak_force_n = e.peak_force_n;
@@ -460,7 +464,8 @@ std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs
       bool skip = false;
       try {
         const std::string hash =
-            row_hash(designs[i], scene_hash, options.fidelity + "|" + options.model, material);
+            row_hash(designs[i], scene_hash,
+                     options.fidelity + "|" + options.model + "|axis=" + options.axis, material);
         const auto previous = done.find(hash);
         skip = previous != done.end();
         row = skip ? previous->second

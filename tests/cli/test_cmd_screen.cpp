@@ -2,11 +2,16 @@
 // depth, bad designs among good ones, results kept on disk, JSON with units in its keys.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
+#include "fe/needle_meshes.h"
+#include "mneedle/needle/mesh_io.h"
 #include "run_mneedle.h"
 
 namespace {
@@ -97,6 +102,49 @@ TEST(ScreenCommand, BrokenDesignGetsAnErrorRowAndTheOthersAreKept) {
   for (std::string line; std::getline(jsonl, line);) ++lines;
   EXPECT_EQ(lines, 2);
   fs::remove_all(dir);
+}
+
+// A CAD export: the needle standing on its holder, long axis along +y (tip up), in mm, moved off
+// the origin. With the default --axis auto the needle is found, cut from its holder and placed;
+// it must give the bare needle's row. Tolerances: the cut lies 1e-6 of the mesh's height below
+// the holder's face, so the needle is 2 nm shorter (capacity ~ 1/L^2: 4e-6 relative); the
+// puncture reads the tip, which only the rotation's round-off moves (1e-9 relative).
+TEST(ScreenCommand, NeedleOnAHolderExportedYUpGivesTheBareNeedlesRow) {
+  const double radius = 150e-6, length = 1e-3;
+  const double cone = radius / std::tan(std::numbers::pi / 12.0);
+  std::vector<std::array<double, 2>> rings{{0.0, 0.0}};
+  for (int k = 1; k <= 8; ++k) rings.push_back({radius * k / 8.0, cone * k / 8.0});
+  rings.push_back({radius, length});
+  const mneedle::TriangleMesh bare = mneedle::test::revolved_needle(rings, 48);
+  rings.push_back({2.5e-3, length});
+  rings.push_back({2.5e-3, length + 1e-3});
+  mneedle::TriangleMesh held = mneedle::test::revolved_needle(rings, 48);
+  for (mneedle::Vec3& p : held.vertices) p = {p[0] + 1e-3, -p[2] + 2e-3, p[1] + 3e-3};  // y up
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("mneedle_holder_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  mneedle::write_stl_binary(bare, dir / "bare.stl", 1e-3);
+  mneedle::write_stl_binary(held, dir / "on_holder.stl", 1e-3);
+  const auto run = run_mneedle("screen '" + dir.string() + "' --scene '" + kRoot +
+                               "/designs/scenes/optimize_silicone.toml' --model analytic --unit mm "
+                               "--json");
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  std::map<std::string, nlohmann::json> by_name;
+  const nlohmann::json out = nlohmann::json::parse(run.out);
+  for (const auto& d : out["designs"]) by_name[d["design"].get<std::string>()] = d;
+  const auto& a = by_name.at("bare");
+  const auto& b = by_name.at("on_holder");
+  ASSERT_TRUE(a["ok"].get<bool>() && b["ok"].get<bool>()) << run.out;
+  EXPECT_NE(b["frame_note"].get<std::string>().find("holder"), std::string::npos);
+  const double cap = a["capacity_N"].get<double>();
+  EXPECT_NEAR(b["capacity_N"].get<double>(), cap, 1e-5 * cap);
+  const double len = a["length_m"].get<double>();
+  EXPECT_NEAR(b["length_m"].get<double>(), len, 1e-5 * len);
+  const double depth = a["puncture_depth_m"].get<double>();
+  EXPECT_NEAR(b["puncture_depth_m"].get<double>(), depth, 1e-9 * depth);
+  const double peak = a["peak_force_N"].get<double>();
+  EXPECT_NEAR(b["peak_force_N"].get<double>(), peak, 1e-6 * peak);
 }
 
 TEST(ScreenCommand, ResumeWithoutOutIsAnError) {

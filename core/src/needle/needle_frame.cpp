@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -31,6 +32,14 @@ constexpr double kRelativeTolerance = 1e-6;
 constexpr double kProbeFraction = 0.05;
 // Ends whose probed widths differ by less than this fraction count as alike.
 constexpr double kAlikeFraction = 0.02;
+// A principal axis is trusted when its moment is this many times the next one (a needle is
+// several times longer than wide; a stub or a needle on a wide plate is not).
+constexpr double kElongation = 1.5;
+// ... and then a needle's end is found when its section is this narrow against the other end's.
+constexpr double kHolderNarrowing = 0.25;
+// Faces whose normal is within asin(0.2) = 11.5 deg of perpendicular to a trial axis count as
+// the shaft's sides when the axis is refined (a bevel tilts the principal axis by a few deg).
+constexpr double kSideFaceSlope = 0.2;
 
 double size_of(const TriangleMesh& mesh) {
   const BoundingBox box = bounding_box(mesh);
@@ -166,16 +175,75 @@ std::string format_vector(const Vector3d& v) {
   return out.str();
 }
 
-// The principal axis, signed so that it points toward the narrower end.
-Vector3d automatic_tip_direction(const TriangleMesh& mesh, const Vector3d& center,
-                                 std::string& note) {
+// A principal axis is tilted by whatever breaks the body's symmetry (a bevel's cut tilts it by
+// degrees). The shaft's side faces are exactly parallel to the true axis: among the faces
+// nearly parallel to `axis`, the direction their normals avoid (the smallest eigenvector of
+// sum A n n^T) is the shaft's axis. Returns `axis` unchanged without a clear shaft.
+Vector3d refined_by_side_faces(const TriangleMesh& mesh, const Vector3d& axis) {
+  Matrix3d tensor = Matrix3d::Zero();
+  for (const Triangle& t : mesh.triangles) {
+    const Vector3d a = to_eigen(mesh.vertices[t[0]]);
+    const Vector3d n2 =
+        (to_eigen(mesh.vertices[t[1]]) - a).cross(to_eigen(mesh.vertices[t[2]]) - a);
+    const double twice_area = n2.norm();
+    if (!(twice_area > 0.0)) continue;
+    const Vector3d n = n2 / twice_area;
+    if (std::abs(n.dot(axis)) < kSideFaceSlope) tensor += 0.5 * twice_area * n * n.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Matrix3d> solver(tensor);
+  const auto& lambda = solver.eigenvalues();
+  if (!(lambda[1] > 0.0) || !(lambda[0] < 1e-3 * lambda[1])) return axis;
+  const Vector3d refined = solver.eigenvectors().col(0);
+  return refined.dot(axis) < 0.0 ? Vector3d(-refined) : refined;
+}
+
+// `axis` (either sign; the principal axis when empty), signed so that it points toward the
+// narrower end. Empty when no axis was given and the body has no clear principal axis.
+std::optional<Vector3d> narrower_end_direction(const TriangleMesh& mesh, const Vector3d& center,
+                                               std::optional<Vector3d> given, std::string& note) {
   const Eigen::SelfAdjointEigenSolver<Matrix3d> solver(surface_second_moment(mesh, center));
-  Vector3d axis = solver.eigenvectors().col(2);  // eigenvalues ascend: the longest direction
+  const auto& moments = solver.eigenvalues();  // ascending
+  if (!given && !(moments[2] >= kElongation * moments[1])) {
+    // Not longer than wide: a needle on a wide holder or plate, or a stub. The needle's tip is
+    // the narrowest end of any principal axis; a holder's rim is never that narrow.
+    double best_width = std::numeric_limits<double>::infinity(), other_end = 0.0;
+    Vector3d best;
+    for (int k = 0; k < 3; ++k) {
+      const Vector3d a = refined_by_side_faces(mesh, solver.eigenvectors().col(k));
+      const Vector3d u = a.unitOrthogonal();
+      const Vector3d w = a.cross(u);
+      const auto [low, high] = extent_along(mesh, center, a);
+      const double probe = kProbeFraction * (high - low);
+      const double lw = section_width(cross_section_points(mesh, center, a, low + probe), u, w);
+      const double hw = section_width(cross_section_points(mesh, center, a, high - probe), u, w);
+      if (std::min(lw, hw) < best_width) {
+        best_width = std::min(lw, hw);
+        other_end = std::max(lw, hw);
+        best = lw < hw ? Vector3d(-a) : a;
+      }
+    }
+    std::ostringstream out;
+    out.precision(4);
+    out << "auto axis: the body is not clearly longer than it is wide (principal moments "
+        << format_vector(moments) << "); ";
+    if (best_width < kHolderNarrowing * other_end) {
+      out << "the narrowest end of a principal axis, " << format_vector(best) << " (section "
+          << best_width << " m wide against " << other_end << " m at the other end), is the tip";
+      note = out.str();
+      return best;
+    }
+    out << "no end is narrower than the other: used the input z, tip at the lowest z";
+    note = out.str();
+    return std::nullopt;
+  }
+  Vector3d axis =
+      given ? given->normalized() : refined_by_side_faces(mesh, solver.eigenvectors().col(2));
   Eigen::Index largest = 0;
   axis.cwiseAbs().maxCoeff(&largest);
   if (axis[largest] < 0.0) axis = -axis;  // a reproducible sign for the tie-break below
-  const Vector3d u = solver.eigenvectors().col(0);
-  const Vector3d w = solver.eigenvectors().col(1);
+  // Two directions across the axis for the section widths.
+  const Vector3d u = axis.unitOrthogonal();
+  const Vector3d w = axis.cross(u);
   const auto [low, high] = extent_along(mesh, center, axis);
   const double probe = kProbeFraction * (high - low);
   const double low_width =
@@ -184,9 +252,9 @@ Vector3d automatic_tip_direction(const TriangleMesh& mesh, const Vector3d& cente
       section_width(cross_section_points(mesh, center, axis, high - probe), u, w);
   std::ostringstream out;
   out.precision(4);
-  out << "auto axis: principal axis " << format_vector(axis) << "; cross-section widths "
-      << kProbeFraction * 100 << "% from each end: " << low_width << " m (low end) and "
-      << high_width << " m (high end); ";
+  out << (given ? "axis: given line " : "auto axis: principal axis ") << format_vector(axis)
+      << "; cross-section widths " << kProbeFraction * 100 << "% from each end: " << low_width
+      << " m (low end) and " << high_width << " m (high end); ";
   if (std::abs(low_width - high_width) <= kAlikeFraction * std::max(low_width, high_width)) {
     out << "the ends look alike: chose the low end as the tip";
     note = out.str();
@@ -251,9 +319,17 @@ FrameInfo find_needle_frame(const TriangleMesh& mesh, const AxisChoice& choice) 
       direction = normalized_direction(choice.tip_direction);
       info.note = "axis: given tip direction " + format_vector(direction);
       break;
+    case AxisChoice::Kind::line:
+      if (const auto d = narrower_end_direction(
+              mesh, center, normalized_direction(choice.tip_direction), info.note)) {
+        direction = *d;
+      }
+      break;
     case AxisChoice::Kind::automatic:
-      direction = automatic_tip_direction(mesh, center, info.note);
-      info.auto_axis = true;
+      if (const auto d = narrower_end_direction(mesh, center, std::nullopt, info.note)) {
+        direction = *d;
+        info.auto_axis = true;
+      }
       break;
   }
   info.axis = to_vec3(direction);
@@ -276,6 +352,41 @@ FrameInfo place_in_needle_frame(TriangleMesh& mesh, const AxisChoice& choice) {
   const Vector3d origin = to_eigen(info.origin);
   for (Vec3& p : mesh.vertices) p = to_vec3(rotation * (to_eigen(p) - origin));
   return info;
+}
+
+AxisChoice parse_axis_choice(std::string_view text) {
+  AxisChoice choice;
+  const std::string t(text);
+  if (t == "auto") {
+    choice.kind = AxisChoice::Kind::automatic;
+    return choice;
+  }
+  if (t == "x" || t == "y" || t == "z") {
+    choice.kind = AxisChoice::Kind::line;
+    choice.tip_direction = {t == "x" ? 1.0 : 0.0, t == "y" ? 1.0 : 0.0, t == "z" ? 1.0 : 0.0};
+    return choice;
+  }
+  std::vector<double> parts;
+  std::stringstream stream(t);
+  for (std::string part; std::getline(stream, part, ',');) {
+    double value = 0.0;
+    const char* end = part.data() + part.size();
+    const auto [rest, error] = std::from_chars(part.data(), end, value);
+    if (error != std::errc() || rest != end || !std::isfinite(value)) {
+      parts.clear();
+      break;
+    }
+    parts.push_back(value);
+  }
+  if (parts.size() != 3) {
+    throw InputError("axis '" + t +
+                     "': expected auto, x, y, z (the tip at the narrower end) or a tip direction "
+                     "a,b,c such as 0,-1,0");
+  }
+  choice.kind = AxisChoice::Kind::given;
+  choice.tip_direction = {parts[0], parts[1], parts[2]};
+  normalized_direction(choice.tip_direction);  // throws for a zero or non-finite vector
+  return choice;
 }
 
 FrameInfo place_in_needle_frame(TriangleMesh& mesh, std::optional<Vec3> tip_direction) {

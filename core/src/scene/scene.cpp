@@ -14,6 +14,7 @@
 
 #include "mneedle/base/error.h"
 #include "mneedle/needle/mesh_io.h"
+#include "mneedle/needle/needle_frame.h"
 
 namespace mneedle {
 namespace {
@@ -530,7 +531,7 @@ PluginGeometry read_plugin_geometry(Table& g, NeedleDraft& draft) {
         g.fail(g.key_path(key), line_of(*node), "expected a plugin name such as \"sharp_bevel\"");
       }
       p.plugin = s->get();
-    } else if (key == "stl" || key == "unit") {
+    } else if (key == "stl" || key == "unit" || key == "axis") {
       g.fail(g.key_path(key), line_of(*node),
              "applies to stl geometry only; a geometry has either plugin or stl");
     } else {
@@ -564,6 +565,28 @@ StlGeometry read_stl_geometry(Table& g, NeedleDraft& draft, const std::filesyste
     stl.unit_scale = length_unit_scale(stl.unit);
   } catch (const InputError& e) {
     g.fail_key("unit", e.what());
+  }
+  // axis = "auto" | "x" | "y" | "z" | [a, b, c] (the tip direction); docs/scene.md.
+  if (const toml::node* axis = g.get("axis")) {
+    if (const auto* text = axis->as_string()) {
+      stl.axis = text->get();
+    } else if (const auto* list = axis->as_array(); list && list->size() == 3) {
+      std::ostringstream joined;
+      joined.precision(17);
+      for (std::size_t k = 0; k < 3; ++k) {
+        const auto value = (*list)[k].value<double>();
+        if (!value) g.fail_key("axis", "expected three numbers, e.g. [0, -1, 0]");
+        joined << (k ? "," : "") << *value;
+      }
+      stl.axis = joined.str();
+    } else {
+      g.fail_key("axis", "expected \"auto\", \"x\", \"y\", \"z\" or a tip direction [a, b, c]");
+    }
+    try {
+      parse_axis_choice(stl.axis);
+    } catch (const InputError& e) {
+      g.fail_key("axis", e.what());
+    }
   }
   g.finish();
   draft.auto_name = given.stem().string();

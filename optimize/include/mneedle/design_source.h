@@ -11,16 +11,27 @@
 #include "mneedle/fe/axisymmetric.h"
 #include "mneedle/insertion/insertion_run.h"
 #include "mneedle/needle/mesh.h"
+#include "mneedle/needle/needle_frame.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
 
 namespace mneedle {
+
+/// The default axis choice for mesh files: automatic.
+inline AxisChoice automatic_axis() {
+  AxisChoice a;
+  a.kind = AxisChoice::Kind::automatic;
+  return a;
+}
 
 struct NeedleSource {
   std::string name;
   TriangleMesh mesh;                     // metres, needle frame
   std::optional<std::string> plugin;     // the shape, when made by a plugin
   std::map<std::string, double> params;  // SI, the shape's parameters (defaults filled in)
+  /// Mesh files: how the axis and tip were found and whether a holder was cut off; empty when
+  /// the input z was the axis and the whole mesh is the needle (nothing worth saying).
+  std::string frame_note;
 };
 
 /// "key=value" settings (values with units, e.g. diameter=230um) → SI values checked against the
@@ -34,8 +45,11 @@ std::map<std::string, double> scene_parameters(const PluginShapeInfo& shape,
                                                const std::map<std::string, Quantity>& given,
                                                const std::string& where);
 
-/// Loads, validates and places a mesh file in the needle frame (its axis along z, tip at lowest z).
-NeedleSource needle_from_file(const std::filesystem::path& file, double metres_per_unit);
+/// Loads, validates and places a mesh file in the needle frame (`axis`: see AxisChoice; the
+/// default finds the principal axis, tip at the narrower end) and cuts off a holder or base the
+/// needle stands on (geometry/holder.h), placing the needle alone again.
+NeedleSource needle_from_file(const std::filesystem::path& file, double metres_per_unit,
+                              const AxisChoice& axis = automatic_axis());
 
 NeedleSource needle_from_plugin(const PluginRegistry& registry, const std::string& shape,
                                 const std::map<std::string, double>& params_si);

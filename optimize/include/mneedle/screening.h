@@ -37,6 +37,7 @@ struct ScreeningOptions {
   bool resume = false;                       // skip designs already in out/results.jsonl
   std::string fidelity = "fast";  // fast | standard | fine: the FE stage of run_insertion
   std::string model = "auto";     // auto | analytic | axisymmetric | 3d
+  std::string axis = "auto";      // mesh files: auto | x | y | z | a,b,c (parse_axis_choice)
 };
 
 /// One row of a screening: an evaluation or the reason there is none. `json` is the row as
@@ -54,6 +55,7 @@ struct ScreeningRow {
   double peak_force_n = 0.0;
   double margin = 0.0;
   bool passes = false;
+  std::string frame_note;  // mesh files: how the axis, tip and a holder were found (or empty)
 };
 
 /// Screens `designs` on `scene` (its file is `scene_file`, for the hash). Every design gets a row,

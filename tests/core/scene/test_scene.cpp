@@ -9,6 +9,7 @@
 #include <initializer_list>
 #include <iterator>
 #include <numbers>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -212,6 +213,39 @@ TEST(Scene, PluginParametersKeepTheirQuantities) {
   EXPECT_EQ(p.at("resolution").dimension, mneedle::Dimension::Dimensionless);
   EXPECT_DOUBLE_EQ(p.at("resolution").value_si, 64.0);
   EXPECT_DOUBLE_EQ(p.at("bore").value_si, 9e-5);
+}
+
+// The scene file is read from the assets folder so its STL path resolves.
+Scene parse_in_assets(const std::string& text) {
+  return mneedle::parse_scene(text, (kAssets / "axis_test.toml").string());
+}
+
+TEST(Scene, StlAxisIsReadAsANameOrATipDirection) {
+  std::ifstream in(kAssets / "stl_needle.toml");
+  std::stringstream whole;
+  whole << in.rdbuf();
+  std::string text = whole.str();
+  const std::string from = "geometry = { stl = \"tiny_needle.stl\", unit = \"mm\" }";
+  ASSERT_NE(text.find(from), std::string::npos);
+  std::string named = text;
+  named.replace(named.find(from), from.size(),
+                "geometry = { stl = \"tiny_needle.stl\", unit = \"mm\", axis = \"y\" }");
+  EXPECT_EQ(std::get<mneedle::StlGeometry>(parse_in_assets(named).needles[0].geometry).axis, "y");
+  std::string vector = text;
+  vector.replace(vector.find(from), from.size(),
+                 "geometry = { stl = \"tiny_needle.stl\", unit = \"mm\", axis = [0, -1, 0] }");
+  EXPECT_EQ(std::get<mneedle::StlGeometry>(parse_in_assets(vector).needles[0].geometry).axis,
+            "0,-1,0");
+  std::string bad = text;
+  bad.replace(bad.find(from), from.size(),
+              "geometry = { stl = \"tiny_needle.stl\", unit = \"mm\", axis = \"up\" }");
+  try {
+    parse_in_assets(bad);
+    FAIL() << "expected an InputError";
+  } catch (const mneedle::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("geometry.axis"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("auto, x, y, z"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Scene, StlNeedleResolvesRelativeToTheSceneFile) {

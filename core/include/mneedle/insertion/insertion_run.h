@@ -26,6 +26,7 @@ struct PreparedNeedle {
   std::optional<fe::AxisymmetricNeedle> axisymmetric;  ///< set for cylinder/cone shapes
   bool mirror_symmetric_y0 = false;  ///< mesh symmetric about its y = 0 plane (bevels)
   bool mirror_symmetric_x0 = false;  ///< mesh symmetric about its x = 0 plane (cones)
+  std::string frame_note;  ///< mesh files: how the axis, tip and a holder were found (or empty)
 };
 
 /// Which model computes the pre-puncture stage.

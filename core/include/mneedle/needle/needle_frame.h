@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "mneedle/needle/mesh.h"
 
@@ -24,10 +25,18 @@ struct FrameInfo {
 
 /// How the caller names the tip direction.
 struct AxisChoice {
-  enum class Kind { input_z, given, automatic };
+  /// input_z: the input z, tip at the lowest z. given: `tip_direction`. line: the axis along
+  /// `tip_direction` (either sign), the tip at its narrower end. automatic: the principal axis
+  /// of the surface, tip at the narrower end; a body that is not longer than it is wide (largest
+  /// principal moment under 1.5x the next) has no principal axis to trust and takes input_z.
+  enum class Kind { input_z, given, line, automatic };
   Kind kind = Kind::input_z;
-  Vec3 tip_direction{0.0, 0.0, -1.0};  ///< used when kind == given (need not be unit length)
+  Vec3 tip_direction{0.0, 0.0, -1.0};  ///< used by given and line (need not be unit length)
 };
+
+/// "auto", "x", "y", "z" (a line, tip at its narrower end) or "a,b,c" (the tip direction).
+/// Throws InputError naming the text and the accepted forms.
+AxisChoice parse_axis_choice(std::string_view text);
 
 /// Moves `mesh` into the needle frame. Without a direction the input z is the axis and the
 /// tip is at the lowest z; a direction names where the tip points. The tip is the single

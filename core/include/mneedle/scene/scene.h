@@ -90,6 +90,9 @@ struct StlGeometry {
   std::filesystem::path path;  ///< resolved against the scene file's folder
   std::string unit;            ///< "um" | "mm" | "m"
   double unit_scale = 1e-3;    ///< metres per file unit
+  /// The needle's axis in the file: "auto" (principal axis, tip at the narrower end), "x", "y",
+  /// "z", or a tip direction "a,b,c" (needle/needle_frame.h, parse_axis_choice).
+  std::string axis = "auto";
 };
 
 struct NeedleSpec {
