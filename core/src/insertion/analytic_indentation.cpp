@@ -20,6 +20,9 @@
 namespace mneedle {
 namespace {
 
+// Relative change of a sliced radius below which it is round-off (equivalent needle).
+constexpr double kRadiusNoise = 1e-6;
+
 constexpr double kPi = 3.14159265358979323846;
 
 std::string um(double metres) {
@@ -284,8 +287,11 @@ fe::AxisymmetricNeedle equivalent_axisymmetric_needle(const TriangleMesh& mesh, 
   for (int i = 0; i <= samples; ++i) {
     const double h = top * i / samples;
     const double area = slicer.slice(std::clamp(h, inset, length - inset)).area_m2;
-    // Running maximum: a narrower section above a wider one never meets the tissue first.
-    radius = std::max(radius, std::sqrt(std::max(area, 0.0) / kPi));
+    // Running maximum: a narrower section above a wider one never meets the tissue first. A
+    // rise within 1e-6 of it is the slicer's round-off, not a taper: kept as the same radius
+    // (a near-vertical piece of slope 1e5 would wreck Sneddon's integrals).
+    const double r = std::sqrt(std::max(area, 0.0) / kPi);
+    if (r > radius * (1.0 + kRadiusNoise)) radius = r;
     needle.heights_m.push_back(h);
     needle.radii_m.push_back(radius);
   }
