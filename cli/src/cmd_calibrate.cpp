@@ -297,6 +297,10 @@ void add_calibrate_command(CLI::App& app) {
       "calibrate",
       "Fit a scene's tissue constants (pressure scale, friction coefficient, P_c or toughness) to "
       "one measured insertion curve of its needle");
+  cmd->footer(
+      "Example:\n  mneedle calibrate my_scene.toml --curve measured.csv --fit "
+      "scale,friction_coefficient "
+      "--puncture-at detect --out fitted.toml --plot fit.svg");
   cmd->add_option("SCENE", a->scene, "Scene file with the one needle that was measured")
       ->required();
   cmd->add_option("--curve", a->curve, "Measured force-depth curve (CSV)")->required();

@@ -136,6 +136,7 @@ void add_force_command(CLI::App& app) {
   auto options = std::make_shared<ForceOptions>();
   CLI::App* cmd = app.add_subcommand(
       "force", "Post-puncture force curve of each needle of a scene (paper A distributed loads)");
+  cmd->footer("Example:\n  mneedle force designs/scenes/silicone_phantom.toml --step 250um --csv");
   cmd->add_option("SCENE", options->scene, "Scene file (TOML)")->required();
   auto* json = cmd->add_flag("--json", options->json, "Print JSON");
   cmd->add_flag("--csv", options->csv,

@@ -478,6 +478,7 @@ void run_stats(const StatsArgs& args) {
 void add_fit_command(CLI::App& app) {
   auto args = std::make_shared<FitArgs>();
   auto* cmd = app.add_subcommand("fit", "Fit paper B's tri-force model to force-depth recordings");
+  cmd->footer("Example:\n  mneedle fit curve1.csv curve2.csv --model triforce --out fit1");
   cmd->add_option("curves", args->files, "Force-depth CSV files (fitted jointly)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -501,6 +502,9 @@ void add_predict_command(CLI::App& app) {
   auto args = std::make_shared<PredictArgs>();
   auto* cmd = app.add_subcommand(
       "predict", "Predict force against depth and time: insertion, hold, retraction");
+  cmd->footer(
+      "Example:\n  mneedle predict --model triforce --params fit1/fit.json --speed 2mm/s "
+      "--angle 90deg --depth 20mm");
   cmd->add_option("--model", args->model, "Force model")->capture_default_str();
   cmd->add_option("--params", args->params_file, "Parameters written by `mneedle fit --json/--out`")
       ->required();
@@ -531,6 +535,7 @@ void add_predict_command(CLI::App& app) {
 void add_stats_command(CLI::App& app) {
   auto args = std::make_shared<StatsArgs>();
   auto* cmd = app.add_subcommand("stats", "One-way ANOVA and Tukey HSD between groups");
+  cmd->footer("Example:\n  mneedle stats peaks.csv --value force_N --group group");
   cmd->add_option("grouped", args->file, "CSV with a group column and a value column")
       ->required()
       ->check(CLI::ExistingFile);

@@ -15,6 +15,10 @@
 namespace mneedle {
 namespace {
 
+// Widths of a needle outside which a mesh file is reported as a likely unit mistake.
+constexpr double kSmallestWidth_m = 1e-6;
+constexpr double kLargestWidth_m = 20e-3;
+
 const PluginParameter& find_parameter(const PluginShapeInfo& shape, const std::string& name) {
   for (const auto& p : shape.parameters)
     if (p.name == name) return p;
@@ -81,6 +85,15 @@ NeedleSource needle_from_file(const std::filesystem::path& file, double metres_p
          << std::setprecision(3) << jump->holder_outline_m2 / jump->needle_outline_m2
          << "x the needle's): the needle is the part below it";
     n.frame_note = note.str();
+  }
+  // A width far outside what microneedles measure is usually a unit mistake (a file in um read
+  // as mm is 1000x too wide; in mm read as um, 1000x too narrow): say so, do not guess.
+  const BoundingBox box = bounding_box(n.mesh);
+  const double width = std::max(box.max[0] - box.min[0], box.max[1] - box.min[1]);
+  if (width < kSmallestWidth_m || width > kLargestWidth_m) {
+    n.frame_note += std::string(n.frame_note.empty() ? "" : "; ") + "warning: the needle is " +
+                    format_quantity(width, Dimension::Length) +
+                    " wide: is the file's length unit right (--unit, or unit = in the scene)?";
   }
   return n;
 }

@@ -9,6 +9,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <sstream>
 
 #include "fe/needle_meshes.h"
 #include "mneedle/needle/mesh_io.h"
@@ -64,10 +65,11 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
   }
 }
 
-TEST(ScreenCommand, DepthAtFirstContactIsMarkedAndRankedAfterResolvedBeforeNone) {
-  // On the analytic model in skin the flat punch's F / A_sec is above 3 MPa at the first depth
-  // step (its edge is singular): a puncture "at first contact", whose depth is the step's. The
-  // sharp bevel's falls below the threshold (the stratum corneum spreads the load): no puncture.
+// The analytic model in skin: the stratum corneum spreads a flat punch's load as in the FE (the
+// cylinder's F / A_sec stays below 3 MPa to 200 um; docs/validation.md), so neither shipped STL
+// punctures. (Until the round-off guard of the equivalent needle the flat STL cylinder carried
+// 207 N at the first step and "punctured at first contact".)
+TEST(ScreenCommand, AnalyticModelInSkinLetsNeitherFlatNorSharpStlPuncture) {
   const std::string designs =
       "'" + kRoot + "/designs/cylinder.stl' '" + kRoot + "/designs/sharp_bevel.stl'";
   const auto run =
@@ -75,12 +77,33 @@ TEST(ScreenCommand, DepthAtFirstContactIsMarkedAndRankedAfterResolvedBeforeNone)
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
   ASSERT_EQ(j["designs"].size(), 2u);
-  EXPECT_EQ(j["designs"][0]["design"], "cylinder") << j.dump(2);
-  EXPECT_TRUE(j["designs"][0]["puncture_at_first_contact"].get<bool>());
-  EXPECT_FALSE(j["designs"][1]["punctured"].get<bool>());
   EXPECT_EQ(j["model"], "analytic");
-  for (const auto& d : j["designs"]) EXPECT_EQ(d["models_run"][0], "analytic") << d.dump();
-  const auto table = run_mneedle("screen " + designs + " --scene '" + kSkin + "' --model analytic");
+  for (const auto& d : j["designs"]) {
+    EXPECT_EQ(d["models_run"][0], "analytic") << d.dump();
+    EXPECT_FALSE(d["punctured"].get<bool>()) << d.dump();
+    EXPECT_LT(d["peak_force_N"].get<double>(), 0.05) << d.dump();
+  }
+}
+
+// With a threshold below the pressure of the first depth step the criterion fires "at first
+// contact": the depth is the step's, marked * in the table and flagged in the JSON.
+TEST(ScreenCommand, DepthAtFirstContactIsMarkedWithAStar) {
+  std::ifstream in(kSkin);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string scene = text.str();
+  scene.replace(scene.find("critical_pressure = \"3 MPa\""), 27, "critical_pressure = \"1 kPa\"");
+  const auto file = std::filesystem::temp_directory_path() /
+                    ("mneedle_first_contact_" + std::to_string(::getpid()) + ".toml");
+  std::ofstream(file) << scene;
+  const std::string args = "screen '" + kRoot + "/designs/cylinder.stl' --scene '" + file.string() +
+                           "' --model analytic";
+  const auto run = run_mneedle(args + " --json");
+  const auto table = run_mneedle(args);
+  std::filesystem::remove(file);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_TRUE(j["designs"][0]["puncture_at_first_contact"].get<bool>()) << j.dump(2);
   ASSERT_EQ(table.exit_code, 0) << table.err;
   EXPECT_NE(table.out.find(" um* "), std::string::npos) << table.out;
 }
@@ -168,6 +191,15 @@ TEST(StrengthCommand, CylinderPluginBucklesAtEulersLoadOverTheWholeLength) {
   for (const char* key :
        {"material", "E_Pa", "I_min_m4", "length_m", "buckling_N", "strength_N", "capacity_N"})
     EXPECT_TRUE(j.contains(key)) << key;
+}
+
+// A 230 um cylinder exported in mm and read as um is 230 nm wide: a unit mistake, said so.
+TEST(StrengthCommand, ANeedleOfImplausibleWidthWarnsOfTheUnit) {
+  const auto run =
+      run_mneedle("strength '" + kRoot + "/designs/cylinder.stl' --unit um --material silicon");
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("warning: the needle is 230 nm wide"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("unit"), std::string::npos) << run.err;
 }
 
 TEST(StrengthCommand, MeshFileAndPluginAgree) {
