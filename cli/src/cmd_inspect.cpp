@@ -29,6 +29,7 @@ struct InspectOptions {
   std::string file;
   std::string unit = "mm";
   std::string axis;
+  std::string output;  // write the (repaired) mesh here, binary STL in --unit
   bool repair = false;
   bool json = false;
 };
@@ -167,6 +168,15 @@ void run_inspect(const InspectOptions& options) {
   require_finite_json(tree, "inspect " + options.file);
   if (options.json) std::cout << tree.dump(2) << "\n";
   if (!result.validation.valid) throw InputError(defects_line(result));
+  if (!options.output.empty()) {
+    // Input coordinates and unit, with the unit in the header so loaders read it back.
+    write_stl_binary(result.mesh, options.output, length_unit_scale(options.unit),
+                     "mneedle inspect unit=" + options.unit);
+    if (!options.json) {
+      std::cout << "wrote " << options.output << " (" << result.mesh.triangles.size()
+                << " triangles, unit " << options.unit << ")\n";
+    }
+  }
   if (!options.json) print_text(result, std::cout);
 }
 
@@ -185,10 +195,13 @@ void add_inspect_command(CLI::App& app) {
   command->add_option("--axis", options->axis,
                       "Direction the tip points, x,y,z in file coordinates, or 'auto' for the "
                       "principal axis (default: the tip at the lowest z)");
+  command->add_option("-o,--output", options->output,
+                      "Write the mesh (repaired with --repair) as binary STL in --unit; only a "
+                      "valid mesh is written");
   command->add_flag("--json", options->json, "Print one JSON object on stdout");
   command->footer(
       "Example:\n  mneedle inspect designs/sharp_bevel.stl --unit mm --json\n"
-      "  mneedle inspect scan.stl --unit um --repair --axis auto");
+      "  mneedle inspect scan.stl --unit um --repair --axis auto -o fixed.stl");
   command->callback([options] { run_inspect(*options); });
 }
 

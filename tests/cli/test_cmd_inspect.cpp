@@ -97,6 +97,27 @@ TEST_F(InspectCommand, RepairFixesInwardMeshAndSaysWhat) {
   EXPECT_GT(out["volume_m3"].get<double>(), 0.0);
 }
 
+// The repaired mesh is written (and then loads valid without --repair, its unit read back from
+// the header); a mesh the repair cannot fix writes nothing.
+TEST_F(InspectCommand, RepairWritesTheFixedMeshOnlyWhenItIsValid) {
+  const auto fixed = std::filesystem::temp_directory_path() /
+                     ("mneedle_fixed_" + std::to_string(::getpid()) + ".stl");
+  const CommandRun run = run_mneedle("inspect '" + asset("all_flipped.stl") +
+                                     "' --repair --json -o '" + fixed.string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const CommandRun again = run_mneedle("inspect '" + fixed.string() + "' --json");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  const auto before = nlohmann::json::parse(run.out), after = nlohmann::json::parse(again.out);
+  EXPECT_TRUE(after["repairs"].empty());
+  EXPECT_NEAR(after["volume_m3"].get<double>(), before["volume_m3"].get<double>(),
+              1e-6 * before["volume_m3"].get<double>());  // float32 STL coordinates
+  std::filesystem::remove(fixed);
+  const CommandRun broken = run_mneedle("inspect '" + asset("self_intersecting.stl") +
+                                        "' --repair -o '" + fixed.string() + "'");
+  EXPECT_EQ(broken.exit_code, 1);
+  EXPECT_FALSE(std::filesystem::exists(fixed));
+}
+
 TEST_F(InspectCommand, InwardMeshWithoutRepairFails) {
   const CommandRun run = run_mneedle("inspect '" + asset("all_flipped.stl") + "'");
   EXPECT_EQ(run.exit_code, 1);
