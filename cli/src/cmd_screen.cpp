@@ -23,6 +23,7 @@ struct ScreenArgs {
   std::string fidelity = "fast";
   std::string model = "auto";
   std::string axis = "auto";
+  bool repair = false;
   int jobs = 1;
   std::string out;
   bool json = false;
@@ -93,6 +94,7 @@ void run_screen(const ScreenArgs& args) {
   options.fidelity = args.fidelity;
   options.model = args.model;
   options.axis = args.axis;
+  options.repair = args.repair;
   parse_axis_choice(args.axis);  // a bad --axis is a usage error before any design runs
   if (options.resume && !options.out) throw InputError("screen: --resume needs --out DIR");
 
@@ -154,6 +156,9 @@ void add_screen_command(CLI::App& app) {
                   "Needle axis in the mesh files: auto (principal axis, tip at the narrower end), "
                   "x, y, z, or a tip direction a,b,c; a holder the needle stands on is cut off")
       ->capture_default_str();
+  cmd->add_flag("--repair", args->repair,
+                "Repair mesh files before checking them (outward orientation, degenerate faces, "
+                "borders), as inspect --repair; the row says what changed");
   cmd->add_option("--model", args->model,
                   "Pre-puncture model: auto (axisymmetric for cylinders and cones on the axis, "
                   "else 3-D), analytic, axisymmetric or 3d")

@@ -66,14 +66,21 @@ std::map<std::string, double> scene_parameters(const PluginShapeInfo& shape,
 }
 
 NeedleSource needle_from_file(const std::filesystem::path& file, double metres_per_unit,
-                              const AxisChoice& axis) {
+                              const AxisChoice& axis, bool repair) {
   NeedleSource n;
   n.name = file.stem().string();
   n.mesh = load_mesh(file, metres_per_unit);
+  std::string repaired;
+  if (repair) {
+    for (const std::string& change : repair_mesh(n.mesh).changes) {
+      repaired += (repaired.empty() ? "repaired: " : ", ") + change;
+    }
+  }
   require_valid_mesh(n.mesh, file.string());
   const FrameInfo frame = place_in_needle_frame(n.mesh, axis);
   const bool input_z = std::abs(frame.axis[2] + 1.0) < 1e-9;
-  if (!input_z) n.frame_note = frame.note;
+  n.frame_note = repaired;
+  if (!input_z) n.frame_note += (n.frame_note.empty() ? "" : "; ") + frame.note;
   if (const auto jump = find_holder_jump(n.mesh)) {
     // Cut a hair below the holder's face, so the cut never runs along it.
     const double cut = jump->height_m - 1e-6 * jump->total_height_m;

@@ -143,7 +143,7 @@ ScreenedNeedle design_needle(const DesignInput& d, const PluginRegistry& registr
       d.plugin
           ? needle_from_plugin(registry, *d.plugin,
                                scene_parameters(registry.shape(*d.plugin), d.parameters, where))
-          : needle_from_file(d.file, d.metres_per_unit, parse_axis_choice(o.axis));
+          : needle_from_file(d.file, d.metres_per_unit, parse_axis_choice(o.axis), o.repair);
   ScreenedNeedle n;
   n.frame_note = source.frame_note;
   n.options.fidelity = parse_fidelity(o.fidelity);
@@ -465,7 +465,9 @@ std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs
       try {
         const std::string hash =
             row_hash(designs[i], scene_hash,
-                     options.fidelity + "|" + options.model + "|axis=" + options.axis, material);
+                     options.fidelity + "|" + options.model + "|axis=" + options.axis +
+                         (options.repair ? "|repair" : ""),
+                     material);
         const auto previous = done.find(hash);
         skip = previous != done.end();
         row = skip ? previous->second

@@ -170,6 +170,21 @@ TEST(ScreenCommand, NeedleOnAHolderExportedYUpGivesTheBareNeedlesRow) {
   EXPECT_NEAR(b["peak_force_N"].get<double>(), peak, 1e-6 * peak);
 }
 
+TEST(ScreenCommand, RepairLetsAnInwardMeshThroughAndSaysWhatChanged) {
+  const std::string mesh = std::string(MNEEDLE_TEST_ASSETS) + "/meshes/all_flipped.stl";
+  const std::string scene = kRoot + "/designs/scenes/silicone_phantom.toml";
+  const auto plain =
+      run_mneedle("screen '" + mesh + "' --scene '" + scene + "' --model analytic --json");
+  EXPECT_EQ(plain.exit_code, 1);
+  EXPECT_NE(plain.out.find("screen --repair"), std::string::npos) << plain.out;
+  const auto repaired =
+      run_mneedle("screen '" + mesh + "' --scene '" + scene + "' --model analytic --repair --json");
+  ASSERT_EQ(repaired.exit_code, 0) << repaired.err;
+  const auto row = nlohmann::json::parse(repaired.out)["designs"][0];
+  EXPECT_TRUE(row["ok"].get<bool>());
+  EXPECT_EQ(row["frame_note"], "repaired: reoriented 6 faces");
+}
+
 TEST(ScreenCommand, ResumeWithoutOutIsAnError) {
   const auto run = run_mneedle("screen '" + kRoot + "/designs' --scene '" + kSkin + "' --resume");
   EXPECT_EQ(run.exit_code, 1);

@@ -194,7 +194,9 @@ void check_orientation(const TriangleMesh& mesh, const SurfaceMesh& surface,
     result.outward = false;
     result.errors.push_back("mesh encloses no volume");
   } else if (result.volume_m3 < 0.0) {
-    result.errors.push_back("mesh is inward-oriented (negative volume; `mneedle inspect FILE --repair -o fixed.stl` reorients it)");
+    result.errors.push_back(
+        "mesh is inward-oriented (negative volume; `screen --repair` or `mneedle inspect FILE "
+        "--repair -o fixed.stl` reorients it)");
   } else if (!PMP::does_bound_a_volume(surface)) {
     result.outward = false;
     result.errors.push_back("mesh does not bound a volume (a shell is inside out)");

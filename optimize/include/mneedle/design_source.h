@@ -47,9 +47,10 @@ std::map<std::string, double> scene_parameters(const PluginShapeInfo& shape,
 
 /// Loads, validates and places a mesh file in the needle frame (`axis`: see AxisChoice; the
 /// default finds the principal axis, tip at the narrower end) and cuts off a holder or base the
-/// needle stands on (geometry/holder.h), placing the needle alone again.
+/// needle stands on (geometry/holder.h), placing the needle alone again. `repair` runs
+/// repair_mesh first (outward orientation, degenerate faces, borders) and notes what it changed.
 NeedleSource needle_from_file(const std::filesystem::path& file, double metres_per_unit,
-                              const AxisChoice& axis = automatic_axis());
+                              const AxisChoice& axis = automatic_axis(), bool repair = false);
 
 NeedleSource needle_from_plugin(const PluginRegistry& registry, const std::string& shape,
                                 const std::map<std::string, double>& params_si);

@@ -38,6 +38,7 @@ struct ScreeningOptions {
   std::string fidelity = "fast";  // fast | standard | fine: the FE stage of run_insertion
   std::string model = "auto";     // auto | analytic | axisymmetric | 3d
   std::string axis = "auto";      // mesh files: auto | x | y | z | a,b,c (parse_axis_choice)
+  bool repair = false;            // mesh files: repair_mesh before validation
 };
 
 /// One row of a screening: an evaluation or the reason there is none. `json` is the row as

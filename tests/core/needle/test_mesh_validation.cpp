@@ -108,7 +108,9 @@ TEST(MeshValidation, AllFacesFlippedIsInward) {
   EXPECT_FALSE(v.outward);
   EXPECT_EQ(v.inconsistent_faces, 0u);
   EXPECT_LT(v.volume_m3, 0.0);
-  EXPECT_TRUE(has_error(v, "mesh is inward-oriented (negative volume; `mneedle inspect FILE --repair -o fixed.stl` reorients it)"))
+  EXPECT_TRUE(has_error(v,
+                        "mesh is inward-oriented (negative volume; `screen --repair` or `mneedle "
+                        "inspect FILE --repair -o fixed.stl` reorients it)"))
       << joined(v);
 }
 
