@@ -232,7 +232,10 @@ void run(const CalibrateArgs& a) {
   const CurveColumns columns{a.depth_col, a.force_col, "", a.depth_unit, a.force_unit};
   const ForceCurve measured = read_force_curve_csv(a.curve, columns);
   if (a.puncture_at == "detect") {
-    options.puncture_travel_m = largest_force_drop(measured).bottom_depth_m;
+    // On the loading branch only: a hold or a retraction has larger drops than any puncture.
+    const LoadingBranch branch = extract_loading_branch(measured);
+    options.puncture_travel_m =
+        largest_force_drop(branch.curve).bottom_depth_m + branch.contact_travel_m;
   } else if (!a.puncture_at.empty()) {
     options.puncture_travel_m = length_option("--puncture-at", a.puncture_at);
   }

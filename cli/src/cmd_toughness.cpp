@@ -231,7 +231,6 @@ void add_toughness_command(CLI::App& app) {
   auto a = std::make_shared<ToughnessArgs>();
   auto* cmd = app.add_subcommand(
       "toughness", "Fracture toughness J = integral of (F - F') dz / A from two insertions");
-  cmd->footer("Example:\n  mneedle toughness first.csv second.csv --area 0.0415mm^2");
   cmd->footer(
       "Columns are read by name with their unit: depth_m, depth_mm, travel_mm, position_um,\n"
       "'z [mm]', force_N, fz_N, force_mN, 'F (mN)'; --depth-col/--force-col pick others, and\n"

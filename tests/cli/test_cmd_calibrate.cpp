@@ -154,7 +154,7 @@ bool refdata_required() {
 // cannot separate q from mu (correlation -1): mu goes to its bound and the model becomes a line
 // through the origin, which extrapolates 30 % better than a free line but misses the plateau
 // after 36.7 mm (held-out error 1.8x the fit's: a miss, docs/validation.md).
-TEST(CmdCalibrate, LiverCurveInADeepBlockBeatsAStraightLineButNotItsOwnFitError) {
+TEST(CmdCalibrate, LiverCurveInADeepBlockBeatsAStraightLine) {
   if (!std::filesystem::exists(liver_curve())) {
     if (refdata_required()) FAIL() << "refdata required but absent: " << liver_curve();
     GTEST_SKIP() << "refdata absent: " << liver_curve();

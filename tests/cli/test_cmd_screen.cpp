@@ -81,6 +81,8 @@ TEST(ScreenCommand, AnalyticModelInSkinLetsNeitherFlatNorSharpStlPuncture) {
   for (const auto& d : j["designs"]) {
     EXPECT_EQ(d["models_run"][0], "analytic") << d.dump();
     EXPECT_FALSE(d["punctured"].get<bool>()) << d.dump();
+    // The FE gives 20-25 mN at 200 um for these needles (docs/validation.md, "Layered skin
+    // after the puncture"); 50 mN catches a return of the newton-sized answers.
     EXPECT_LT(d["peak_force_N"].get<double>(), 0.05) << d.dump();
   }
 }

@@ -157,6 +157,11 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
       base.friction != ShaftFriction::coulomb) {
     fail("friction_coefficient needs [loads] friction = \"coulomb\"");
   }
+  if (chosen.count(CalibratedConstant::scale) && base.mode == LoadModelMode::paper_a_fig17) {
+    fail(
+        "scale cannot be fitted in mode paper_a_fig17 (its K is paper A's, E D / (4 H)); fit "
+        "S by changing [loads] scale, or use mode distributed");
+  }
   const std::vector<LayerPressure> base_q = layer_pressures(base);
 
   const Samples all = samples_from(measured, options.contact_travel_m);
@@ -209,12 +214,15 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
   struct Split {
     std::optional<double> depth;
     const PreCurve* pre = nullptr;
+    /// The P_c this split stands for when P_c is fitted: the alpha load's cap (docs/model.md,
+    /// "Wall pressure cap") follows it in every layer that reads the same fracture data.
+    std::optional<double> critical_pressure;
   };
   const auto split_for_threshold = [&](double threshold) {
-    Split split{given_puncture_depth, last_rung};
+    Split split{given_puncture_depth, last_rung, std::nullopt};
     for (const PreCurve& rung : rungs) {
       if (const auto crossing = first_crossing(rung.depth_m, rung.criterion, threshold)) {
-        split = {crossing->depth_m, &rung};
+        split = {crossing->depth_m, &rung, std::nullopt};
         break;
       }
     }
@@ -235,6 +243,15 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
       c.layers[j].pressure_scale_source = "calibrate";
     }
     if (c.layers.empty()) c.stiffness_Pa = *base.stiffness_Pa * v.scale;
+    if (split.critical_pressure) {
+      const std::optional<double> old =
+          base.layers.empty() ? std::nullopt : base.layers.front().critical_pressure_Pa;
+      for (LoadLayer& layer : c.layers) {
+        if (!old || layer.critical_pressure_Pa == old) {
+          layer.critical_pressure_Pa = *split.critical_pressure;
+        }
+      }
+    }
     const SurfaceLoadModel post(needle.mesh, c);
     std::vector<double> out;
     for (std::size_t i : which) {
@@ -292,7 +309,7 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
   BoundedFit fit;
   std::optional<double> threshold, threshold_error;
   if (!fits_pc && !fits_gamma) {
-    best_split = given_puncture_depth ? Split{given_puncture_depth, nullptr}
+    best_split = given_puncture_depth ? Split{given_puncture_depth, nullptr, std::nullopt}
                                       : split_for_threshold(scene_threshold);
     fit = fit_bounded(residuals_for(best_split), x0, bounds, {});
   } else {
@@ -309,7 +326,11 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     if (gaps.empty()) fail("no two fitted samples lie within the pre-puncture run's depth");
     const auto gap_cost = [&](std::size_t g, std::vector<double>& x, int starts) {
       const double d = 0.5 * (gaps[g].first + gaps[g].second);
-      const Split split{d, rung_for_depth(d)};
+      const PreCurve* rung = rung_for_depth(d);
+      const Split split{
+          d, rung,
+          fits_pc ? std::optional<double>(interpolate_at(rung->depth_m, rung->criterion, d))
+                  : std::nullopt};
       if (smooth.empty()) return cost_of(residuals_for(split)(x));
       BoundedFitOptions o;
       o.starts = starts;
@@ -319,7 +340,7 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
       return f.cost;
     };
     // Every gap when there are few, else every k-th and then the neighbours of the best.
-    const std::size_t stride = std::max<std::size_t>(1, gaps.size() / 40);
+    const std::size_t stride = std::max<std::size_t>(1, (gaps.size() + 39) / 40);
     std::size_t best_gap = 0;
     double best_cost = std::numeric_limits<double>::infinity();
     std::vector<double> x_start = x0;
@@ -341,7 +362,11 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
       }
     }
     const double d = 0.5 * (gaps[best_gap].first + gaps[best_gap].second);
-    best_split = {d, rung_for_depth(d)};
+    best_split = {d, rung_for_depth(d), std::nullopt};
+    if (fits_pc) {
+      best_split.critical_pressure =
+          interpolate_at(best_split.pre->depth_m, best_split.pre->criterion, d);
+    }
     if (!smooth.empty()) fit = fit_bounded(residuals_for(best_split), x_start, bounds, {});
     const PreCurve& rung = *best_split.pre;
     const double lo = interpolate_at(rung.depth_m, rung.criterion, gaps[best_gap].first);

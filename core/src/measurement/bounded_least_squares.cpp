@@ -168,9 +168,13 @@ BoundedFit fit_bounded(const ResidualVector& residuals, const std::vector<double
     }
   }
   for (std::size_t j = 0; j < p; ++j) {
-    const double width = bounds[j].hi - bounds[j].lo;
-    fit.at_bound.push_back(x[static_cast<Eigen::Index>(j)] - bounds[j].lo < 1e-6 * width ||
-                           bounds[j].hi - x[static_cast<Eigen::Index>(j)] < 1e-6 * width);
+    // Measured where the search happens: in log space for a log bound.
+    const bool log = bounds[j].log;
+    const auto map = [log](double v) { return log ? std::log(v) : v; };
+    const double value = map(x[static_cast<Eigen::Index>(j)]);
+    const double lo = map(bounds[j].lo), hi = map(bounds[j].hi);
+    const double width = hi - lo;
+    fit.at_bound.push_back(value - lo < 1e-6 * width || hi - value < 1e-6 * width);
   }
   return fit;
 }

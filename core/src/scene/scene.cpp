@@ -891,6 +891,15 @@ Scene parse_scene(std::string_view text, std::string source_name) {
   for (auto& d : needles) scene.needles.push_back(std::move(d.spec));
   scene.model = read_model(root.optional_table("model"), scene.tissue);
   scene.loads = read_loads(root.optional_table("loads"));
+  if (scene.loads.mode == LoadMode::PaperAFig17) {
+    for (std::size_t i = 0; i < scene.tissue.layers.size(); ++i) {
+      if (scene.tissue.layers[i].pressure_scale) {
+        root.fail("tissue.layers[" + std::to_string(i) + "].pressure_scale",
+                  scene.tissue.layers[i].line,
+                  "not with [loads] mode = \"paper_a_fig17\", which takes q = S E D / (4 H)");
+      }
+    }
+  }
   scene.requirements = read_requirements(root.optional_table("requirements"), scene.insertion);
   scene.materials = read_materials(root);
   return scene;

@@ -609,6 +609,15 @@ TEST(SceneErrors, PressureScaleNeedsItsSource) {
       {"tissue.layers[1].pressure_scale_source", "missing"});
 }
 
+TEST(SceneErrors, PaperAFig17ModeRefusesALayerPressureScale) {
+  expect_error(with(R"(thickness = "1130 um")",
+                    "thickness = \"1130 um\"\npressure_scale = \"45 kPa\"\n"
+                    "pressure_scale_source = \"x\"") +
+                   "\n[loads]\nmode = \"paper_a_fig17\"\nspecimen_diameter = \"44.107 mm\"\n"
+                   "specimen_height = \"21.145 mm\"\n",
+               {"tissue.layers[1].pressure_scale", "paper_a_fig17"});
+}
+
 TEST(SceneErrors, PaperAFig17ModeNeedsThePhantomAndOnlyIt) {
   expect_error(std::string(kBase) + "\n[loads]\nmode = \"paper_a_fig17\"\n",
                {"loads.specimen_diameter", "missing"});
