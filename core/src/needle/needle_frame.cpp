@@ -33,7 +33,7 @@ constexpr double kProbeFraction = 0.05;
 // Ends whose probed widths differ by less than this fraction count as alike.
 constexpr double kAlikeFraction = 0.02;
 // A principal axis is trusted when its moment is this many times the next one (a needle is
-// several times longer than wide; a stub or a needle on a wide plate is not).
+// several times longer than wide; a short, wide body or a needle on a wide plate is not).
 constexpr double kElongation = 1.5;
 // ... and then a needle's end is found when its section is this narrow against the other end's.
 constexpr double kHolderNarrowing = 0.25;
@@ -204,7 +204,7 @@ std::optional<Vector3d> narrower_end_direction(const TriangleMesh& mesh, const V
   const Eigen::SelfAdjointEigenSolver<Matrix3d> solver(surface_second_moment(mesh, center));
   const auto& moments = solver.eigenvalues();  // ascending
   if (!given && !(moments[2] >= kElongation * moments[1])) {
-    // Not longer than wide: a needle on a wide holder or plate, or a stub. The needle's tip is
+    // Not longer than wide: a needle on a wide holder or plate, or a short, wide body. The tip is
     // the narrowest end of any principal axis; a holder's rim is never that narrow.
     double best_width = std::numeric_limits<double>::infinity(), other_end = 0.0;
     Vector3d best;
