@@ -11,6 +11,7 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -23,6 +24,9 @@
 #include "mneedle/fe/tissue_mesh.h"
 #include "mneedle/geometry/cross_section.h"
 #include "mneedle/needle/mesh_io.h"
+#include "mneedle/optimum_report.h"
+#include "mneedle/plugin_host.h"
+#include "mneedle/strength/needle_material.h"
 #include "mneedle/tip_optimizer.h"
 
 namespace mneedle::cli {
@@ -149,7 +153,12 @@ struct Problem {
   // Objective (m or N) and constraints, each satisfied when <= 0 and scaled to be O(1):
   // margin >= safety factor, wall >= minimum feature, puncture at or above the target depth.
   DesignScore score(const std::map<std::string, double>& values) const {
-    const NeedleSource n = needle(values);
+    NeedleSource n;
+    try {
+      n = needle(values);
+    } catch (const InvalidShapeError& e) {
+      throw InfeasibleDesign(e.what());  // a bevel longer than the needle is a design property
+    }
     const DesignEvaluation e = evaluate(n);
     const double sf = e.safety_factor;
     const double margin = std::isfinite(e.margin) ? e.margin : 1e6;
@@ -167,41 +176,103 @@ std::string objective_text(const std::string& objective, double value) {
                                    : "puncture depth " + format_quantity(value, Dimension::Length);
 }
 
-void write_outputs(const std::filesystem::path& dir, const OptimizerResult& r,
-                   const std::vector<DesignVariable>& vars, const TriangleMesh& best_mesh,
-                   const nlohmann::json& summary, const std::string& objective_key) {
-  std::filesystem::create_directories(dir);
-  write_stl_binary(best_mesh, dir / "best.stl", 1e-3, "mneedle optimize best design unit=mm");
-  std::ofstream csv(dir / "history.csv");
-  // Full precision: a history that rounds cannot be compared with the summary it produced.
-  csv << std::setprecision(17);
-  auto number = [](double x) {
-    std::ostringstream out;
-    out << std::setprecision(17) << x;
-    return out.str();
-  };
-  for (const auto& v : vars) csv << v.name << "_SI,";
-  csv << objective_key;
-  for (const char* c : kConstraintNames) csv << "," << c;
-  csv << ",feasible,failed,start,seconds,error\n";
-  for (const auto& e : r.history) {
+// history.csv, one row per distinct design as soon as it is evaluated (flushed), so a killed run
+// keeps every design it paid for; full precision, so the history compares with the summary.
+class HistoryWriter {
+ public:
+  HistoryWriter(const std::filesystem::path& file, const std::vector<DesignVariable>& vars,
+                const std::string& objective_key)
+      : file_(file), out_(file), vars_(vars) {
+    if (!out_) throw InputError("--out: cannot write '" + file.string() + "'");
+    out_ << std::setprecision(17);
+    for (const auto& v : vars_) out_ << v.name << "_SI,";
+    out_ << objective_key;
+    for (const char* c : kConstraintNames) out_ << "," << c;
+    out_ << ",feasible,failed,impossible,start,seconds,error\n" << std::flush;
+  }
+
+  void write(const EvaluationRecord& e) {
     std::vector<double> numbers;
     std::vector<std::string> columns;
-    for (const auto& v : vars) {
+    for (const auto& v : vars_) {
       numbers.push_back(e.values.at(v.name));
       columns.push_back(v.name);
     }
     require_finite_row(numbers, columns, "history row", "optimize");
-    for (double x : numbers) csv << x << ",";
-    csv << (e.failed ? "" : number(e.objective));
-    for (int i = 0; i < kConstraints; ++i) csv << "," << (e.failed ? "" : number(e.constraints[i]));
+    for (double x : numbers) out_ << x << ",";
+    // A failed or impossible point has no objective or constraint values: empty fields.
+    const bool valued = !e.failed && !e.impossible;
+    if (valued) out_ << e.objective;
+    for (int i = 0; i < kConstraints; ++i) {
+      out_ << ",";
+      if (valued) out_ << e.constraints[i];
+    }
     std::string error = e.error;
     std::replace(error.begin(), error.end(), '"', '\'');
-    csv << "," << e.feasible << "," << e.failed << "," << e.start << "," << e.seconds << ",\""
-        << error << "\"\n";
+    std::replace(error.begin(), error.end(), '\n', ' ');
+    out_ << "," << e.feasible << "," << e.failed << "," << e.impossible << "," << e.start << ","
+         << e.seconds << ",\"" << error << "\"\n"
+         << std::flush;
+    if (!out_) throw InputError("--out: writing '" + file_.string() + "' failed");
   }
+
+ private:
+  std::filesystem::path file_;
+  std::ofstream out_;
+  const std::vector<DesignVariable>& vars_;
+};
+
+void write_outputs(const std::filesystem::path& dir, const TriangleMesh& best_mesh,
+                   const nlohmann::json& summary) {
+  write_stl_binary(best_mesh, dir / "best.stl", 1e-3, "mneedle optimize best design unit=mm");
   require_finite_json(summary, "optimize");
   std::ofstream(dir / "summary.json") << summary.dump(2) << "\n";
+}
+
+// The optimum's place (bound, constraint, interior) and the failures, for JSON.
+nlohmann::json optimum_json(const OptimumReport& report) {
+  const auto names = [](const std::vector<int>& indices) {
+    nlohmann::json list = nlohmann::json::array();
+    for (int i : indices) list.push_back(kConstraintNames[i]);
+    return list;
+  };
+  const auto causes = [](const std::vector<FailureCount>& counts) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const FailureCount& f : counts) list.push_back({{"error", f.error}, {"count", f.count}});
+    return list;
+  };
+  return {{"interior", report.interior()},
+          {"on_lower_bound", report.on_lower_bound},
+          {"on_upper_bound", report.on_upper_bound},
+          {"active_constraints", names(report.active_constraints)},
+          {"violated_constraints", names(report.violated_constraints)},
+          {"failed_evaluations", report.failed},
+          {"failures", causes(report.failures)},
+          {"impossible_designs", report.impossible},
+          {"impossible_causes", causes(report.impossible_causes)}};
+}
+
+// One line: where the optimum is. A bound means the box stopped the search, not the physics.
+std::string optimum_text(const OptimumReport& report) {
+  if (report.interior()) return "interior (no bound and no constraint is active)";
+  std::vector<std::string> parts;
+  for (const auto& n : report.on_lower_bound) parts.push_back("lower bound of " + n);
+  for (const auto& n : report.on_upper_bound) parts.push_back("upper bound of " + n);
+  const auto constraint = [](int i) {
+    const std::string c = kConstraintNames[i];
+    return c.substr(0, c.size() - std::string("_constraint").size()) + " constraint";
+  };
+  for (int i : report.active_constraints) parts.push_back(constraint(i));
+  std::string text;
+  for (std::size_t i = 0; i < parts.size(); ++i) text += (i ? ", the " : "on the ") + parts[i];
+  for (std::size_t i = 0; i < report.violated_constraints.size(); ++i)
+    text += (i              ? ", the "
+             : text.empty() ? "beyond the "
+                            : "; beyond the ") +
+            constraint(report.violated_constraints[i]);
+  if (!report.on_lower_bound.empty() || !report.on_upper_bound.empty())
+    text += " (widen --bound to search further)";
+  return text;
 }
 
 nlohmann::json number_or_null(double v) {
@@ -226,6 +297,18 @@ double fixed_tip_size(const Problem& p, const std::vector<DesignVariable>& vars,
       .fine_size;
 }
 
+// "  3 of 20 evaluations failed: 2x "…"; 1x "…"": the commonest causes first, at most three.
+void print_causes(int count, int evaluations, const char* what,
+                  const std::vector<FailureCount>& causes) {
+  if (count == 0) return;
+  std::cout << "  " << count << " of " << evaluations << " evaluations " << what << ":";
+  const std::size_t shown = std::min<std::size_t>(causes.size(), 3);
+  for (std::size_t i = 0; i < shown; ++i)
+    std::cout << (i ? ";" : "") << " " << causes[i].count << "x \"" << causes[i].error << "\"";
+  if (causes.size() > shown) std::cout << "; " << causes.size() - shown << " other causes";
+  std::cout << "\n";
+}
+
 void run_optimize(const OptimizeArgs& a) {
   const Scene scene = load_scene(a.scene);
   const auto registry = PluginRegistry::discover({a.plugin_dirs.begin(), a.plugin_dirs.end()});
@@ -241,6 +324,8 @@ void run_optimize(const OptimizeArgs& a) {
     for (const auto& n : scene.needles)
       if (n.material && problem.material.empty()) problem.material = *n.material;
   if (problem.material.empty()) problem.material = "silicon";
+  // Checked once here: an unknown name would otherwise fail every evaluation of the search.
+  find_needle_material(problem.material, scene_needle_materials(scene));
   problem.evaluation.fidelity = parse_fidelity(a.fidelity);
   problem.evaluation.model = parse_pre_model(a.model);
   const std::vector<double> start = start_values(shape, vars, problem.fixed);
@@ -263,23 +348,34 @@ void run_optimize(const OptimizeArgs& a) {
                  p.evaluations, p.elapsed_s, objective_text(a.objective, p.best_objective).c_str(),
                  p.feasible ? "feasible" : "none feasible yet", p.start, p.starts);
   };
+  const std::string objective_key =
+      a.objective == "peak-force" ? "peak_force_N" : "puncture_depth_m";
+  std::unique_ptr<HistoryWriter> history;
+  if (!a.out.empty()) {
+    std::filesystem::create_directories(a.out);
+    history = std::make_unique<HistoryWriter>(std::filesystem::path(a.out) / "history.csv", vars,
+                                              objective_key);
+    o.on_evaluation = [&](const EvaluationRecord& e) { history->write(e); };
+  }
   const OptimizerResult r = optimize_design(
       vars, [&](const auto& values) { return problem.score(values); }, kConstraints, o);
   if (r.best.empty()) {
     // Name the first failure: the same cause usually sinks them all.
     std::string first;
     for (const EvaluationRecord& e : r.history)
-      if (e.failed && !e.error.empty()) {
+      if ((e.failed || e.impossible) && !e.error.empty()) {
         first = "; the first: " + e.error;
         break;
       }
-    throw SolverError("optimize: every evaluation failed (" + r.stop_reason + ")" + first);
+    throw SolverError(
+        "optimize: every evaluation failed (" + r.stop_reason + ")" + first +
+        (history ? "; each is in " + (std::filesystem::path(a.out) / "history.csv").string()
+                 : std::string()));
   }
+  const OptimumReport report = describe_optimum(vars, r);
 
   const NeedleSource best = problem.needle(r.best);
   const DesignEvaluation e = problem.evaluate(best);
-  const std::string objective_key =
-      a.objective == "peak-force" ? "peak_force_N" : "puncture_depth_m";
   nlohmann::json summary = {
       {"best",
        {{"params", best.params},
@@ -303,8 +399,9 @@ void run_optimize(const OptimizeArgs& a) {
       {"seconds", r.seconds},
       {"fidelity", a.fidelity},
       {"tip_element_size_m", *problem.evaluation.overrides.tip_size_m},
-      {"material", problem.material}};
-  if (!a.out.empty()) write_outputs(a.out, r, vars, best.mesh, summary, objective_key);
+      {"material", problem.material},
+      {"optimum", optimum_json(report)}};
+  if (!a.out.empty()) write_outputs(a.out, best.mesh, summary);
   if (a.json) {
     print_checked_json(std::cout, summary, "optimize");
     return;
@@ -334,7 +431,11 @@ void run_optimize(const OptimizeArgs& a) {
                                : "")
                     : "not reached before " + format_quantity(e.depth_m, Dimension::Length))
             << "\n  peak force " << format_quantity(e.peak_force_n, Dimension::Force)
-            << ", strength margin " << e.margin << " (safety factor " << e.safety_factor << ")\n";
+            << ", strength margin " << e.margin << " (safety factor " << e.safety_factor << ")\n"
+            << "  optimum " << optimum_text(report) << "\n";
+  print_causes(report.failed, r.evaluations, "failed", report.failures);
+  print_causes(report.impossible, r.evaluations, "were no valid shape (infeasible)",
+               report.impossible_causes);
 }
 
 }  // namespace

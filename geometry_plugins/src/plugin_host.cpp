@@ -264,6 +264,7 @@ struct PluginRegistry::Impl {
     std::string text = info.library.string() + ": shape '" + info.name + "' " +
                        std::string(action) + " failed (" + status_name(status) + ")";
     if (message[0] != '\0') text += ": " + std::string(message);
+    if (status == MNEEDLE_STATUS_INVALID_PARAMETER) throw InvalidShapeError(text);
     throw InputError(text);
   }
 };

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <limits>
 #include <nlopt.hpp>
 #include <numeric>
@@ -23,11 +24,11 @@ double violation(const EvaluationRecord& r) {
   return v;
 }
 
-// Best feasible design, else the least violated; failed evaluations never count.
+// Best feasible design, else the least violated; failed and impossible points never count.
 const EvaluationRecord* best_record(const std::vector<EvaluationRecord>& history) {
   const EvaluationRecord* best = nullptr;
   for (const auto& r : history) {
-    if (r.failed) continue;
+    if (r.failed || r.impossible) continue;
     if (!best || (r.feasible && !best->feasible) ||
         (r.feasible == best->feasible &&
          (r.feasible ? r.objective < best->objective : violation(r) < violation(*best))))
@@ -72,6 +73,12 @@ class ScaledProblem {
       record.constraints = score.constraints;
       record.feasible = std::all_of(score.constraints.begin(), score.constraints.end(),
                                     [](double c) { return c <= 0.0; });
+    } catch (const InfeasibleDesign& e) {
+      // No design there: penalised like a failure, but reported as a property of the point.
+      record.impossible = true;
+      record.error = e.what();
+      record.objective = penalty();
+      record.constraints.assign(m_, 1.0);
     } catch (const std::exception& e) {
       // A failed design is a penalised point: worse than anything seen, and infeasible.
       record.failed = true;
@@ -83,6 +90,15 @@ class ScaledProblem {
     cache_[unit] = result_.history.size();
     result_.history.push_back(record);
     ++result_.evaluations;
+    if (options_.on_evaluation) {
+      // NLopt would turn the caller's exception into its own failure text: keep it and stop.
+      try {
+        options_.on_evaluation(result_.history.back());
+      } catch (...) {
+        caller_error_ = std::current_exception();
+        throw nlopt::forced_stop();
+      }
+    }
     report_progress();
     return result_.history.back();
   }
@@ -97,13 +113,16 @@ class ScaledProblem {
 
   double elapsed() const { return std::chrono::duration<double>(Clock::now() - started_).count(); }
   bool time_up() const { return time_up_; }
+  void rethrow_caller_error() const {
+    if (caller_error_) std::rethrow_exception(caller_error_);
+  }
   void set_start(int start) { start_ = start; }
 
  private:
   double penalty() const {
     double worst = 1.0;
     for (const auto& r : result_.history)
-      if (!r.failed) worst = std::max(worst, std::abs(r.objective) * 10.0);
+      if (!r.failed && !r.impossible) worst = std::max(worst, std::abs(r.objective) * 10.0);
     return worst;
   }
 
@@ -136,6 +155,7 @@ class ScaledProblem {
   std::map<std::vector<double>, std::size_t> cache_;
   bool time_up_ = false;
   int start_ = 1;
+  std::exception_ptr caller_error_;
 };
 
 struct ConstraintData {
@@ -306,7 +326,10 @@ std::string describe_stop(const OptimizerResult& r) {
 void pick_best(OptimizerResult& result) {
   const EvaluationRecord* best = best_record(result.history);
   if (!best) {
-    result.stop_reason += "; every evaluation failed";
+    const bool any_impossible = std::any_of(result.history.begin(), result.history.end(),
+                                            [](const EvaluationRecord& r) { return r.impossible; });
+    result.stop_reason +=
+        any_impossible ? "; no evaluation gave a valid design" : "; every evaluation failed";
     return;
   }
   result.best = best->values;
@@ -364,6 +387,7 @@ OptimizerResult optimize_design(const std::vector<DesignVariable>& variables,
     problem.set_start(static_cast<int>(s) + 1);
     const int before = result.evaluations;
     const int code = run_nlopt(opt, points[s], problem, failure);
+    problem.rethrow_caller_error();
     codes.push_back(code);
     result.starts.push_back(
         {problem.to_si(points[s]), result.evaluations - before,

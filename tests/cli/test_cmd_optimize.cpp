@@ -4,6 +4,8 @@
 // the same code path in run_insertion.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -16,6 +18,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using mneedle::test::mneedle_binary;
 using mneedle::test::run_mneedle;
 
 const std::string kRoot = MNEEDLE_SOURCE_ROOT;
@@ -174,6 +177,92 @@ TEST(OptimizeCommand, BadInputIsAClearError) {
                     "' --vary half_angle --max-time 5kg");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("5kg"), std::string::npos) << run.err;
+}
+
+}  // namespace
+
+namespace {
+
+TEST(OptimizeCommand, UnknownMaterialIsRefusedBeforeTheSearchStarts) {
+  const auto run = run_mneedle("optimize --plugin cone --scene '" + kSkin +
+                               "' --vary half_angle --material unobtainium --max-evals 2");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("unknown needle material 'unobtainium'"), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find("no design could be evaluated"), std::string::npos) << run.err;
+}
+
+TEST(OptimizeCommand, SummarySaysWhereTheOptimumIsAndHowManyEvaluationsFailed) {
+  // The analytic puncture depth falls with the bevel angle over 15-60 deg (docs/model.md,
+  // "Optimisation"), so the search ends on the lower bound and must say so.
+  const fs::path dir = temp_dir("optimum");
+  const std::string common = "optimize --plugin sharp_bevel --scene '" + kSilicone +
+                             "' --vary bevel_angle --bound bevel_angle=15deg:60deg"
+                             " --model analytic --max-evals 20";
+  const auto run = run_mneedle(common + " --json --out '" + dir.string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  const auto& optimum = j["optimum"];
+  EXPECT_FALSE(optimum["interior"].get<bool>()) << optimum.dump();
+  EXPECT_EQ(optimum["on_lower_bound"], nlohmann::json::array({"bevel_angle"})) << optimum.dump();
+  EXPECT_TRUE(optimum["on_upper_bound"].empty()) << optimum.dump();
+  EXPECT_TRUE(optimum["violated_constraints"].empty()) << optimum.dump();
+  EXPECT_EQ(optimum["failed_evaluations"], 0) << optimum.dump();
+  EXPECT_EQ(optimum["impossible_designs"], 0) << optimum.dump();
+  std::ifstream history(dir / "history.csv");
+  int rows = -1;
+  for (std::string line; std::getline(history, line);) ++rows;
+  EXPECT_EQ(rows, j["evaluations"].get<int>());
+  const auto text = run_mneedle(common);
+  EXPECT_NE(text.out.find("optimum on the lower bound of bevel_angle (widen --bound"),
+            std::string::npos)
+      << text.out;
+  fs::remove_all(dir);
+}
+
+TEST(OptimizeCommand, BevelLongerThanTheNeedleIsAnImpossibleDesignNotAFailure) {
+  // The plugin's whole ranges: thin bevels on wide needles are longer than the needle.
+  const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSilicone +
+                               "' --vary bevel_angle,diameter --model analytic --max-evals 30"
+                               " --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  const auto& optimum = j["optimum"];
+  EXPECT_EQ(optimum["failed_evaluations"], 0) << optimum.dump(2);
+  ASSERT_GT(optimum["impossible_designs"].get<int>(), 0) << optimum.dump(2);
+  EXPECT_NE(optimum["impossible_causes"][0]["error"].get<std::string>().find("longer than"),
+            std::string::npos)
+      << optimum.dump(2);
+}
+
+TEST(OptimizeCommand, KilledRunKeepsEveryEvaluatedDesignInItsHistory) {
+  // SIGKILL once the first row is on disk: the rows written must be whole and full precision,
+  // and no summary claims a result.
+  const fs::path dir = temp_dir("killed");
+  const std::string history = (dir / "history.csv").string();
+  const std::string script =
+      "'" + mneedle_binary() + "' optimize --plugin sharp_bevel --scene '" + kSilicone +
+      "' --vary bevel_angle --max-evals 100 --out '" + dir.string() +
+      "' >/dev/null 2>&1 & pid=$!; for i in $(seq 1200); do "
+      "[ -f '" +
+      history + "' ] && [ $(wc -l < '" + history +
+      "') -ge 2 ] && break; sleep 0.1; done; kill -9 $pid; wait $pid 2>/dev/null; true";
+  ASSERT_EQ(std::system(script.c_str()), 0);
+  std::ifstream in(history);
+  std::string header;
+  ASSERT_TRUE(std::getline(in, header)) << "no history after the kill";
+  const auto fields = [](const std::string& line) {
+    return std::count(line.begin(), line.end(), ',') + 1;
+  };
+  int rows = 0;
+  for (std::string line; std::getline(in, line); ++rows) {
+    EXPECT_EQ(fields(line), fields(header)) << line;
+    // 17 significant digits: the first field is the bevel angle in radians (the start, 30 deg,
+    // is pi/6, which no shorter decimal holds).
+    EXPECT_GE(line.find(','), 17u) << line;
+  }
+  EXPECT_GE(rows, 1);
+  EXPECT_FALSE(fs::exists(dir / "summary.json"));
+  fs::remove_all(dir);
 }
 
 }  // namespace

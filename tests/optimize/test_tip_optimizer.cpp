@@ -229,3 +229,79 @@ TEST(TipOptimizer, RejectsBadProblems) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(TipOptimizer, EveryDistinctDesignReachesTheCallerOnceAsSoonAsItIsEvaluated) {
+  mneedle::OptimizerOptions o;
+  o.max_evaluations = 30;
+  int calls = 0;
+  o.on_evaluation = [&](const mneedle::EvaluationRecord&) { ++calls; };
+  int evaluated = 0;
+  auto f = [&](const std::map<std::string, double>& v) {
+    EXPECT_EQ(calls, evaluated) << "a design was not reported before the next one started";
+    ++evaluated;
+    return constrained_bowl(v);
+  };
+  const auto r = mneedle::optimize_design(kBox, f, 1, o);
+  EXPECT_EQ(calls, r.evaluations);
+  EXPECT_EQ(calls, evaluated);
+}
+
+TEST(TipOptimizer, ExceptionFromTheEvaluationCallbackStopsTheSearchAndReachesTheCaller) {
+  mneedle::OptimizerOptions o;
+  o.max_evaluations = 30;
+  int calls = 0;
+  o.on_evaluation = [&](const mneedle::EvaluationRecord&) {
+    if (++calls == 3) throw std::runtime_error("disk full");
+  };
+  try {
+    mneedle::optimize_design(kBox, constrained_bowl, 1, o);
+    FAIL() << "the callback's exception was swallowed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "disk full");
+  }
+  EXPECT_EQ(calls, 3);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(TipOptimizer, ImpossibleDesignsAreInfeasiblePointsNeverFailuresAndNeverTheBest) {
+  // x > 1 is no design at all; the bowl's optimum (1.5, 0.5) lies there, so the best valid
+  // design is on x = 1.
+  auto f = [](const std::map<std::string, double>& v) {
+    if (v.at("x") > 1.0) throw mneedle::InfeasibleDesign("x beyond 1 makes no shape");
+    return constrained_bowl(v);
+  };
+  mneedle::OptimizerOptions o;
+  o.max_evaluations = 200;
+  const auto r = mneedle::optimize_design(kBox, f, 1, o);
+  int impossible = 0;
+  for (const auto& e : r.history) {
+    EXPECT_FALSE(e.failed);
+    if (e.impossible) {
+      ++impossible;
+      EXPECT_EQ(e.error, "x beyond 1 makes no shape");
+      EXPECT_FALSE(e.feasible);
+    }
+  }
+  EXPECT_GT(impossible, 0);
+  ASSERT_FALSE(r.best.empty());
+  EXPECT_LE(r.best.at("x"), 1.0);
+}
+
+TEST(TipOptimizer, OnlyImpossibleDesignsSaySoInTheStopReason) {
+  auto f = [](const std::map<std::string, double>&) -> mneedle::DesignScore {
+    throw mneedle::InfeasibleDesign("never a shape");
+  };
+  mneedle::OptimizerOptions o;
+  o.max_evaluations = 5;
+  const auto r = mneedle::optimize_design(kBox, f, 1, o);
+  EXPECT_TRUE(r.best.empty());
+  EXPECT_NE(r.stop_reason.find("no evaluation gave a valid design"), std::string::npos)
+      << r.stop_reason;
+}
+
+}  // namespace

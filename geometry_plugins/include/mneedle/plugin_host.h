@@ -10,9 +10,18 @@
 #include <string_view>
 #include <vector>
 
+#include "mneedle/base/error.h"
 #include "mneedle/needle/mesh.h"
 
 namespace mneedle {
+
+/// A plugin refused a parameter combination as no valid shape (MNEEDLE_STATUS_INVALID_PARAMETER,
+/// e.g. a bevel longer than the needle): a property of the design, which a search treats as
+/// infeasible rather than as a failure of the run.
+class InvalidShapeError : public InputError {
+ public:
+  using InputError::InputError;
+};
 
 struct PluginParameter {
   std::string name;
@@ -78,7 +87,8 @@ class PluginRegistry {
   std::vector<double> resolve_parameters(std::string_view shape,
                                          const std::map<std::string, double>& si) const;
 
-  /// The shape's mesh (metres, needle frame), checked to be a valid closed solid.
+  /// The shape's mesh (metres, needle frame), checked to be a valid closed solid. Throws
+  /// InvalidShapeError when the plugin says the parameters make no valid shape.
   TriangleMesh generate(std::string_view shape, const std::map<std::string, double>& si) const;
 
   /// Analytic section at height h (m) above the tip; nullopt when the shape has no hook.

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,13 @@ struct DesignScore {
   std::vector<double> constraints;
 };
 
+/// Thrown by a DesignFunction for parameters that make no valid design (a bevel longer than the
+/// needle): the point is infeasible, not a failure of the evaluation, and is never the best.
+class InfeasibleDesign : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 using DesignFunction = std::function<DesignScore(const std::map<std::string, double>& values)>;
 
 /// A snapshot for a progress line: how far the search is and what it has found.
@@ -33,6 +41,18 @@ struct OptimizerProgress {
   double elapsed_s = 0.0;
   int start = 1;  // which of the multi-start runs is going (1-based)
   int starts = 1;
+};
+
+struct EvaluationRecord {
+  std::map<std::string, double> values;
+  double objective = 0.0;
+  std::vector<double> constraints;
+  bool feasible = false;
+  bool failed = false;      // the evaluation threw: `error` says why
+  bool impossible = false;  // InfeasibleDesign: no valid design there; `error` says why
+  std::string error;
+  double seconds = 0.0;
+  int start = 1;  // the multi-start run that asked for it (1-based)
 };
 
 struct OptimizerOptions {
@@ -48,17 +68,10 @@ struct OptimizerOptions {
   std::vector<double> start;         // SI; empty = the middle of the bounds
   double progress_interval_s = 2.0;  // at most one progress call per interval
   std::function<void(const OptimizerProgress&)> progress;  // optional
-};
-
-struct EvaluationRecord {
-  std::map<std::string, double> values;
-  double objective = 0.0;
-  std::vector<double> constraints;
-  bool feasible = false;
-  bool failed = false;
-  std::string error;
-  double seconds = 0.0;
-  int start = 1;  // the multi-start run that asked for it (1-based)
+  /// Called once per distinct design, as soon as it is evaluated (optional): lets a caller write
+  /// its history as it goes, so a killed run keeps what it evaluated. Its exceptions stop the
+  /// search and reach the caller.
+  std::function<void(const EvaluationRecord&)> on_evaluation;
 };
 
 /// One local run of a multi-start search.
