@@ -386,7 +386,13 @@ void SurfaceLoadModel::add_face(const Face& face, double depth_m, LoadSample& sa
     const double high = depth_m - layer_top;
     const double low = depth_m - layer_bottom_m_[j];
     layer_top = layer_bottom_m_[j];
-    if (face.lowest >= high || face.highest <= low) continue;
+    // A face across the axis (no height extent) lies in one layer: the deeper one when it sits
+    // on an interface (docs/model.md, "Pressure scale"); any other face overlaps a slab or not at
+    // all.
+    const bool across = face.highest == face.lowest;
+    if (across ? !(face.lowest > low && face.lowest <= high)
+               : (face.lowest >= high || face.highest <= low))
+      continue;
     const std::vector<Vertex> polygon = clip_to_slab(face, low, high);
     if (polygon.size() >= 3) add_piece(face, polygon, layers_[j], sample);
   }

@@ -164,6 +164,35 @@ TEST(SurfaceLoads, EachLayerLoadsWithItsOwnStiffness) {
   EXPECT_NEAR(model.at(150e-6).alpha_N, 0.2e6 / (1 - 0.16) * kS * end, 1e-12);
 }
 
+TEST(SurfaceLoads, FlatEndExactlyOnALayerInterfaceIsLoadedByTheDeeperLayer) {
+  // A face across the axis has no height extent: at a depth sample on an interface it belonged
+  // to neither slab and carried nothing (half the force on a split gel). It lies in the deeper
+  // layer, as a depth on an interface does for the scene (docs/model.md, "Pressure scale").
+  LoadConstants c;
+  c.friction = mneedle::ShaftFriction::none;
+  c.layers = {layer(100e-6, 1e6, 0.0), layer(0.0, 0.2e6, 0.4)};
+  const SurfaceLoadModel model(mneedle::test::cylinder({}), c);
+  const double end = polygon_area(64, kR);
+  EXPECT_NEAR(model.at(100e-6).alpha_N, 0.2e6 / (1 - 0.16) * kS * end, 1e-12);
+}
+
+TEST(SurfaceLoads, OneMaterialSplitIntoIdenticalLayersLoadsAsOneLayerAtEveryDepth) {
+  // Depth samples on the interfaces included; no tolerance beyond rounding of the same sums.
+  LoadConstants one;
+  one.layers = {layer(0.0, 0.2e6, 0.4)};
+  LoadConstants split;
+  split.layers = {layer(50e-6, 0.2e6, 0.4), layer(100e-6, 0.2e6, 0.4), layer(0.0, 0.2e6, 0.4)};
+  for (const auto& mesh : {mneedle::test::cylinder({}), mneedle::test::cone({}, 0.3)}) {
+    const SurfaceLoadModel a(mesh, one), b(mesh, split);
+    for (double depth : {25e-6, 50e-6, 100e-6, 150e-6, 151e-6, 300e-6}) {
+      const auto x = a.at(depth), y = b.at(depth);
+      EXPECT_NEAR(y.alpha_N, x.alpha_N, 1e-12 * x.force_N) << depth;
+      EXPECT_NEAR(y.beta_N, x.beta_N, 1e-12 * x.force_N) << depth;
+      EXPECT_NEAR(y.friction_N, x.friction_N, 1e-12 * x.force_N) << depth;
+    }
+  }
+}
+
 TEST(SurfaceLoads, AGivenPressureScaleReplacesTheDerivedOneAndKeepsItsSource) {
   LoadConstants c;
   c.friction = mneedle::ShaftFriction::none;
