@@ -59,8 +59,10 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
       continue;
     }
     const auto j = nlohmann::json::parse(row.json);
-    const std::string margin =
-        j["margin"].is_null() ? "no load" : std::to_string(row.margin).substr(0, 6);
+    // Four significant digits in the 8-column cell: 7.32e10 must not print as "732099".
+    char margin_text[32];
+    std::snprintf(margin_text, sizeof margin_text, "%.4g", row.margin);
+    const std::string margin = j["margin"].is_null() ? "no load" : margin_text;
     std::string models;
     for (const auto& m : j["models_run"])
       models += (models.empty() ? "" : "+") + m.get<std::string>();

@@ -193,6 +193,41 @@ TEST(ScreenCommand, ResumeWithoutOutIsAnError) {
   EXPECT_NE(run.err.find("--resume needs --out"), std::string::npos) << run.err;
 }
 
+TEST(ScreenCommand, TablePrintsTheMarginToFourSignificantDigitsWhateverItsSize) {
+  // A 1 Pa gel: the cone's margin is about 7e10; the table printed its first six characters,
+  // "732099", as if it were 7e5.
+  const fs::path dir = fs::temp_directory_path() / ("mneedle_margin_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.toml") << R"([tissue]
+size = ["10 mm", "10 mm", "5 mm"]
+[[tissue.layers]]
+name = "gel"
+material = { model = "linear", E = "1 Pa", nu = 0.49 }
+[tissue.fracture]
+toughness = "0.019 N/mm"
+critical_pressure = "0.663 MPa"
+[[needles]]
+name = "n"
+geometry = { plugin = "cylinder", diameter = "230 um", length = "2.5 mm" }
+material = "silicon"
+[insertion]
+depth = "50 um"
+speed = "1 mm/s"
+)";
+  std::ofstream(dir / "designs.toml") << "[[designs]]\nname = \"cone\"\nplugin = \"cone\"\n";
+  const std::string args = "screen '" + (dir / "designs.toml").string() + "' --scene '" +
+                           (dir / "scene.toml").string() + "' --model analytic";
+  const auto json = run_mneedle(args + " --json");
+  ASSERT_LE(json.exit_code, 1) << json.err;  // a design that fails its target still has a row
+  const double margin = nlohmann::json::parse(json.out)["designs"][0]["margin"].get<double>();
+  ASSERT_GT(margin, 1e9);
+  char expected[32];
+  std::snprintf(expected, sizeof expected, " %.4g ", margin);
+  const auto table = run_mneedle(args);
+  EXPECT_NE(table.out.find(expected), std::string::npos) << expected << "\n" << table.out;
+  fs::remove_all(dir);
+}
+
 TEST(StrengthCommand, CylinderPluginBucklesAtEulersLoadOverTheWholeLength) {
   // Silicon cylinder 230 µm × 1 mm, flat tip (load from the tip), fixed-free: π²EI/(2L)².
   const auto run = run_mneedle(
