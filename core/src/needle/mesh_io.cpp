@@ -225,12 +225,12 @@ TriangleMesh load_mesh(const std::filesystem::path& file, double metres_per_unit
   const std::string extension = lowercase(file.extension().string());
   precheck_file(file, extension);
   Assimp::Importer importer;
-  // DropNormals: STL gives every triangle its own normal, which would stop the vertex join.
   // ValidateDataStructure runs before the other steps and refuses a face that indexes past the
-  // vertex list (a PLY with a bad index otherwise crashes assimp's own post-processing).
+  // vertex list (a PLY with a bad index otherwise crashes assimp's own post-processing). No
+  // JoinIdenticalVertices: it joins within an absolute 1e-5 file units (10 um in a file in
+  // metres), which fuses a fine tip; collect_triangles welds identical positions exactly.
   const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate |
-                         aiProcess_DropNormals | aiProcess_JoinIdenticalVertices |
-                         aiProcess_PreTransformVertices;
+                         aiProcess_DropNormals | aiProcess_PreTransformVertices;
   const aiScene* scene = importer.ReadFile(file.string(), flags);
   if (scene == nullptr) {
     const std::string reason = importer.GetErrorString();

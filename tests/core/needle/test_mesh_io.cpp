@@ -11,6 +11,7 @@
 
 #include "mneedle/base/error.h"
 #include "mneedle/needle/mesh.h"
+#include "needle_shapes.h"
 
 namespace {
 
@@ -209,6 +210,28 @@ TEST(MeshIo, WriteThenReadRoundTripsTheMesh) {
     }
   }
   EXPECT_NEAR(mneedle::signed_volume(read_back), kPyramidVolume, 1e-6 * kPyramidVolume);
+}
+
+TEST(MeshIo, VerticesMicrometresApartStayApartInAFileInMetres) {
+  // A 2 um-radius, 64-sided cylinder (vertices 0.2 um apart) written in metres: assimp's own
+  // vertex join used an absolute 1e-5 file units, 10 um here, and fused the ring into a
+  // non-manifold knot. The weld must be exact, whatever the file's unit.
+  mneedle::test::ShapeOptions o;
+  o.radius = 2e-6;
+  o.length = 20e-6;
+  const TriangleMesh original = mneedle::test::cylinder(o);
+  for (double unit : {1.0, 1e-3, 1e-6}) {
+    const std::filesystem::path file = temporary_file("tiny_cylinder.stl");
+    mneedle::write_stl_binary(original, file, unit);
+    const TriangleMesh read_back = mneedle::load_mesh(file, unit);
+    std::filesystem::remove(file);
+    EXPECT_EQ(read_back.vertices.size(), original.vertices.size()) << unit;
+    EXPECT_EQ(read_back.triangles.size(), original.triangles.size()) << unit;
+    // float32 coordinates: the volume to 1e-6 relative (a few ulps of 2^-24 per coordinate).
+    EXPECT_NEAR(mneedle::signed_volume(read_back), mneedle::signed_volume(original),
+                1e-6 * mneedle::signed_volume(original))
+        << unit;
+  }
 }
 
 TEST(MeshIo, HeaderStartingWithSolidIsAltered) {
