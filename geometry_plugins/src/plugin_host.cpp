@@ -14,6 +14,7 @@
 #include "mneedle/base/units.h"
 #include "mneedle/needle/mesh_validation.h"
 #include "mneedle/plugin.h"
+#include "plugin_descriptor.h"
 
 #ifndef MNEEDLE_BUILTIN_PLUGIN_DIR
 #error "MNEEDLE_BUILTIN_PLUGIN_DIR must name the build tree's plugin folder"
@@ -90,63 +91,6 @@ std::string join(const std::vector<std::string>& items, std::string_view separat
   return out;
 }
 
-bool valid_shape_name(const char* name) {
-  if (name == nullptr || *name == '\0') return false;
-  return std::all_of(name, name + std::char_traits<char>::length(name), [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
-  });
-}
-
-std::string text_or_empty(const char* text) {
-  return text == nullptr ? std::string{} : text;
-}
-
-PluginParameter read_parameter(const mneedle_parameter& p, const std::string& where) {
-  if (p.name == nullptr || *p.name == '\0') throw InputError(where + ": parameter without a name");
-  const std::string here = where + ": parameter '" + p.name + "'";
-  const std::string unit = text_or_empty(p.unit);
-  if (unit != "m" && unit != "rad" && unit != "1") {
-    throw InputError(here + ": unit '" + unit + "' is not one of m, rad, 1");
-  }
-  if (!std::isfinite(p.min_value) || !std::isfinite(p.max_value) ||
-      !std::isfinite(p.default_value) || p.min_value > p.max_value ||
-      p.default_value < p.min_value || p.default_value > p.max_value) {
-    throw InputError(here + ": default, min and max must be finite with min <= default <= max");
-  }
-  return {p.name, unit, text_or_empty(p.help), p.default_value, p.min_value, p.max_value};
-}
-
-PluginShapeInfo read_shape(const mneedle_shape& s, const mneedle_plugin& plugin,
-                           const fs::path& library) {
-  const std::string file = library.string();
-  if (!valid_shape_name(s.name)) {
-    throw InputError(file + ": shape name '" + text_or_empty(s.name) +
-                     "' is empty or not made of a-z, 0-9 and _");
-  }
-  const std::string where = file + ": shape '" + s.name + "'";
-  if (s.generate == nullptr) throw InputError(where + ": no generate function");
-  if (s.parameter_count > 0 && s.parameters == nullptr) {
-    throw InputError(where + ": parameter_count > 0 but no parameters");
-  }
-  PluginShapeInfo info;
-  info.name = s.name;
-  info.plugin_id = plugin.plugin_id;
-  info.help = text_or_empty(s.help);
-  info.library = library;
-  info.thread_safe = s.thread_safe != 0;
-  info.has_section_area = s.section_area != nullptr;
-  info.has_section_properties = s.section_properties != nullptr;
-  for (std::size_t i = 0; i < s.parameter_count; ++i) {
-    info.parameters.push_back(read_parameter(s.parameters[i], where));
-    for (std::size_t j = 0; j + 1 < info.parameters.size(); ++j) {
-      if (info.parameters[j].name == info.parameters.back().name) {
-        throw InputError(where + ": parameter '" + info.parameters[j].name + "' listed twice");
-      }
-    }
-  }
-  return info;
-}
-
 std::shared_ptr<void> open_library(const fs::path& library) {
   dlerror();
   void* handle = dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
@@ -166,21 +110,7 @@ const mneedle_plugin& plugin_description(void* handle, const fs::path& library) 
                      MNEEDLE_PLUGIN_ENTRY_NAME + ")");
   }
   const auto entry = reinterpret_cast<mneedle_plugin_entry_fn>(symbol);
-  const mneedle_plugin* plugin = entry();
-  if (plugin == nullptr) throw InputError(library.string() + ": plugin entry returned null");
-  if (plugin->abi_major != MNEEDLE_PLUGIN_ABI_MAJOR) {
-    throw InputError(library.string() + ": plugin ABI version " +
-                     std::to_string(plugin->abi_major) + "." + std::to_string(plugin->abi_minor) +
-                     " is incompatible with this mneedle (ABI major " +
-                     std::to_string(MNEEDLE_PLUGIN_ABI_MAJOR) + ")");
-  }
-  if (plugin->plugin_id == nullptr || *plugin->plugin_id == '\0') {
-    throw InputError(library.string() + ": plugin without a plugin_id");
-  }
-  if (plugin->shape_count > 0 && plugin->shapes == nullptr) {
-    throw InputError(library.string() + ": shape_count > 0 but no shapes");
-  }
-  return *plugin;
+  return check_plugin_descriptor(entry(), library);
 }
 
 std::vector<fs::path> plugin_files(const fs::path& dir) {
@@ -315,21 +245,12 @@ void PluginRegistry::load_library(const fs::path& library) {
   std::shared_ptr<void> handle = open_library(library);
   const mneedle_plugin& plugin = plugin_description(handle.get(), library);
   // Check every shape before registering any, so a bad library adds nothing.
-  std::vector<PluginShapeInfo> infos;
-  for (std::size_t i = 0; i < plugin.shape_count; ++i) {
-    infos.push_back(read_shape(plugin.shapes[i], plugin, library));
-    for (std::size_t j = 0; j + 1 < infos.size(); ++j) {
-      if (infos[j].name == infos.back().name) {
-        throw InputError(library.string() + ": shape '" + infos[j].name + "' listed twice");
-      }
-    }
-    for (const auto& known : impl_->infos) {
-      if (known.name == infos.back().name) {
+  std::vector<PluginShapeInfo> infos = read_plugin_shapes(plugin, library);
+  for (const auto& info : infos)
+    for (const auto& known : impl_->infos)
+      if (known.name == info.name)
         throw InputError(library.string() + ": shape '" + known.name + "' is already provided by " +
                          known.library.string());
-      }
-    }
-  }
   for (std::size_t i = 0; i < infos.size(); ++i) {
     const mneedle_shape* shape = &plugin.shapes[i];
     impl_->entries.push_back(
