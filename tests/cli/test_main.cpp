@@ -1,7 +1,14 @@
 // The command line's exit statuses and error lines (docs/cli.md, "Exit status").
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <regex>
 #include <string>
+#include <utility>
 
 #include "run_mneedle.h"
 
@@ -44,6 +51,566 @@ TEST(Help, EveryCommandShowsAnExample) {
     EXPECT_EQ(run.exit_code, 0) << command << ": " << run.err;
     EXPECT_NE(run.out.find("Example"), std::string::npos) << command << " --help:\n" << run.out;
   }
+}
+
+}  // namespace
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Every error path the command line has, one bad input each: a malformed number or unit, an
+// out-of-range value, an unknown name, a missing, empty, truncated or garbage file, a malformed
+// key=value. docs/cli.md promises one line `mneedle: error: ...` and exit 1 (bad input), 2 (bad
+// command line) or 3 (solver) for each; an exception message of the standard library, CLI11,
+// nlohmann::json or toml++ reaching the user, or a NaN in a message, is a bug (exit 4 at best).
+// No case may start a simulation: each fails in its checks, well under a second.
+struct Case {
+  const char* name;
+  std::string args;  // {D}: the test's scratch folder, {R}: the repository root
+  int exit_code;
+};
+
+// Text of the libraries' own exceptions (std::stoi, map::at, nlohmann::json, toml++, asserts).
+constexpr const char* kInternalMarkers[] = {
+    // the standard library: containers, number conversions, optional/variant/function, new
+    "map::at", "vector::", "basic_string", "_M_", "stoi", "stod", "stoul", "stoll", "bad_alloc",
+    "bad_optional", "bad_variant", "bad_function", "std::",
+    // nlohmann::json and toml++
+    "json.exception", "[json", "toml::",
+    // main()'s catch-all, std::terminate and assert()
+    "internal error", "what():", "terminate called", "Assertion"};
+
+// The message without its quoted spans: an error may echo what the user typed ("nan", 'inf'),
+// which is no NaN of mneedle's own. A quote opens only after a non-letter, so "shape's" does not.
+std::string unquoted(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if ((c == '\'' || c == '"') &&
+        (i == 0 || !std::isalnum(static_cast<unsigned char>(text[i - 1])))) {
+      const std::size_t close = text.find(c, i + 1);
+      if (close != std::string::npos) {
+        i = close;
+        continue;
+      }
+    }
+    out += c;
+  }
+  return out;
+}
+
+std::string replace_all(std::string text, const std::string& from, const std::string& to) {
+  for (std::size_t at = text.find(from); at != std::string::npos;
+       at = text.find(from, at + to.size()))
+    text.replace(at, from.size(), to);
+  return text;
+}
+
+void write_file(const fs::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+// A valid scene, cut and changed below into each bad one.
+const std::string kTissue = R"toml([tissue]
+size = ["2 mm", "2 mm", "1 mm"]
+
+[[tissue.layers]]
+name = "gel"
+material = { model = "linear", E = "7 kPa", nu = 0.45 }
+)toml";
+const std::string kNeedle = R"toml(
+[[needles]]
+geometry = { plugin = "cone", diameter = "200 um", length = "1 mm" }
+)toml";
+const std::string kInsertion = "\n[insertion]\ndepth = \"0.5 mm\"\n";
+
+std::string scene_with_depth(const std::string& depth) {
+  return kTissue + kNeedle + "\n[insertion]\ndepth = " + depth + "\n";
+}
+
+// The bad (and a few good) input files, written fresh in `dir` for every run.
+void write_inputs(const fs::path& dir) {
+  const std::string curves = kRoot + "/tests/assets/curves/";
+  fs::create_directories(dir / "folder");
+  fs::copy_file(curves + "loading_hold_retraction.csv", dir / "curve.csv");
+  fs::copy_file(curves + "toughness_first.csv", dir / "first.csv");
+  fs::copy_file(curves + "toughness_second.csv", dir / "second.csv");
+  const std::pair<const char*, std::string> files[] = {
+      // scenes
+      {"good.toml", kTissue + kNeedle + kInsertion},
+      {"empty.toml", ""},
+      {"truncated.toml", "[tissue]\nsize = [\"2 mm\", \"2 mm\"\n"},
+      {"binary.toml", std::string("\0\1\2garbage\xff\xfe", 12)},
+      {"depth_text.toml", scene_with_depth("\"abc\"")},
+      {"depth_kg.toml", scene_with_depth("\"5 kg\"")},
+      {"depth_nan.toml", scene_with_depth("\"nan mm\"")},
+      {"depth_huge.toml", scene_with_depth("\"1e400 m\"")},
+      {"depth_array.toml", scene_with_depth("[\"0.5 mm\"]")},
+      {"no_insertion.toml", kTissue + kNeedle},
+      {"unknown_key.toml", kTissue + kNeedle + kInsertion + "colour = \"red\"\n"},
+      {"negative_thickness.toml",
+       replace_all(kTissue, "name = \"gel\"\n", "name = \"gel\"\nthickness = \"-0.1 mm\"\n") +
+           "\n[[tissue.layers]]\nname = \"base\"\n"
+           "material = { model = \"linear\", E = \"7 kPa\", nu = 0.45 }\n" +
+           kNeedle + kInsertion},
+      {"layers_string.toml", "[tissue]\nsize = [\"2 mm\", \"2 mm\", \"1 mm\"]\nlayers = \"gel\"\n" +
+                                 kNeedle + kInsertion},
+      {"unknown_model.toml",
+       replace_all(kTissue, "\"linear\"", "\"rubber\"") + kNeedle + kInsertion},
+      {"unknown_fidelity.toml",
+       kTissue + kNeedle + kInsertion + "\n[model]\nfidelity = \"ultra\"\n"},
+      {"missing_stl.toml",
+       kTissue + "\n[[needles]]\ngeometry = { stl = \"missing.stl\" }\n" + kInsertion},
+      {"unknown_plugin.toml",
+       kTissue + "\n[[needles]]\ngeometry = { plugin = \"no_such_shape\" }\n" + kInsertion},
+      {"two_needles.toml", kTissue + kNeedle + kNeedle + kInsertion},
+      {"no_friction.toml", kTissue + kNeedle + "\n[loads]\nfriction = \"none\"\n" + kInsertion},
+      // meshes
+      {"empty.stl", ""},
+      {"text.stl", "hello, this is not a mesh\n"},
+      {"bad_face.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"},
+      {"no_faces.obj", "v 0 0 0\n"},
+      {"header_only.ply",
+       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+       "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"},
+      {"mesh.xyz", "0 0 0\n"},
+      // force-depth curves
+      {"empty.csv", ""},
+      {"header_only.csv", "time_s,travel_mm,fz_N\n"},
+      {"text_cell.csv", "time_s,travel_mm,fz_N\n0,0,0\n0.1,0.1,abc\n0.2,0.2,0.1\n"},
+      {"one_row.csv", "time_s,travel_mm,fz_N\n0,0,0\n"},
+      {"ragged.csv", "time_s,travel_mm,fz_N\n0,0,0\n0.1,0.1\n0.2,0.2,0.1,7\n"},
+      {"nan_cells.csv", "time_s,travel_mm,fz_N\n0,0,nan\n0.1,0.1,inf\n0.2,0.2,0.1\n"},
+      {"unclosed.csv", "time_s,\"travel_mm\n0,0\n"},
+      // grouped values for stats
+      {"groups.csv", "group,value\na,1\na,2\na,3\nb,4\nb,5\nb,7\n"},
+      {"groups_header_only.csv", "group,value\n"},
+      {"groups_one_row.csv", "group,value\na,1\n"},
+      {"groups_text.csv", "group,value\na,x\nb,2\n"},
+      {"groups_one_group.csv", "group,value\na,1\na,2\na,3\n"},
+      {"groups_ragged.csv", "group,value\na,1\nb\n"},
+      {"groups_no_variance.csv", "group,value\na,1\na,1\nb,2\nb,2\n"},
+      {"groups_nan.csv", "group,value\na,nan\na,1\nb,2\nb,3\n"},
+      // tri-force parameters for predict
+      {"params.json", R"({"params": {}})"},
+      {"no_params.json", R"({"model": "triforce"})"},
+      {"params_array.json", R"({"params": [1, 2]})"},
+      {"params_text.json", R"({"params": {"mu": "x"}})"},
+      {"params_unknown.json", R"({"params": {"no_such_param": 1}})"},
+      {"params_negative.json", R"({"params": {"mu": -5}})"},
+  };
+  for (const auto& [name, text] : files) write_file(dir / name, text);
+}
+
+TEST(ErrorPaths, EveryBadInputGivesOneClearLineAndNoInternalText) {
+  const fs::path dir = fs::temp_directory_path() / ("mneedle_errors_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  write_inputs(dir);
+  const Case cases[] = {
+      {"scene check: missing file", "scene check {D}/missing.toml", 1},
+      {"scene check: a directory", "scene check {D}/folder", 1},
+      {"scene check: empty file", "scene check {D}/empty.toml", 1},
+      {"scene check: truncated TOML", "scene check {D}/truncated.toml", 1},
+      {"scene check: binary garbage", "scene check {D}/binary.toml", 1},
+      {"scene check: depth is text", "scene check {D}/depth_text.toml", 1},
+      {"scene check: depth in kg", "scene check {D}/depth_kg.toml", 1},
+      {"scene check: depth NaN", "scene check {D}/depth_nan.toml", 1},
+      {"scene check: depth 1e400 m", "scene check {D}/depth_huge.toml", 1},
+      {"scene check: depth is an array", "scene check {D}/depth_array.toml", 1},
+      {"scene check: no [insertion] table", "scene check {D}/no_insertion.toml", 1},
+      {"scene check: unknown key", "scene check {D}/unknown_key.toml", 1},
+      {"scene check: negative thickness", "scene check {D}/negative_thickness.toml", 1},
+      {"scene check: layers is a string", "scene check {D}/layers_string.toml", 1},
+      {"scene check: unknown material model", "scene check {D}/unknown_model.toml", 1},
+      {"scene check: unknown fidelity", "scene check {D}/unknown_fidelity.toml", 1},
+      {"scene check: missing STL", "scene check {D}/missing_stl.toml", 1},
+      {"scene check: no FILE", "scene check", 2},
+      {"plugins: describe unknown shape", "plugins describe no_such_shape", 1},
+      {"plugins: describe empty name", "plugins describe ''", 1},
+      {"plugins: list missing plugin dir", "plugins list --plugin-dir {D}/missing_dir", 1},
+      {"plugins: describe file as plugin dir", "plugins describe cone --plugin-dir {D}/good.toml",
+       1},
+      {"generate: unknown shape", "generate no_such_shape -o {D}/out.stl", 1},
+      {"generate: --set without =", "generate cone --set x -o {D}/out.stl", 1},
+      {"generate: --set =1", "generate cone --set =1 -o {D}/out.stl", 1},
+      {"generate: --set empty value", "generate sharp_bevel --set bevel_angle= -o {D}/out.stl", 1},
+      {"generate: --set text value", "generate sharp_bevel --set bevel_angle=abc -o {D}/out.stl",
+       1},
+      {"generate: --set angle without unit",
+       "generate sharp_bevel --set bevel_angle=30 -o {D}/out.stl", 1},
+      {"generate: --set length in kg", "generate cone --set diameter=5kg -o {D}/out.stl", 1},
+      {"generate: --set 1e400m", "generate cone --set diameter=1e400m -o {D}/out.stl", 1},
+      {"generate: --set nan", "generate cone --set diameter=nan -o {D}/out.stl", 1},
+      {"generate: --set -inf", "generate cone --set diameter=-inf -o {D}/out.stl", 1},
+      {"generate: --set above maximum", "generate cone --set diameter=20mm -o {D}/out.stl", 1},
+      {"generate: --set negative", "generate cone --set diameter=-1mm -o {D}/out.stl", 1},
+      {"generate: --set unknown parameter", "generate cone --set colour=1 -o {D}/out.stl", 1},
+      {"generate: --set given twice",
+       "generate cone --set diameter=200um --set diameter=300um -o {D}/out.stl", 1},
+      {"generate: --set count with unit", "generate cone --set resolution=3mm -o {D}/out.stl", 1},
+      {"generate: --unit unknown", "generate cone --unit furlong -o {D}/out.stl", 1},
+      {"generate: --plugin-dir missing",
+       "generate cone --plugin-dir {D}/missing_dir -o {D}/out.stl", 1},
+      {"generate: -o is a directory", "generate cone -o {D}/folder", 1},
+      {"generate: -o in a missing folder", "generate cone -o {D}/missing_dir/out.stl", 1},
+      {"generate: no -o", "generate cone", 2},
+      {"inspect: missing file", "inspect {D}/missing.stl", 1},
+      {"inspect: a directory", "inspect {D}/folder", 1},
+      {"inspect: empty STL", "inspect {D}/empty.stl", 1},
+      {"inspect: text that is not STL", "inspect {D}/text.stl", 1},
+      {"inspect: OBJ face index out of range", "inspect {D}/bad_face.obj", 1},
+      {"inspect: OBJ without faces", "inspect {D}/no_faces.obj", 1},
+      {"inspect: PLY header only", "inspect {D}/header_only.ply", 1},
+      {"inspect: unknown extension", "inspect {D}/mesh.xyz", 1},
+      {"inspect: --unit unknown", "inspect {D}/empty.stl --unit parsec", 1},
+      {"inspect: --axis unknown name", "inspect {R}/designs/cone.stl --axis w", 1},
+      {"inspect: --axis zero vector", "inspect {R}/designs/cone.stl --axis 0,0,0", 1},
+      {"inspect: --axis with nan", "inspect {R}/designs/cone.stl --axis nan,0,1", 1},
+      {"inspect: --axis two numbers", "inspect {R}/designs/cone.stl --axis 1,2", 1},
+      {"inspect: --axis 1e400", "inspect {R}/designs/cone.stl --axis 1e400,0,0", 1},
+      {"inspect: -o is a directory", "inspect {R}/designs/cone.stl -o {D}/folder", 1},
+      {"inspect: --json, missing file", "inspect {D}/missing.stl --json", 1},
+      {"force: missing scene", "force {D}/missing.toml", 1},
+      {"force: empty scene", "force {D}/empty.toml", 1},
+      {"force: --step text", "force {D}/good.toml --step abc", 1},
+      {"force: --step empty", "force {D}/good.toml --step ''", 1},
+      {"force: --step 1e400m", "force {D}/good.toml --step 1e400m", 1},
+      {"force: --step nan", "force {D}/good.toml --step nan", 1},
+      {"force: --step -inf", "force {D}/good.toml --step=-inf", 1},
+      {"force: --step in kg", "force {D}/good.toml --step 5kg", 1},
+      {"force: --step without unit", "force {D}/good.toml --step 10", 1},
+      {"force: --step zero", "force {D}/good.toml --step 0um", 1},
+      {"force: --step too fine", "force {D}/good.toml --step 1e-15m", 1},
+      {"force: --max-points text", "force {D}/good.toml --max-points abc", 2},
+      {"force: --max-points zero", "force {D}/good.toml --max-points 0", 1},
+      {"force: unknown plugin in scene", "force {D}/unknown_plugin.toml", 1},
+      {"force: --plugin-dir missing", "force {D}/good.toml --plugin-dir {D}/missing_dir", 1},
+      {"strength: no --material", "strength --plugin cone", 2},
+      {"strength: neither file nor plugin", "strength --material pla", 1},
+      {"strength: file and plugin", "strength {R}/designs/cone.stl --plugin cone --material pla",
+       1},
+      {"strength: unknown --material", "strength --plugin cone --material unobtainium", 1},
+      {"strength: unknown --plugin", "strength --plugin nope --material pla", 1},
+      {"strength: --set text value", "strength --plugin cone --set diameter=abc --material pla", 1},
+      {"strength: unknown --end", "strength --plugin cone --material pla --end clamped", 1},
+      {"strength: --depth text", "strength --plugin cone --material pla --depth abc", 1},
+      {"strength: --depth without unit", "strength --plugin cone --material pla --depth 5", 1},
+      {"strength: --depth negative", "strength --plugin cone --material pla --depth=-1mm", 1},
+      {"strength: --lateral-ratio text",
+       "strength --plugin cone --material pla --lateral-ratio abc", 2},
+      {"strength: --lateral-ratio nan", "strength --plugin cone --material pla --lateral-ratio nan",
+       1},
+      {"strength: --lateral-ratio negative",
+       "strength --plugin cone --material pla --lateral-ratio=-1", 1},
+      {"strength: empty mesh file", "strength {D}/empty.stl --material pla", 1},
+      {"strength: --unit unknown", "strength {R}/designs/cone.stl --unit ly --material pla", 1},
+      {"strength: --axis unknown", "strength {R}/designs/cone.stl --axis q --material pla", 1},
+      {"strength: --plugin-dir missing",
+       "strength --plugin cone --material pla --plugin-dir {D}/missing_dir", 1},
+      {"screen: missing scene", "screen {R}/designs/cone.stl --scene {D}/missing.toml", 1},
+      {"screen: invalid scene", "screen {R}/designs/cone.stl --scene {D}/depth_text.toml", 1},
+      {"screen: empty folder", "screen {D}/folder --scene {D}/good.toml", 1},
+      {"screen: missing design", "screen {D}/missing.stl --scene {D}/good.toml", 1},
+      {"screen: garbage design list", "screen {D}/depth_text.toml --scene {D}/good.toml", 1},
+      {"screen: empty design list", "screen {D}/empty.toml --scene {D}/good.toml", 1},
+      {"screen: empty STL design", "screen {D}/empty.stl --scene {D}/good.toml --json", 1},
+      {"screen: unknown --material",
+       "screen {D}/empty.stl --scene {D}/good.toml --material unobtainium --json", 1},
+      {"screen: --unit unknown", "screen {R}/designs/cone.stl --scene {D}/good.toml --unit furlong",
+       1},
+      {"screen: --axis unknown", "screen {R}/designs/cone.stl --scene {D}/good.toml --axis w", 1},
+      {"screen: --resume without --out",
+       "screen {R}/designs/cone.stl --scene {D}/good.toml --resume", 1},
+      {"screen: --jobs zero", "screen {R}/designs/cone.stl --scene {D}/good.toml --jobs 0", 2},
+      {"screen: --fidelity unknown",
+       "screen {R}/designs/cone.stl --scene {D}/good.toml --fidelity ultra", 2},
+      {"screen: --model unknown", "screen {R}/designs/cone.stl --scene {D}/good.toml --model fem",
+       2},
+      {"screen: --plugin-dir missing",
+       "screen {R}/designs/cone.stl --scene {D}/good.toml --plugin-dir {D}/missing_dir", 1},
+      {"optimize: unknown --plugin", "optimize --plugin nope --scene {D}/good.toml --vary diameter",
+       1},
+      {"optimize: invalid scene",
+       "optimize --plugin cone --scene {D}/negative_thickness.toml --vary diameter", 1},
+      {"optimize: --vary unknown", "optimize --plugin cone --scene {D}/good.toml --vary colour", 1},
+      {"optimize: --vary only a comma", "optimize --plugin cone --scene {D}/good.toml --vary ,", 1},
+      {"optimize: --set without =",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --set x", 1},
+      {"optimize: --bound without =",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --bound diameter", 1},
+      {"optimize: --bound without :",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --bound diameter=1mm", 1},
+      {"optimize: --bound text",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --bound diameter=abc:1mm", 1},
+      {"optimize: --bound empty high",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --bound diameter=100um:", 1},
+      {"optimize: --bound without unit",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --bound diameter=1:2", 1},
+      {"optimize: --bound reversed",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --bound diameter=300um:100um",
+       1},
+      {"optimize: --min-feature text",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --min-feature abc", 1},
+      {"optimize: --min-feature zero",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --min-feature 0um", 1},
+      {"optimize: unknown --material",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --material unobtainium", 1},
+      {"optimize: --objective unknown",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --objective speed", 2},
+      {"optimize: --fidelity unknown",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --fidelity ultra", 2},
+      {"optimize: --model unknown",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --model fem", 2},
+      {"optimize: --algorithm unknown",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --algorithm newton", 2},
+      {"optimize: --local unknown",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --local lbfgs", 2},
+      {"optimize: --starts zero",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --starts 0", 2},
+      {"optimize: --max-evals text",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --max-evals abc", 2},
+      {"optimize: --max-evals zero",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --max-evals 0", 1},
+      {"optimize: --seed negative",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --seed=-1", 2},
+      {"optimize: --max-time text",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --max-time abc", 1},
+      {"optimize: --max-time a length",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --max-time 5mm", 1},
+      {"optimize: --plugin-dir missing",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --plugin-dir {D}/missing_dir",
+       1},
+      {"fit: missing file", "fit {D}/missing.csv", 2},
+      {"fit: empty CSV", "fit {D}/empty.csv", 1},
+      {"fit: header only", "fit {D}/header_only.csv", 1},
+      {"fit: text cell", "fit {D}/text_cell.csv", 1},
+      {"fit: one row", "fit {D}/one_row.csv", 1},
+      {"fit: ragged rows", "fit {D}/ragged.csv", 1},
+      {"fit: nan and inf cells", "fit {D}/nan_cells.csv", 1},
+      {"fit: unclosed quote", "fit {D}/unclosed.csv", 1},
+      {"fit: unknown --model", "fit {D}/curve.csv --model linear", 1},
+      {"fit: --speed text", "fit {D}/curve.csv --speed abc", 1},
+      {"fit: --speed a length", "fit {D}/curve.csv --speed 5mm", 1},
+      {"fit: --speed zero", "fit {D}/curve.csv --speed 0mm/s", 1},
+      {"fit: --angle without unit", "fit {D}/curve.csv --angle 90", 1},
+      {"fit: --depth-col missing", "fit {D}/curve.csv --depth-col nope", 1},
+      {"fit: --force-col missing", "fit {D}/curve.csv --force-col nope", 1},
+      {"fit: --depth-unit unknown", "fit {D}/curve.csv --depth-unit furlong", 1},
+      {"fit: --force-unit unknown", "fit {D}/curve.csv --force-unit kg", 1},
+      {"fit: --fix without =", "fit {D}/curve.csv --fix beta", 1},
+      {"fit: --fix text value", "fit {D}/curve.csv --fix beta=abc", 1},
+      {"fit: --fix unknown", "fit {D}/curve.csv --fix nope=1", 1},
+      {"fit: --fix force without unit", "fit {D}/curve.csv --fix K0_N=1", 1},
+      {"fit: --free unknown", "fit {D}/curve.csv --free nope", 1},
+      {"fit: --layer-start text", "fit {D}/curve.csv --layer-start abc", 1},
+      {"fit: --layer-start negative", "fit {D}/curve.csv --layer-start=-5mm", 1},
+      {"fit: --detect-layers text", "fit {D}/curve.csv --detect-layers abc", 2},
+      {"fit: --starts text", "fit {D}/curve.csv --starts abc", 2},
+      {"predict: no --params", "predict --depth 1mm", 2},
+      {"predict: missing --params", "predict --params {D}/missing.json --depth 1mm", 1},
+      {"predict: no params object", "predict --params {D}/no_params.json --depth 1mm", 1},
+      {"predict: params is an array", "predict --params {D}/params_array.json --depth 1mm", 1},
+      {"predict: params value text", "predict --params {D}/params_text.json --depth 1mm", 1},
+      {"predict: params unknown name", "predict --params {D}/params_unknown.json --depth 1mm", 1},
+      {"predict: params negative", "predict --params {D}/params_negative.json --depth 1mm", 1},
+      {"predict: unknown --model", "predict --model linear --params {D}/params.json --depth 1mm",
+       1},
+      {"predict: no --depth", "predict --params {D}/params.json", 1},
+      {"predict: --depth text", "predict --params {D}/params.json --depth abc", 1},
+      {"predict: --depth nan", "predict --params {D}/params.json --depth nanmm", 1},
+      {"predict: --depth negative", "predict --params {D}/params.json --depth=-1mm", 1},
+      {"predict: --depth 1e300 m", "predict --params {D}/params.json --depth 1e300m", 1},
+      {"predict: --speed zero", "predict --params {D}/params.json --depth 1mm --speed 0mm/s", 1},
+      {"predict: --speed a length", "predict --params {D}/params.json --depth 1mm --speed 1mm", 1},
+      {"predict: --angle text", "predict --params {D}/params.json --depth 1mm --angle abc", 1},
+      {"predict: --hold negative", "predict --params {D}/params.json --depth 1mm --hold=-1s", 1},
+      {"predict: --retract-speed text",
+       "predict --params {D}/params.json --depth 1mm --retract-speed abc", 1},
+      {"predict: --step zero", "predict --params {D}/params.json --depth 1mm --step 0s", 1},
+      {"predict: --step tiny", "predict --params {D}/params.json --depth 1mm --step 1e-12s", 1},
+      {"predict: --perturb-amplitude text",
+       "predict --params {D}/params.json --depth 1mm --perturb-amplitude abc", 1},
+      {"predict: --perturb-frequency text",
+       "predict --params {D}/params.json --depth 1mm --perturb-frequency abc", 2},
+      {"predict: --perturb-frequency zero",
+       "predict --params {D}/params.json --depth 1mm --perturb-frequency 0", 1},
+      {"predict: --perturb-frequency nan",
+       "predict --params {D}/params.json --depth 1mm --perturb-frequency nan", 1},
+      {"predict: --max-samples text",
+       "predict --params {D}/params.json --depth 1mm --max-samples abc", 2},
+      {"predict: --max-samples zero",
+       "predict --params {D}/params.json --depth 1mm --max-samples 0", 1},
+      {"predict: --compare missing", "predict --params {D}/params.json --compare {D}/missing.csv",
+       2},
+      {"predict: --compare empty", "predict --params {D}/params.json --compare {D}/empty.csv", 1},
+      {"predict: --compare text cell",
+       "predict --params {D}/params.json --compare {D}/text_cell.csv", 1},
+      {"predict: --compare, --depth-col missing",
+       "predict --params {D}/params.json --compare {D}/curve.csv --depth-col nope", 1},
+      {"predict: --compare, --force-col missing",
+       "predict --params {D}/params.json --compare {D}/curve.csv --force-col nope", 1},
+      {"stats: missing file", "stats {D}/missing.csv", 2},
+      {"stats: a directory", "stats {D}/folder", 2},
+      {"stats: empty CSV", "stats {D}/empty.csv", 1},
+      {"stats: header only", "stats {D}/groups_header_only.csv", 1},
+      {"stats: one row", "stats {D}/groups_one_row.csv", 1},
+      {"stats: text cell", "stats {D}/groups_text.csv", 1},
+      {"stats: one group", "stats {D}/groups_one_group.csv", 1},
+      {"stats: ragged rows", "stats {D}/groups_ragged.csv", 1},
+      {"stats: no variance", "stats {D}/groups_no_variance.csv", 1},
+      {"stats: nan cell", "stats {D}/groups_nan.csv", 1},
+      {"stats: --value missing", "stats {D}/groups.csv --value nope", 1},
+      {"stats: --group missing", "stats {D}/groups.csv --group nope", 1},
+      {"stats: --alpha text", "stats {D}/groups.csv --alpha abc", 2},
+      {"stats: --alpha zero", "stats {D}/groups.csv --alpha 0", 1},
+      {"stats: --alpha two", "stats {D}/groups.csv --alpha 2", 1},
+      {"stats: --alpha nan", "stats {D}/groups.csv --alpha nan", 1},
+      {"simulate: missing scene", "simulate {D}/missing.toml", 1},
+      {"simulate: empty scene", "simulate {D}/empty.toml", 1},
+      {"simulate: truncated scene", "simulate {D}/truncated.toml", 1},
+      {"simulate: --fidelity unknown", "simulate {D}/good.toml --fidelity ultra", 2},
+      {"simulate: --contact unknown", "simulate {D}/good.toml --contact glue", 2},
+      {"simulate: --criterion unknown", "simulate {D}/good.toml --criterion luck", 2},
+      {"simulate: --model unknown", "simulate {D}/good.toml --model fem", 2},
+      {"simulate: --axis unknown", "simulate {D}/good.toml --axis w", 1},
+      {"simulate: --max-needles text", "simulate {D}/good.toml --max-needles abc", 2},
+      {"simulate: unknown plugin in scene", "simulate {D}/unknown_plugin.toml", 1},
+      {"simulate: missing STL in scene", "simulate {D}/missing_stl.toml", 1},
+      {"simulate: --plugin-dir missing", "simulate {D}/good.toml --plugin-dir {D}/missing_dir", 1},
+      {"toughness: missing first", "toughness {D}/missing.csv {D}/second.csv --area 1mm^2", 1},
+      {"toughness: empty first", "toughness {D}/empty.csv {D}/second.csv --area 1mm^2", 1},
+      {"toughness: header only", "toughness {D}/header_only.csv {D}/second.csv --area 1mm^2", 1},
+      {"toughness: text cell", "toughness {D}/text_cell.csv {D}/second.csv --area 1mm^2", 1},
+      {"toughness: one row", "toughness {D}/one_row.csv {D}/second.csv --area 1mm^2", 1},
+      {"toughness: ragged rows", "toughness {D}/ragged.csv {D}/second.csv --area 1mm^2", 1},
+      {"toughness: empty second", "toughness {D}/first.csv {D}/empty.csv --area 1mm^2", 1},
+      {"toughness: no second pass", "toughness {D}/first.csv --area 1mm^2", 1},
+      {"toughness: unknown --second-from",
+       "toughness {D}/first.csv --second-from middle --area 1mm^2", 1},
+      {"toughness: --second-from tail without a drop",
+       "toughness {D}/second.csv --second-from tail --area 1mm^2", 1},
+      {"toughness: no crack area", "toughness {D}/first.csv {D}/second.csv", 1},
+      {"toughness: --area and --plugin",
+       "toughness {D}/first.csv {D}/second.csv --area 1mm^2 --plugin cone", 1},
+      {"toughness: --area text", "toughness {D}/first.csv {D}/second.csv --area abc", 1},
+      {"toughness: --area a length", "toughness {D}/first.csv {D}/second.csv --area 5mm", 1},
+      {"toughness: --area zero", "toughness {D}/first.csv {D}/second.csv --area 0mm^2", 1},
+      {"toughness: --area inf", "toughness {D}/first.csv {D}/second.csv --area inf", 1},
+      {"toughness: --area 1e-400", "toughness {D}/first.csv {D}/second.csv --area 1e-400", 1},
+      {"toughness: unknown --align",
+       "toughness {D}/first.csv {D}/second.csv --area 1mm^2 --align sideways", 1},
+      {"toughness: --max-depth text",
+       "toughness {D}/first.csv {D}/second.csv --area 1mm^2 --max-depth abc", 1},
+      {"toughness: --max-depth without unit",
+       "toughness {D}/first.csv {D}/second.csv --area 1mm^2 --max-depth 2", 1},
+      {"toughness: --needle missing",
+       "toughness {D}/first.csv {D}/second.csv --needle {D}/missing.stl", 1},
+      {"toughness: --needle text", "toughness {D}/first.csv {D}/second.csv --needle {D}/text.stl",
+       1},
+      {"toughness: --unit unknown",
+       "toughness {D}/first.csv {D}/second.csv --needle {R}/designs/cone.stl --unit ft", 1},
+      {"toughness: unknown --plugin", "toughness {D}/first.csv {D}/second.csv --plugin nope", 1},
+      {"toughness: --set text value",
+       "toughness {D}/first.csv {D}/second.csv --plugin cone --set diameter=abc", 1},
+      {"toughness: --set unknown",
+       "toughness {D}/first.csv {D}/second.csv --plugin cone --set colour=1", 1},
+      {"toughness: --plugin-dir missing",
+       "toughness {D}/first.csv {D}/second.csv --plugin cone --plugin-dir {D}/missing_dir", 1},
+      {"toughness: --depth-col missing",
+       "toughness {D}/first.csv {D}/second.csv --area 1mm^2 --depth-col nope", 1},
+      {"toughness: --force-col missing",
+       "toughness {D}/first.csv {D}/second.csv --area 1mm^2 --force-col nope", 1},
+      {"toughness: --depth-unit a mass",
+       "toughness {D}/first.csv {D}/second.csv --area 1mm^2 --depth-unit kg", 1},
+      {"toughness: --force-unit a length",
+       "toughness {D}/first.csv {D}/second.csv --area 1mm^2 --force-unit mm", 1},
+      {"toughness: --integrand is a directory",
+       "toughness {D}/first.csv {D}/second.csv --area 1mm^2 --integrand {D}/folder", 1},
+      {"calibrate: missing scene", "calibrate {D}/missing.toml --curve {D}/curve.csv --fit scale",
+       1},
+      {"calibrate: invalid scene", "calibrate {D}/depth_kg.toml --curve {D}/curve.csv --fit scale",
+       1},
+      {"calibrate: two needles", "calibrate {D}/two_needles.toml --curve {D}/curve.csv --fit scale",
+       1},
+      {"calibrate: no --curve", "calibrate {D}/good.toml --fit scale", 2},
+      {"calibrate: unknown --fit", "calibrate {D}/good.toml --curve {D}/curve.csv --fit stiffness",
+       1},
+      {"calibrate: empty --fit", "calibrate {D}/good.toml --curve {D}/curve.csv --fit ''", 1},
+      {"calibrate: --fit repeated",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale,scale --puncture-at 3mm", 1},
+      {"calibrate: --fit both criteria",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit critical_pressure,toughness", 1},
+      {"calibrate: friction without Coulomb",
+       "calibrate {D}/no_friction.toml --curve {D}/curve.csv --fit friction_coefficient "
+       "--puncture-at 3mm",
+       1},
+      {"calibrate: --curve missing", "calibrate {D}/good.toml --curve {D}/missing.csv --fit scale",
+       1},
+      {"calibrate: --curve empty", "calibrate {D}/good.toml --curve {D}/empty.csv --fit scale", 1},
+      {"calibrate: --curve header only",
+       "calibrate {D}/good.toml --curve {D}/header_only.csv --fit scale", 1},
+      {"calibrate: --curve text cell",
+       "calibrate {D}/good.toml --curve {D}/text_cell.csv --fit scale", 1},
+      {"calibrate: --curve ragged", "calibrate {D}/good.toml --curve {D}/ragged.csv --fit scale",
+       1},
+      {"calibrate: --curve one row",
+       "calibrate {D}/good.toml --curve {D}/one_row.csv --fit scale --puncture-at detect", 1},
+      {"calibrate: --contact-at text",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --contact-at abc", 1},
+      {"calibrate: --contact-at nan",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --contact-at nanmm", 1},
+      {"calibrate: --puncture-at in kg",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --puncture-at 5kg", 1},
+      {"calibrate: --puncture-at detect, no drop",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --puncture-at detect", 1},
+      {"calibrate: --puncture-at beyond the curve",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --puncture-at 100mm", 1},
+      {"calibrate: --fit-range without :",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --fit-range 5mm", 1},
+      {"calibrate: --fit-range without unit",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --fit-range 1:5", 1},
+      {"calibrate: --fit-range reversed",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --puncture-at 3mm --fit-range "
+       "5mm:1mm",
+       1},
+      {"calibrate: --fidelity unknown",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --fidelity ultra", 2},
+      {"calibrate: --depth-col missing",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --depth-col nope", 1},
+      {"calibrate: --force-col missing",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --force-col nope", 1},
+      {"calibrate: --depth-unit a time",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --depth-unit s", 1},
+      {"calibrate: --force-unit unknown",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --force-unit lbf", 1},
+      {"calibrate: --plugin-dir missing",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --plugin-dir {D}/missing_dir", 1},
+      {"calibrate: --out is a directory",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --puncture-at 3mm --out "
+       "{D}/folder",
+       1},
+      {"calibrate: --plot is a directory",
+       "calibrate {D}/good.toml --curve {D}/curve.csv --fit scale --puncture-at 3mm --plot "
+       "{D}/folder",
+       1},
+  };
+  const std::regex non_finite(R"(\b(nan|inf)\b)", std::regex::icase);
+  for (const Case& c : cases) {
+    const std::string args =
+        replace_all(replace_all(c.args, "{D}", "'" + dir.string() + "'"), "{R}", "'" + kRoot + "'");
+    SCOPED_TRACE(std::string(c.name) + ": mneedle " + args);
+    const auto run = run_mneedle(args);
+    EXPECT_EQ(run.exit_code, c.exit_code) << run.err;
+    // One line: a second one would be a stack of messages or a stray progress or warning line.
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+    EXPECT_TRUE(run.err.ends_with('\n')) << run.err;
+    EXPECT_TRUE(run.err.starts_with("mneedle: error: ")) << run.err;
+    for (const char* marker : kInternalMarkers)
+      EXPECT_EQ(run.err.find(marker), std::string::npos) << marker << " in: " << run.err;
+    EXPECT_FALSE(std::regex_search(unquoted(run.err), non_finite)) << run.err;
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace
