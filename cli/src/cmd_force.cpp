@@ -144,7 +144,8 @@ void add_force_command(CLI::App& app) {
       ->excludes(json);
   cmd->add_option("--step", options->step, "Depth step with a unit (default 10um)");
   cmd->add_option("--max-points", options->max_points,
-                  "Largest number of depths a curve may have (default 1000000)");
+                  "Largest number of depths a curve may have (default 1000000)")
+      ->check(CLI::Range(1L, 1'000'000'000L));
   cmd->add_option("--plugin-dir", options->plugin_dirs, "Extra folder to search for plugins");
   cmd->callback([options] {
     const ForceResult result = compute(*options);

@@ -18,6 +18,7 @@
 #include "commands.h"
 #include "json_output.h"
 #include "mneedle/base/error.h"
+#include "mneedle/base/files.h"
 #include "mneedle/base/units.h"
 #include "mneedle/design_evaluation.h"
 #include "mneedle/design_source.h"
@@ -66,6 +67,19 @@ std::vector<std::string> split(const std::string& text, char sep) {
   return parts;
 }
 
+// One end of a --bound, in the parameter's unit; errors name --bound, not --set.
+double bound_value(const PluginShapeInfo& shape, const std::string& name, const std::string& text,
+                   const char* end) {
+  try {
+    return parse_parameter_settings(shape, {name + "=" + text}).at(name);
+  } catch (const InputError& e) {
+    std::string why = e.what();
+    const std::string prefix = "--set " + name + ": ";
+    if (why.rfind(prefix, 0) == 0) why = why.substr(prefix.size());
+    throw InputError("--bound " + name + " (" + end + "): " + why);
+  }
+}
+
 // The plugin's bounds, narrowed by --bound name=lo:hi (values with units).
 std::vector<DesignVariable> variables(const PluginShapeInfo& shape, const OptimizeArgs& a) {
   std::map<std::string, std::pair<std::string, std::string>> user;
@@ -83,14 +97,16 @@ std::vector<DesignVariable> variables(const PluginShapeInfo& shape, const Optimi
       throw InputError("--vary: shape '" + shape.name + "' has no parameter '" + name + "'");
     DesignVariable v{name, it->min, it->max};
     if (const auto u = user.find(name); u != user.end()) {
-      const auto lo = parse_parameter_settings(shape, {name + "=" + u->second.first}).at(name);
-      const auto hi = parse_parameter_settings(shape, {name + "=" + u->second.second}).at(name);
-      v.lower = std::max(v.lower, lo);
-      v.upper = std::min(v.upper, hi);
+      v.lower = std::max(v.lower, bound_value(shape, name, u->second.first, "low"));
+      v.upper = std::min(v.upper, bound_value(shape, name, u->second.second, "high"));
     }
     out.push_back(v);
   }
   if (out.empty()) throw InputError("--vary: name at least one parameter, e.g. --vary bevel_angle");
+  // A bound on a parameter that is not varied would be silently ignored.
+  for (const auto& [name, range] : user)
+    if (std::none_of(out.begin(), out.end(), [&](const auto& v) { return v.name == name; }))
+      throw InputError("--bound '" + name + "': not one of the --vary parameters (" + a.vary + ")");
   return out;
 }
 
@@ -352,7 +368,7 @@ void run_optimize(const OptimizeArgs& a) {
       a.objective == "peak-force" ? "peak_force_N" : "puncture_depth_m";
   std::unique_ptr<HistoryWriter> history;
   if (!a.out.empty()) {
-    std::filesystem::create_directories(a.out);
+    create_output_folder(a.out, "--out");
     history = std::make_unique<HistoryWriter>(std::filesystem::path(a.out) / "history.csv", vars,
                                               objective_key);
     o.on_evaluation = [&](const EvaluationRecord& e) { history->write(e); };
@@ -476,7 +492,7 @@ void add_optimize_command(CLI::App& app) {
   cmd->add_option("--starts", a->starts,
                   "cobyla/bobyqa: runs from the start point and scattered points, best kept")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 1000));
   cmd->add_option("--max-evals", a->max_evals, "Evaluation budget (distinct designs)")
       ->capture_default_str();
   cmd->add_option("--max-time", a->max_time, "Wall-time budget with a unit, e.g. 300s");

@@ -168,7 +168,7 @@ void add_screen_command(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "analytic", "axisymmetric", "3d"}));
   cmd->add_option("--jobs", args->jobs,
                   "Designs evaluated at once (each with one OpenBLAS thread when > 1)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 1000));
   cmd->add_option("--out", args->out,
                   "Folder for results.csv and results.jsonl, written as designs finish");
   cmd->add_flag("--resume", args->resume, "Skip designs already in --out for the same inputs");

@@ -279,7 +279,8 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--plugin-dir", options->plugin_dirs, "Extra plugin folder (repeatable)");
   cmd->add_option("--max-needles", options->max_needles,
                   "Most needles one finite element model may hold")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
   cmd->add_flag("--no-reductions", options->no_reductions,
                 "solve the whole scene: no half model, layer merge or domain cut (to check them)");
   auto* json = cmd->add_flag("--json", options->json, "print the run as JSON");

@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "mneedle/base/error.h"
+#include "mneedle/base/files.h"
 #include "mneedle/blas_threads.h"
 #include "mneedle/design_source.h"
 
@@ -377,7 +378,7 @@ class ResultWriter {
  public:
   explicit ResultWriter(const std::optional<fs::path>& out) {
     if (!out) return;
-    fs::create_directories(*out);
+    create_output_folder(*out, "--out");
     const bool fresh_csv = !fs::exists(*out / "results.csv");
     jsonl_.open(*out / "results.jsonl", std::ios::app);
     csv_.open(*out / "results.csv", std::ios::app);

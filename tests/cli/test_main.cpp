@@ -78,6 +78,8 @@ constexpr const char* kInternalMarkers[] = {
     "bad_optional", "bad_variant", "bad_function", "std::",
     // nlohmann::json and toml++
     "json.exception", "[json", "toml::",
+    // assimp names its own structures in its validation messages
+    "aiMesh", "aiScene", "mIndices",
     // main()'s catch-all, std::terminate and assert()
     "internal error", "what():", "terminate called", "Assertion"};
 
@@ -168,6 +170,7 @@ void write_inputs(const fs::path& dir) {
       {"no_friction.toml", kTissue + kNeedle + "\n[loads]\nfriction = \"none\"\n" + kInsertion},
       // meshes
       {"empty.stl", ""},
+      {"short.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n"},
       {"text.stl", "hello, this is not a mesh\n"},
       {"bad_face.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"},
       {"no_faces.obj", "v 0 0 0\n"},
@@ -283,7 +286,9 @@ TEST(ErrorPaths, EveryBadInputGivesOneClearLineAndNoInternalText) {
       {"force: --step zero", "force {D}/good.toml --step 0um", 1},
       {"force: --step too fine", "force {D}/good.toml --step 1e-15m", 1},
       {"force: --max-points text", "force {D}/good.toml --max-points abc", 2},
-      {"force: --max-points zero", "force {D}/good.toml --max-points 0", 1},
+      {"force: --max-points zero", "force {D}/good.toml --max-points 0", 2},
+      {"force: --max-points negative", "force {D}/good.toml --max-points=-5", 2},
+      {"inspect: OFF cut short", "inspect {D}/short.off --unit mm", 1},
       {"force: unknown plugin in scene", "force {D}/unknown_plugin.toml", 1},
       {"force: --plugin-dir missing", "force {D}/good.toml --plugin-dir {D}/missing_dir", 1},
       {"strength: no --material", "strength --plugin cone", 2},
@@ -475,6 +480,21 @@ TEST(ErrorPaths, EveryBadInputGivesOneClearLineAndNoInternalText) {
       {"simulate: --model unknown", "simulate {D}/good.toml --model fem", 2},
       {"simulate: --axis unknown", "simulate {D}/good.toml --axis w", 1},
       {"simulate: --max-needles text", "simulate {D}/good.toml --max-needles abc", 2},
+      {"simulate: --max-needles negative", "simulate {D}/good.toml --max-needles=-1", 2},
+      {"simulate: --vtu is a file", "simulate {D}/good.toml --vtu {D}/good.toml", 1},
+      {"toughness: a folder as the first curve", "toughness {D}/folder {D}/second.csv --area 1mm^2",
+       1},
+      {"calibrate: a folder as the curve", "calibrate {D}/good.toml --curve {D}/folder --fit scale",
+       1},
+      {"optimize: --out is a file",
+       "optimize --plugin cone --scene {D}/good.toml --vary half_angle --out {D}/good.toml", 1},
+      {"optimize: --bound on a parameter not varied",
+       "optimize --plugin cone --scene {D}/good.toml --vary half_angle --bound tip_radius=1um:2um",
+       1},
+      {"optimize: --bound without a name",
+       "optimize --plugin cone --scene {D}/good.toml --vary half_angle --bound =1mm:2mm", 1},
+      {"screen: --out is a file",
+       "screen {R}/designs/cone.stl --scene {D}/good.toml --out {D}/good.toml --json", 1},
       {"simulate: unknown plugin in scene", "simulate {D}/unknown_plugin.toml", 1},
       {"simulate: missing STL in scene", "simulate {D}/missing_stl.toml", 1},
       {"simulate: --plugin-dir missing", "simulate {D}/good.toml --plugin-dir {D}/missing_dir", 1},

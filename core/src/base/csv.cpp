@@ -4,6 +4,7 @@
 #include <iterator>
 
 #include "mneedle/base/error.h"
+#include "mneedle/base/files.h"
 
 namespace mneedle {
 namespace {
@@ -125,10 +126,7 @@ CsvTable parse_csv(std::string_view text, std::string source) {
 }
 
 CsvTable read_csv(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open the file");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return parse_csv(text, file.string());
+  return parse_csv(read_input_file(file), file.string());
 }
 
 }  // namespace mneedle

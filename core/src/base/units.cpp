@@ -139,6 +139,17 @@ struct Parsed {
   std::string unit;  // blanks collapsed; empty for a plain number
 };
 
+// number × factor, except for a submultiple whose inverse is a whole number (um, mm, mN, kPa's
+// inverse is not needed): there number ÷ inverse, which IEEE rounds correctly, so "10 um" is the
+// double nearest 1e-5 — the value a plugin's bound "10e-6" holds — not 10 × 1e-6 = 9.999…e-6.
+double to_si(double number, double factor) {
+  if (factor < 1.0) {
+    const double inverse = std::round(1.0 / factor);
+    if (std::abs(1.0 / factor - inverse) <= 1e-9 * inverse) return number / inverse;
+  }
+  return number * factor;
+}
+
 Parsed split_number_and_unit(std::string_view text) {
   const std::string_view t = trim(text);
   if (t.empty()) {
@@ -232,7 +243,7 @@ Quantity parse_quantity(std::string_view text) {
   if (p.unit.empty()) return {p.number, Dimension::Dimensionless};
   const auto unit = find_unit(p.unit);
   if (!unit) throw InputError(quoted(text) + ": unknown unit '" + p.unit + "'");
-  const double si = p.number * unit->to_si;
+  const double si = to_si(p.number, unit->to_si);
   if (!std::isfinite(si)) throw InputError(quoted(text) + ": value overflows in SI units");
   return {si, unit->dimension};
 }

@@ -15,6 +15,7 @@
 
 #include "axisymmetric_internal.h"
 #include "mneedle/base/error.h"
+#include "mneedle/base/files.h"
 #include "mneedle/fe/axisymmetric.h"
 
 namespace mneedle::fe {
@@ -577,7 +578,7 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
         model.layer_materials());
     cracked = make_stepper(*cracked_model, needle, options, false);
   }
-  if (!options.vtu_directory.empty()) std::filesystem::create_directories(options.vtu_directory);
+  if (!options.vtu_directory.empty()) create_output_folder(options.vtu_directory, "--vtu");
   InsertionResult result;
   for (int k = 1; k <= options.output_steps; ++k) {
     const double depth = options.depth_m * k / options.output_steps;

@@ -15,6 +15,7 @@
 #include "fe/needle_shape.h"
 #include "fe/vtu_writer.h"
 #include "mneedle/base/error.h"
+#include "mneedle/base/files.h"
 #include "mneedle/fe/crack.h"
 #include "mneedle/fe/solid3d.h"
 #include "mneedle/fe/sparse_solver.h"
@@ -1038,7 +1039,7 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   for (double a : crack_areas) total_crack_area += whole * a;
   if (cracked_run && !(total_crack_area > 0.0))
     throw SolverError("simulate_3d: the crack opened no mesh face (crack_depth_m too small?)");
-  if (!options.vtu_directory.empty()) std::filesystem::create_directories(options.vtu_directory);
+  if (!options.vtu_directory.empty()) create_output_folder(options.vtu_directory, "--vtu");
   for (int k = 1; k <= steps; ++k) {
     const double depth = options.depth * k / steps;
     Step3d step = run.advance_to(depth);

@@ -11,6 +11,7 @@
 #include "fe/needle_shape.h"
 #include "insertion/insertion_planner.h"
 #include "mneedle/base/error.h"
+#include "mneedle/base/files.h"
 #include "mneedle/base/units.h"
 #include "mneedle/fe/indentation3d.h"
 #include "mneedle/fe/tissue_mesh.h"
@@ -648,7 +649,7 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     run.criterion = plan.threshold->criterion;
     run.threshold = plan.threshold->threshold;
   }
-  if (!plan.vtu_directory.empty()) std::filesystem::create_directories(plan.vtu_directory);
+  if (!plan.vtu_directory.empty()) create_output_folder(plan.vtu_directory, "--vtu");
 
   std::vector<std::optional<SurfaceLoadModel>> post(needles.size());
   const LoadConstants constants = load_constants(scene);

@@ -264,6 +264,9 @@ double pentahedron_load(const std::array<Vec3, 3>& triangle,
   using namespace vec3;
   const Vec3 twice_area_normal =
       cross(sub(triangle[1], triangle[0]), sub(triangle[2], triangle[0]));
+  // A piece without area (a sliver clipped at an interface that rounding put a few 1e-20 m
+  // from the tip) carries nothing; its normal would be 0/0.
+  if (!(norm(twice_area_normal) > 0.0)) return 0.0;
   const Vec3 normal = normalized(twice_area_normal);
   const double peak = *std::max_element(vertex_loads_Pa.begin(), vertex_loads_Pa.end());
   if (!(peak > 0.0)) return 0.0;

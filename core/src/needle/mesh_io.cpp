@@ -239,6 +239,10 @@ TriangleMesh load_mesh(const std::filesystem::path& file, double metres_per_unit
         reason.find("contains no faces") != std::string::npos) {
       fail(file, "mesh is empty (no triangles)");
     }
+    // assimp's validation names its own structures (aiMesh::mFaces[3]::mIndices[2]): say what
+    // that means in the file instead.
+    if (reason.find("Validation failed") != std::string::npos)
+      fail(file, "not a readable mesh (a face refers to vertices the file does not hold)");
     fail(file, "not a readable mesh (" + reason + ")");
   }
   TriangleMesh mesh = collect_triangles(file, *scene, metres_per_unit);

@@ -33,6 +33,17 @@ TEST(Units, MicrometresConvertToMetres) {
   EXPECT_DOUBLE_EQ(parse_quantity("230 \xCE\xBCm", Dimension::Length), 230e-6);
 }
 
+TEST(Units, SubmultiplesGiveTheDoubleNearestTheDecimalValue) {
+  // Exactly equal, not DOUBLE_EQ: a plugin's minimum of 10e-6 m must accept "10 um"
+  // (10 × 1e-6 is 9.999…e-6, one ulp below).
+  EXPECT_EQ(parse_quantity("10 um", Dimension::Length), 10e-6);
+  EXPECT_EQ(parse_quantity("230 um", Dimension::Length), 230e-6);
+  EXPECT_EQ(parse_quantity("0.5 mm", Dimension::Length), 0.5e-3);
+  EXPECT_EQ(parse_quantity("3 nm", Dimension::Length), 3e-9);
+  EXPECT_EQ(parse_quantity("7 mN", Dimension::Force), 7e-3);
+  EXPECT_EQ(parse_quantity("0.7 kPa", Dimension::Pressure), 700.0);
+}
+
 TEST(Units, EveryLengthUnitScales) {
   EXPECT_DOUBLE_EQ(parse_quantity("5 nm", Dimension::Length), 5e-9);
   EXPECT_DOUBLE_EQ(parse_quantity("1.5 mm", Dimension::Length), 1.5e-3);

@@ -65,6 +65,15 @@ TEST(SurfaceLoads, PentahedronVolumeIsAreaTimesMeanLoadInAllThreeCases) {
   }
 }
 
+TEST(SurfaceLoads, PieceWithoutAreaCarriesNothingNotNaN) {
+  // Collinear corners: a sliver that clipping at a rounded interface height leaves behind
+  // (the shipped skin scene at 120 um gave "non-finite value NaN at curve[12].beta_N").
+  const std::array<mneedle::Vec3, 3> line{mneedle::Vec3{0, 0, 0}, mneedle::Vec3{1e-5, 0, 0},
+                                          mneedle::Vec3{2e-5, 0, 0}};
+  EXPECT_EQ(mneedle::pentahedron_load(line, {1e3, 2e3, 1.35e-20}), 0.0);
+  EXPECT_EQ(mneedle::pentahedron_load({line[0], line[0], line[0]}, {1e3, 1e3, 1e3}), 0.0);
+}
+
 TEST(SurfaceLoads, FlatCylinderCarriesKSTimesItsEndPlusCoulombFriction) {
   const ShapeOptions o;
   const SurfaceLoadModel model(mneedle::test::cylinder(o), fixed_k());
