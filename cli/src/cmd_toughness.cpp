@@ -96,6 +96,20 @@ InsertionPass load_pass(const std::string& file, const ToughnessArgs& a) {
   return prepare_pass(read_force_curve_csv(file, columns));
 }
 
+// --max-depth as a length; zero or negative is refused, not read as "no limit".
+double parse_max_depth(const std::string& text) {
+  double metres = 0.0;
+  try {
+    metres = parse_quantity(text, Dimension::Length);
+  } catch (const InputError& e) {
+    throw InputError("--max-depth: " + std::string(e.what()));
+  }
+  if (!(metres > 0.0)) {
+    throw InputError("--max-depth '" + text + "': must be a positive length, e.g. 0.5mm");
+  }
+  return metres;
+}
+
 void write_integrand(const std::string& path, const ForceDifference& d) {
   std::ofstream out(path);
   if (!out) throw InputError(path + ": cannot write the integrand file");
@@ -154,7 +168,7 @@ void run_toughness(const ToughnessArgs& a) {
   }
   ToughnessOptions options;
   options.alignment = parse_depth_alignment(a.align);
-  if (!a.max_depth.empty()) options.max_depth_m = parse_quantity(a.max_depth, Dimension::Length);
+  if (!a.max_depth.empty()) options.max_depth_m = parse_max_depth(a.max_depth);
   const ForceDifference d = force_difference(first, second, options);
   const CrackAreaChoice area = crack_area(a, d.end_depth_m);
   const double j = toughness_J_per_m2(d, area.area_m2);

@@ -13,6 +13,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 #include <sstream>
 
 #include "commands.h"
@@ -414,6 +415,9 @@ struct StatsArgs {
   std::string value = "value";
   std::string group = "group";
   double alpha = 0.05;
+  // Tukey compares every pair: k groups make k (k - 1) / 2 rows of output (1000 groups: half a
+  // million rows, a few seconds and about 1 GB for the report; docs/performance.md).
+  std::size_t max_groups = 1000;
   bool json = false;
 };
 
@@ -421,6 +425,13 @@ void run_stats(const StatsArgs& args) {
   std::vector<std::string> labels;
   std::vector<double> values;
   read_grouped_csv(args.file, args.value, args.group, labels, values);
+  const std::size_t groups = std::set<std::string>(labels.begin(), labels.end()).size();
+  if (groups > args.max_groups) {
+    throw InputError(args.file + ": " + std::to_string(groups) + " groups in column '" +
+                     args.group + "', more than --max-groups " + std::to_string(args.max_groups) +
+                     " (" + std::to_string(groups * (groups - 1) / 2) +
+                     " Tukey pairs); raise --max-groups to compare them all");
+  }
   const auto r = one_way_anova(labels, values, args.alpha);
   {
     nlohmann::json groups = nlohmann::json::array(), pairs = nlohmann::json::array();
@@ -542,6 +553,9 @@ void add_stats_command(CLI::App& app) {
   cmd->add_option("--value", args->value, "Value column")->capture_default_str();
   cmd->add_option("--group", args->group, "Group column")->capture_default_str();
   cmd->add_option("--alpha", args->alpha, "Family-wise significance level")->capture_default_str();
+  cmd->add_option("--max-groups", args->max_groups,
+                  "Most groups to compare (every pair is a row of the Tukey table)")
+      ->capture_default_str();
   cmd->add_flag("--json", args->json, "Print JSON");
   cmd->callback([args] { run_stats(*args); });
 }

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "refdata.h"
 #include "run_mneedle.h"
 
 namespace {
@@ -146,19 +147,12 @@ std::filesystem::path liver_curve() {
   return kRefdata / "okamura_liver" / "depth_force_curveA_mm.csv";
 }
 
-bool refdata_required() {
-  return std::getenv("MNEEDLE_REQUIRE_REFDATA") != nullptr;
-}
-
 // In the shipped scene the liver block is 60 mm deep and the needle never leaves it. The curve
 // cannot separate q from mu (correlation -1): mu goes to its bound and the model becomes a line
 // through the origin, which extrapolates 30 % better than a free line but misses the plateau
 // after 36.7 mm (held-out error 1.8x the fit's: a miss, docs/validation.md).
 TEST(CmdCalibrate, LiverCurveInADeepBlockBeatsAStraightLine) {
-  if (!std::filesystem::exists(liver_curve())) {
-    if (refdata_required()) FAIL() << "refdata required but absent: " << liver_curve();
-    GTEST_SKIP() << "refdata absent: " << liver_curve();
-  }
+  MNEEDLE_NEED_REFDATA(liver_curve());
   const LiverFit f = liver_fit(kLiverScene, liver_curve());
   EXPECT_TRUE(f.friction_at_bound);
   EXPECT_LE(f.held_out_rmse, 0.7 * f.line_rmse);
@@ -170,10 +164,7 @@ TEST(CmdCalibrate, LiverCurveInADeepBlockBeatsAStraightLine) {
 // published size) lets the model predict the rest within 1.5x its fit error and 30 % below a
 // straight line's.
 TEST(CmdCalibrate, LiverCurveThroughASampleOfTheInferredThicknessBeatsAStraightLine) {
-  if (!std::filesystem::exists(liver_curve())) {
-    if (refdata_required()) FAIL() << "refdata required but absent: " << liver_curve();
-    GTEST_SKIP() << "refdata absent: " << liver_curve();
-  }
+  MNEEDLE_NEED_REFDATA(liver_curve());
   std::string scene = read(kLiverScene);
   scene.replace(scene.find("\"60 mm\"]"), 8, "\"31.3 mm\"]");
   scene.replace(scene.find("depth = \"40 mm\""), 15, "depth = \"31 mm\"");

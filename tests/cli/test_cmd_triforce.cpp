@@ -104,6 +104,47 @@ TEST(CmdTriforce, StatsPrintsAnovaAndTukey) {
   EXPECT_NEAR(j["tukey_hsd"][0]["meandiff"].get<double>(), 5.0666667 - 5.4666667, 1e-6);
 }
 
+TEST(CmdTriforce, FitOnTravelThatDecreasesNamesTheColumnNotTheForce) {
+  // A loading written deepest row first: travel 6 -> 0.1 mm. Read forwards the force only falls,
+  // which used to be reported as "the force never rises above the noise".
+  std::filesystem::create_directories(kWork);
+  const auto file = kWork / "reversed.csv";
+  {
+    std::ofstream out(file);
+    out << "time_s,travel_mm,fz_N\n";
+    for (int i = 0; i < 60; ++i) {
+      const double travel = 6.0 - 0.1 * i;
+      out << 0.1 * i << "," << travel << "," << 0.15 * travel * travel << "\n";
+    }
+  }
+  const auto run = run_mneedle("fit '" + file.string() + "'");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("reversed.csv:3: column 'travel_mm' decreases from its first sample"),
+            std::string::npos)
+      << run.err;
+  EXPECT_EQ(run.err.find("noise"), std::string::npos) << run.err;
+}
+
+TEST(CmdTriforce, StatsRefusesMoreGroupsThanMaxGroupsBeforeComparingThem) {
+  std::filesystem::create_directories(kWork);
+  const auto file = kWork / "five_groups.csv";
+  {
+    std::ofstream out(file);
+    out << "group,value\n";
+    for (int g = 0; g < 5; ++g) out << "g" << g << "," << g << ".1\ng" << g << "," << g << ".3\n";
+  }
+  const auto refused = run_mneedle("stats '" + file.string() + "' --max-groups 4");
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("five_groups.csv: 5 groups in column 'group', more than "
+                             "--max-groups 4 (10 Tukey pairs)"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_TRUE(refused.out.empty()) << refused.out;
+  const auto allowed = run_mneedle("stats '" + file.string() + "' --max-groups 5 --json");
+  ASSERT_EQ(allowed.exit_code, 0) << allowed.err;
+  EXPECT_EQ(nlohmann::json::parse(allowed.out)["tukey_hsd"].size(), 10u);
+}
+
 TEST(CmdTriforce, BadCurveFailsWithFileAndLine) {
   const auto run =
       run_mneedle("fit '" + std::string(MNEEDLE_TEST_ASSETS) + "/curves/text_in_number.csv'");

@@ -120,9 +120,100 @@ std::size_t deepest_index(const std::vector<double>& depth, std::size_t from) {
   return depth.size() - 1;
 }
 
+// Whether the first m forces climb rather than stay flat: the straight line fitted through them
+// (least squares against the sample index) rises across them by more than noise_factor times
+// their robust spread about that line and by more than min_rise_fraction of the peak above their
+// lowest force. The spread is taken about the line, not about the median, so that a climbing
+// head does not pass its own rise off as noise. Needs m >= 4 (3 points leave the spread
+// about a line no degree of freedom to show).
+bool head_rises(const std::vector<double>& force, std::size_t m, double highest,
+                const LoadingBranchOptions& options) {
+  const double xm = 0.5 * static_cast<double>(m - 1);
+  double ym = 0.0;
+  for (std::size_t i = 0; i < m; ++i) ym += force[i];
+  ym /= static_cast<double>(m);
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const double dx = static_cast<double>(i) - xm;
+    sxy += dx * (force[i] - ym);
+    sxx += dx * dx;
+  }
+  const double slope = sxy / sxx;
+  std::vector<double> residual(m);
+  for (std::size_t i = 0; i < m; ++i)
+    residual[i] = force[i] - (ym + slope * (static_cast<double>(i) - xm));
+  const double centre = median(residual);
+  for (auto& r : residual) r = std::abs(r - centre);
+  const double spread = 1.4826 * median(residual);
+  const double lowest =
+      *std::min_element(force.begin(), force.begin() + static_cast<std::ptrdiff_t>(m));
+  const double rise = slope * static_cast<double>(m - 1);
+  return rise > options.noise_factor * spread &&
+         rise > options.min_rise_fraction * (highest - lowest);
+}
+
+struct Baseline {
+  double level_N = 0.0;  // sensor offset
+  double noise_N = 0.0;  // robust standard deviation about it
+};
+
+// Median and scaled median absolute deviation of the first `head` forces.
+Baseline head_baseline(const std::vector<double>& force, std::size_t head) {
+  std::vector<double> leading(force.begin(), force.begin() + static_cast<std::ptrdiff_t>(head));
+  Baseline b;
+  b.level_N = median(leading);
+  for (auto& f : leading) f = std::abs(f - b.level_N);
+  b.noise_N = 1.4826 * median(leading);
+  return b;
+}
+
+// The force rises at the first sample above the baseline by more than max(noise_factor noise,
+// min_rise_fraction of the peak); contact is the last sample before that within one noise
+// deviation of the baseline (or the first sample). nullopt when the force never rises.
+std::optional<std::size_t> find_contact(const std::vector<double>& force, const Baseline& base,
+                                        double highest, const LoadingBranchOptions& options) {
+  const double peak = highest - base.level_N;
+  if (!(peak > 0.0)) return std::nullopt;
+  const double threshold =
+      std::max(options.noise_factor * base.noise_N, options.min_rise_fraction * peak);
+  std::size_t contact = 0;
+  while (contact < force.size() && !(force[contact] - base.level_N > threshold)) ++contact;
+  if (contact == force.size()) return std::nullopt;
+  // Walk back to where the force was last within the noise: that is where the needle touched.
+  while (contact > 0 && force[contact - 1] - base.level_N > base.noise_N) --contact;
+  if (contact > 0) --contact;
+  return contact;
+}
+
+// The travel must grow into the tissue. A recording whose deepest travel is its first sample and
+// which then goes shallower (a retraction alone, rows in reverse order, or a depth axis pointing
+// out of the tissue) has no loading branch; say so before looking at the force, whose rise would
+// otherwise be searched for in the wrong direction.
+void require_advancing_travel(const ForceCurve& raw) {
+  const auto& z = raw.depth_m;
+  if (deepest_index(z, 0) != 0) return;
+  std::size_t shallowest = 0;
+  for (std::size_t i = 1; i < z.size(); ++i)
+    if (z[i] < z[shallowest]) shallowest = i;
+  if (shallowest == 0) return;  // constant travel: reported as not advancing after contact
+  std::size_t first_step = 1;
+  while (z[first_step] >= z[0]) ++first_step;
+  const std::string column =
+      raw.depth_column.empty() ? "the depth" : "column '" + raw.depth_column + "'";
+  throw InputError(where(raw.source, raw.line[first_step]) + ": " + column +
+                   " decreases from its first sample (" +
+                   format_quantity(z[0] + 0.0, Dimension::Length) + " at line " +
+                   std::to_string(raw.line[0]) + " to " +
+                   format_quantity(z[shallowest], Dimension::Length) + " at line " +
+                   std::to_string(raw.line[shallowest]) +
+                   ") and never goes deeper: depth must increase into the tissue (rows reversed, "
+                   "a retraction alone, or an axis pointing out of the tissue?)");
+}
+
 ForceCurve slice(const ForceCurve& raw, std::size_t first, std::size_t last) {
   ForceCurve out;
   out.source = raw.source;
+  out.depth_column = raw.depth_column;
   for (std::size_t i = first; i <= last; ++i) {
     if (!raw.time_s.empty()) out.time_s.push_back(raw.time_s[i]);
     out.depth_m.push_back(raw.depth_m[i]);
@@ -139,6 +230,11 @@ std::string describe_cut(const ForceCurve& raw, const LoadingBranch& b) {
     << b.contact_travel_m * 1e3 << " mm, baseline " << b.baseline_N << " N removed); cut "
     << b.contact_index << " before contact, " << b.hold_samples << " in the hold, "
     << b.retraction_samples << " in the retraction";
+  if (b.contact_before_first_sample) {
+    s << "; already loaded at the first sample: contact at travel 0, no baseline removed";
+  } else if (b.starts_at_contact) {
+    s << "; fewer than 3 samples before contact: no baseline removed";
+  }
   return s.str();
 }
 
@@ -164,6 +260,7 @@ ForceCurve read_force_curve_csv(const std::filesystem::path& file, const CurveCo
       column_scale(header[force_col], columns.force_unit, Dimension::Force, curve.source);
   const double time_scale =
       time_col ? column_scale(header[*time_col], "", Dimension::Time, curve.source) : 1.0;
+  curve.depth_column = header[depth_col];
   for (const auto& row : table.rows) {
     const auto& fields = row.fields;
     const std::size_t line_number = row.line;
@@ -186,32 +283,59 @@ ForceCurve read_force_curve_csv(const std::filesystem::path& file, const CurveCo
 LoadingBranch extract_loading_branch(const ForceCurve& raw, const LoadingBranchOptions& options) {
   const std::size_t n = raw.force_N.size();
   if (n < 3) throw InputError(raw.source + ": no loading branch: fewer than 3 samples");
-  // The approach (before any force) gives the sensor offset and its noise.
-  const std::size_t window = std::clamp<std::size_t>(n / 20, 3, 200);
-  std::vector<double> head(raw.force_N.begin(),
-                           raw.force_N.begin() + static_cast<std::ptrdiff_t>(window));
+  require_advancing_travel(raw);
+  // The approach (before any force) gives the sensor offset and its noise: the first 5 % of the
+  // samples, but only while they are flat and only those before contact (docs/model.md, "Curve
+  // reading"). A head whose force climbs along it is halved until it does not; a contact found
+  // inside the head means it holds loaded samples, so the baseline is taken again from the
+  // samples before that contact, until they all precede it.
+  const double highest = *std::max_element(raw.force_N.begin(), raw.force_N.end());
+  std::size_t head = std::clamp<std::size_t>(n / 20, 3, 200);
+  while (head >= 4 && head_rises(raw.force_N, head, highest, options)) head /= 2;
   LoadingBranch b;
-  b.baseline_N = median(head);
-  for (auto& f : head) f = std::abs(f - b.baseline_N);
-  b.noise_N = 1.4826 * median(head);
-  const double peak = *std::max_element(raw.force_N.begin(), raw.force_N.end()) - b.baseline_N;
-  const double threshold =
-      std::max(options.noise_factor * b.noise_N, options.min_rise_fraction * peak);
-  std::size_t rise = n;
-  for (std::size_t i = 0; i < n && rise == n; ++i) {
-    if (raw.force_N[i] - b.baseline_N > threshold && peak > 0.0) rise = i;
+  b.starts_at_contact = head < 3;
+  Baseline base;
+  std::optional<std::size_t> found;
+  if (!b.starts_at_contact) {
+    base = head_baseline(raw.force_N, head);
+    found = find_contact(raw.force_N, base, highest, options);
+    if (!found) {
+      throw InputError(where(raw.source, raw.line.back()) +
+                       ": no loading branch: the force never rises above the noise (baseline " +
+                       std::to_string(base.level_N) + " N, noise " + std::to_string(base.noise_N) +
+                       " N)");
+    }
+    while (*found < head) {
+      if (*found < 3) {
+        b.starts_at_contact = true;
+        break;
+      }
+      head = *found;
+      const Baseline shorter = head_baseline(raw.force_N, head);
+      const auto again = find_contact(raw.force_N, shorter, highest, options);
+      if (!again) break;  // too few samples left to see the rise against: keep the longer head
+      base = shorter;
+      found = again;
+    }
   }
-  if (rise == n) {
-    throw InputError(where(raw.source, raw.line.back()) +
-                     ": no loading branch: the force never rises above the noise (baseline " +
-                     std::to_string(b.baseline_N) + " N, noise " + std::to_string(b.noise_N) +
-                     " N)");
+  if (b.starts_at_contact) {
+    // Fewer than 3 flat samples precede contact: the force rises from (about) the first sample
+    // and the recording has no unloaded part to measure an offset on. Its force is taken as
+    // already zeroed, as `mneedle simulate --csv` and `mneedle force --csv` write it, and contact
+    // is the last sample at or below zero force before the rise, or the first sample.
+    base = Baseline{};
+    found = find_contact(raw.force_N, base, highest, options).value_or(0);
   }
-  // Walk back to where the force was last within the noise: that is where the needle touched.
-  std::size_t contact = rise;
-  while (contact > 0 && raw.force_N[contact - 1] - b.baseline_N > b.noise_N) --contact;
-  if (contact > 0) --contact;
+  b.baseline_N = base.level_N;
+  b.noise_N = base.noise_N;
+  const std::size_t contact = *found;
   b.contact_index = contact;
+  // Already loaded at the first sample, which lies within one step of travel 0: the recording
+  // was written from the surface on (depth below the surface, as `mneedle simulate --csv` writes
+  // it from its first step), so the surface at travel 0 is the contact.
+  const auto& z = raw.depth_m;
+  b.contact_before_first_sample = b.starts_at_contact && contact == 0 && raw.force_N[0] > 0.0 &&
+                                  z[0] > 0.0 && z[0] <= z[1] - z[0];
   b.end_index = deepest_index(raw.depth_m, contact);
   if (b.end_index < contact + 2 || raw.depth_m[b.end_index] <= raw.depth_m[contact]) {
     throw InputError(where(raw.source, raw.line[contact]) +
@@ -222,7 +346,7 @@ LoadingBranch extract_loading_branch(const ForceCurve& raw, const LoadingBranchO
   std::size_t i = b.end_index + 1;
   while (i < n && raw.depth_m[i] >= max_depth - 2e-3 * range) ++i, ++b.hold_samples;
   b.retraction_samples = n - i;
-  b.contact_travel_m = raw.depth_m[contact];
+  b.contact_travel_m = b.contact_before_first_sample ? 0.0 : raw.depth_m[contact];
   b.curve = slice(raw, contact, b.end_index);
   for (auto& d : b.curve.depth_m) d -= b.contact_travel_m;
   for (auto& f : b.curve.force_N) f -= b.baseline_N;

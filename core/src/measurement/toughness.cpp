@@ -49,6 +49,14 @@ std::size_t count_beyond(const ForceCurve& c, double end) {
       std::count_if(c.depth_m.begin(), c.depth_m.end(), [end](double z) { return z > end; }));
 }
 
+// Samples of a pass (its own, not the zero added at depth 0) from depth 0 to `end`.
+std::size_t samples_within(const ForceCurve& c, double end) {
+  const double tolerance = 1e-9 * end;  // as for the grid: equal but for rounding
+  return static_cast<std::size_t>(std::count_if(c.depth_m.begin(), c.depth_m.end(), [&](double z) {
+    return z >= -tolerance && z <= end + tolerance;
+  }));
+}
+
 std::size_t count_within(const ForceCurve& c, double end) {
   return c.depth_m.size() - count_beyond(c, end);
 }
@@ -108,10 +116,28 @@ ForceDifference force_difference(const InsertionPass& first, const InsertionPass
   const ForceCurve f = start_at_zero(first.curve);
   const ForceCurve b = start_at_zero(shifted);
   double end = std::min(f.depth_m.back(), b.depth_m.back());
-  if (options.max_depth_m > 0.0) end = std::min(end, options.max_depth_m);
-  if (!(end > 0.0)) {
-    throw InputError(first.cut.source + " and " + second.cut.source +
-                     ": no common depth range to integrate over");
+  const std::string both = first.cut.source + " and " + second.cut.source;
+  if (options.max_depth_m) {
+    const double max_depth = *options.max_depth_m;
+    if (!(max_depth > 0.0) || !std::isfinite(max_depth)) {
+      throw InputError(both + ": --max-depth " + format_quantity(max_depth, Dimension::Length) +
+                       ": must be a positive length");
+    }
+    end = std::min(end, max_depth);
+  }
+  if (!(end > 0.0)) throw InputError(both + ": no common depth range to integrate over");
+  // A range shorter than a few samples gives a number, but not an integral of the curves
+  // (docs/model.md, "Fracture toughness from two insertions", step 4).
+  const std::size_t first_kept = samples_within(first.curve, end);
+  const std::size_t second_kept = samples_within(shifted, end);
+  if (std::min(first_kept, second_kept) < kMinIntegrationSamples) {
+    const bool by_option = options.max_depth_m && *options.max_depth_m <= end;
+    throw InputError(
+        both + ": " + (by_option ? "--max-depth " : "the common depth range up to ") +
+        format_quantity(end, Dimension::Length) + " keeps " + std::to_string(first_kept) +
+        (first_kept == 1 ? " sample of " : " samples of ") + first.cut.source + " and " +
+        std::to_string(second_kept) + " of " + second.cut.source + "; at least " +
+        std::to_string(kMinIntegrationSamples) + " of each are needed");
   }
   ForceDifference out;
   out.end_depth_m = end;

@@ -2,16 +2,44 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "mneedle/base/error.h"
+#include "refdata.h"
 
 namespace {
 
 const std::string kCurves = std::string(MNEEDLE_TEST_ASSETS) + "/curves/";
 const std::filesystem::path kRefdata =
     std::filesystem::path(MNEEDLE_SOURCE_ROOT) / ".." / "shared" / "refdata";
+
+const std::filesystem::path kWork = std::filesystem::temp_directory_path() /
+                                    ("mneedle_test_force_curve_" + std::to_string(::getpid()));
+
+// Removes the scratch directory when the test program ends.
+struct ScratchCleanup {
+  ~ScratchCleanup() {
+    std::error_code ignored;
+    std::filesystem::remove_all(kWork, ignored);
+  }
+} const kScratchCleanup;
+
+// A noise-free curve sampled every `step` of travel from `first` to `last`.
+mneedle::ForceCurve sampled(double (*force)(double), double first, double last, double step) {
+  mneedle::ForceCurve c;
+  c.source = "sampled.csv";
+  for (int i = 0; first + i * step <= last + 1e-12; ++i) {
+    c.depth_m.push_back(first + i * step);
+    c.force_N.push_back(force(first + i * step));
+    c.line.push_back(static_cast<std::size_t>(i) + 2);
+  }
+  return c;
+}
 
 std::string error_of(const std::string& file, const mneedle::CurveColumns& columns = {}) {
   try {
@@ -81,6 +109,72 @@ TEST(ForceCurve, LoadingBranchStartsAtContactAndCutsHoldAndRetraction) {
   EXPECT_NE(b.summary.find(" in the hold"), std::string::npos) << b.summary;
 }
 
+TEST(ForceCurve, CurveRisingFromItsFirstSampleStartsAtContactWithNoBaselineRemoved) {
+  // As `mneedle force --csv` writes it: (0, 0), then 50 N/m from the first sample on. The first
+  // 5 % of the samples rise, so none of them is a baseline (docs/model.md, "Curve reading").
+  const auto b =
+      mneedle::extract_loading_branch(sampled([](double z) { return 50.0 * z; }, 0.0, 2e-3, 10e-6));
+  EXPECT_TRUE(b.starts_at_contact);
+  EXPECT_FALSE(b.contact_before_first_sample);
+  EXPECT_EQ(b.contact_index, 0u);
+  EXPECT_EQ(b.baseline_N, 0.0);
+  EXPECT_EQ(b.contact_travel_m, 0.0);
+  EXPECT_DOUBLE_EQ(b.curve.force_N.back(), 0.1);  // 50 N/m at 2 mm, nothing subtracted
+  EXPECT_NE(b.summary.find("no baseline removed"), std::string::npos) << b.summary;
+}
+
+TEST(ForceCurve, CurveLoadedAtItsFirstStepIsMeasuredFromTravelZero) {
+  // As `mneedle simulate --csv` writes it: depth below the surface from its first step (80 um)
+  // on, already loaded there. Contact is the surface, travel 0, not the first sample.
+  const auto b = mneedle::extract_loading_branch(
+      sampled([](double z) { return 1e3 * std::pow(z, 1.5); }, 80e-6, 1.6e-3, 80e-6));
+  EXPECT_TRUE(b.contact_before_first_sample);
+  EXPECT_EQ(b.contact_index, 0u);
+  EXPECT_EQ(b.contact_travel_m, 0.0);
+  EXPECT_EQ(b.baseline_N, 0.0);
+  EXPECT_EQ(b.curve.depth_m.front(), 80e-6);
+  EXPECT_EQ(b.curve.force_N.front(), 1e3 * std::pow(80e-6, 1.5));
+}
+
+TEST(ForceCurve, ApproachShorterThanTheBaselineWindowKeepsItsOffsetAndContact) {
+  // 201 samples: the baseline window is the first 10, but only 5 are approach (0.5 mN offset,
+  // contact at the 5th, travel 40 um). The loaded samples of the window are left out of it.
+  const auto b = mneedle::extract_loading_branch(
+      sampled([](double z) { return 0.5e-3 + (z > 40e-6 + 1e-12 ? 50.0 * (z - 40e-6) : 0.0); }, 0.0,
+              2e-3, 10e-6));
+  EXPECT_FALSE(b.starts_at_contact);
+  EXPECT_EQ(b.contact_index, 4u);
+  EXPECT_NEAR(b.contact_travel_m, 40e-6, 1e-15);  // reference: the construction, exact to rounding
+  EXPECT_EQ(b.baseline_N, 0.5e-3);
+  EXPECT_EQ(b.noise_N, 0.0);
+}
+
+TEST(ForceCurve, TravelDecreasingFromTheFirstSampleIsNamedBeforeTheForce) {
+  // Rows of a loading written deepest first: the force falls with the travel, so without the
+  // travel check it reads as "never rises above the noise".
+  std::filesystem::create_directories(kWork);
+  const auto file = kWork / "decreasing.csv";
+  {
+    std::ofstream out(file);
+    out << "time_s,travel_mm,fz_N\n";
+    for (int i = 0; i < 60; ++i) {
+      const double travel = 6.0 - 0.1 * i;
+      out << 0.1 * i << "," << travel << "," << 0.15 * travel * travel << "\n";
+    }
+  }
+  std::string msg = "no error";
+  try {
+    mneedle::extract_loading_branch(mneedle::read_force_curve_csv(file));
+  } catch (const mneedle::InputError& e) {
+    msg = e.what();
+  }
+  EXPECT_NE(msg.find("decreasing.csv:3: column 'travel_mm' decreases from its first sample"),
+            std::string::npos)
+      << msg;
+  EXPECT_NE(msg.find("6 mm at line 2 to 100 um at line 61"), std::string::npos) << msg;
+  EXPECT_EQ(msg.find("noise"), std::string::npos) << msg;
+}
+
 TEST(ForceCurve, HoldSegmentStartsAtTheEndOfLoading) {
   const auto raw = mneedle::read_force_curve_csv(kCurves + "loading_hold_retraction.csv");
   const auto b = mneedle::extract_loading_branch(raw);
@@ -99,7 +193,7 @@ TEST(ForceCurve, LoadingSpeedIsTheSlopeOfTravelOverTime) {
 TEST(ForceCurve, RealPhantomRecordingContactsAFewMillimetresIn) {
   const auto file =
       kRefdata / "phantom_insertions" / "skin-on-muscle_1_0_3_2_2024-06-19-11-43-49.csv";
-  if (!std::filesystem::exists(file)) GTEST_SKIP() << "refdata absent: " << file;
+  MNEEDLE_NEED_REFDATA(file);
   const auto b = mneedle::extract_loading_branch(mneedle::read_force_curve_csv(file));
   EXPECT_GT(b.contact_travel_m, 1.0e-3);
   EXPECT_LT(b.contact_travel_m, 4.0e-3);
@@ -110,7 +204,7 @@ TEST(ForceCurve, RealPhantomRecordingContactsAFewMillimetresIn) {
 
 TEST(ForceCurve, DigitisedLiverCurveWithoutTimeColumnIsReadable) {
   const auto file = kRefdata / "okamura_liver" / "depth_force_curveA_mm.csv";
-  if (!std::filesystem::exists(file)) GTEST_SKIP() << "refdata absent: " << file;
+  MNEEDLE_NEED_REFDATA(file);
   const auto raw = mneedle::read_force_curve_csv(file);
   EXPECT_TRUE(raw.time_s.empty());
   const auto b = mneedle::extract_loading_branch(raw);

@@ -10,6 +10,7 @@
 #include "mneedle/base/error.h"
 #include "mneedle/geometry/tip_area.h"
 #include "needle_shapes.h"
+#include "refdata.h"
 
 namespace {
 
@@ -78,6 +79,36 @@ TEST(Toughness, SyntheticPairFromAKnownJGivesItBackWithinOnePercent) {
   EXPECT_NEAR(d.difference_work_J, d.first_work_J - d.second_work_J, 1e-15);
 }
 
+TEST(Toughness, PairStartingAtContactGivesTheKnownJ) {
+  // Both passes recorded from contact on, as `mneedle force --csv` writes them: no approach to
+  // take a baseline from. Reference kJ; 1 % as for the pair with an approach above (trapezoid
+  // rule on a 1 um grid, the crack term ending between two samples).
+  const auto first = mneedle::prepare_pass(recording(first_force, 0.0, 500e-6, 1e-6));
+  const auto second = mneedle::prepare_pass(recording(second_force, 0.0, 450e-6, 2e-6));
+  EXPECT_EQ(first.cut.before_contact, 0u);
+  EXPECT_EQ(first.cut.baseline_N, 0.0);
+  EXPECT_EQ(second.cut.baseline_N, 0.0);
+  const auto d = mneedle::force_difference(first, second);
+  EXPECT_NEAR(mneedle::toughness_J_per_m2(d, kShaftArea), kJ, 0.01 * kJ);
+}
+
+TEST(Toughness, PassLoadedFromItsFirstStepIsMeasuredFromTravelZero) {
+  // The first pass as `mneedle simulate --csv` writes it, from its first step (1 um) on, already
+  // loaded there; the second from (0, 0). Reference kJ; 1 %: the trapezoid rule loses about half
+  // a step of the crack term where it ends (0.4 % here), while measuring the first pass from its
+  // first sample, one step off, would add 1.8 %.
+  mneedle::ForceCurve first = recording(first_force, 0.0, 500e-6, 1e-6);
+  first.depth_m.erase(first.depth_m.begin());
+  first.force_N.erase(first.force_N.begin());
+  first.line.erase(first.line.begin());
+  const auto pass = mneedle::prepare_pass(first);
+  EXPECT_EQ(pass.cut.contact_travel_m, 0.0);
+  EXPECT_EQ(pass.curve.depth_m.front(), first.depth_m.front());
+  const auto d = mneedle::force_difference(
+      pass, mneedle::prepare_pass(recording(second_force, 0.0, 500e-6, 1e-6)));
+  EXPECT_NEAR(mneedle::toughness_J_per_m2(d, kShaftArea), kJ, 0.01 * kJ);
+}
+
 TEST(Toughness, AssetPairInMillinewtonsMillimetresAndMicrometresGivesTheKnownJ) {
   const auto d = mneedle::force_difference(pass_from("toughness_first.csv"),
                                            pass_from("toughness_second.csv"));
@@ -126,6 +157,30 @@ TEST(Toughness, MaxDepthInsideTheTipGivesTheCrackGrownSoFar) {
   const auto d = mneedle::force_difference(first, second, options);
   EXPECT_DOUBLE_EQ(d.end_depth_m, 150e-6);
   EXPECT_NEAR(d.difference_work_J, kJ * pi * std::pow(150e-6 * kTan, 2), 1e-3 * kJ * kShaftArea);
+}
+
+TEST(Toughness, NonPositiveMaxDepthIsAnInputErrorNamingTheOption) {
+  const auto first = mneedle::prepare_pass(recording(first_force, 50e-6, 550e-6, 1e-6));
+  for (double bad : {0.0, -1e-3, std::nan("")}) {
+    mneedle::ToughnessOptions options;
+    options.max_depth_m = bad;
+    const auto msg = error_of([&] { mneedle::force_difference(first, first, options); });
+    EXPECT_NE(msg.find("--max-depth"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("must be a positive length"), std::string::npos) << msg;
+  }
+}
+
+TEST(Toughness, MaxDepthKeepingFewerThanThreeSamplesSaysHowManyRemain) {
+  const auto first = mneedle::prepare_pass(recording(first_force, 50e-6, 550e-6, 1e-6));
+  mneedle::ToughnessOptions options;
+  options.max_depth_m = 1e-15;  // only the contact sample, at depth 0
+  const auto msg = error_of([&] { mneedle::force_difference(first, first, options); });
+  EXPECT_NE(msg.find("--max-depth"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("keeps 1 sample of synthetic.csv and 1 of synthetic.csv"), std::string::npos)
+      << msg;
+  EXPECT_NE(msg.find("at least 3 of each are needed"), std::string::npos) << msg;
+  options.max_depth_m = 2e-6;  // samples at 0, 1 and 2 um: enough
+  EXPECT_NEAR(mneedle::force_difference(first, first, options).end_depth_m, 2e-6, 1e-18);
 }
 
 TEST(Toughness, TravelAlignmentKeepsTheSecondPassAtItsOwnTravel) {
@@ -249,7 +304,7 @@ TEST(Toughness, FlatRecordingHasNoRetractionPass) {
 TEST(Toughness, PhantomRecordingGivesAFinitePositiveJFromBothConstructions) {
   const auto file =
       kRefdata / "phantom_insertions" / "skin-on-muscle_2_0_3_1_2024-06-19-11-35-16.csv";
-  if (!std::filesystem::exists(file)) GTEST_SKIP() << "refdata absent: " << file;
+  MNEEDLE_NEED_REFDATA(file);
   const auto raw = mneedle::read_force_curve_csv(file);
   const auto first = mneedle::prepare_pass(raw);
   mneedle::ForceDrop drop;
@@ -266,7 +321,7 @@ TEST(Toughness, PhantomRecordingGivesAFinitePositiveJFromBothConstructions) {
 
 TEST(Toughness, DigitisedLiverCurveMergesItsRunsAtOneDepth) {
   const auto file = kRefdata / "okamura_liver" / "depth_force_curveA_mm.csv";
-  if (!std::filesystem::exists(file)) GTEST_SKIP() << "refdata absent: " << file;
+  MNEEDLE_NEED_REFDATA(file);
   const auto first = mneedle::prepare_pass(mneedle::read_force_curve_csv(file));
   EXPECT_GT(first.cut.repeated_depth, 20u);  // the drop at 19.15 mm is a run at one depth
   EXPECT_GT(first.cut.receding_depth, 0u);

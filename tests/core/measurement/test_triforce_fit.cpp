@@ -9,6 +9,7 @@
 
 #include "mneedle/base/error.h"
 #include "mneedle/measurement/force_curve.h"
+#include "refdata.h"
 
 namespace {
 
@@ -126,9 +127,9 @@ TEST(TriforceFit, PredictionAtAnotherSpeedUsesTheMaxwellBranch) {
 }
 
 TEST(TriforceFit, RealPhantomCurveFitsWithPositiveR2) {
-  const auto file = std::filesystem::path(MNEEDLE_SOURCE_ROOT) / ".." / "shared" / "refdata" /
-                    "phantom_insertions" / "skin-on-muscle_1_0_3_2_2024-06-19-11-43-49.csv";
-  if (!std::filesystem::exists(file)) GTEST_SKIP() << "refdata absent: " << file;
+  const auto file = mneedle::test::refdata_dir() / "phantom_insertions" /
+                    "skin-on-muscle_1_0_3_2_2024-06-19-11-43-49.csv";
+  MNEEDLE_NEED_REFDATA(file);
   const auto branch = mneedle::extract_loading_branch(mneedle::read_force_curve_csv(file));
   mneedle::FitCurve c{file.filename().string(),
                       branch.curve.depth_m,

@@ -17,6 +17,7 @@ struct ForceCurve {
   std::vector<double> depth_m;    ///< needle travel along its axis
   std::vector<double> force_N;    ///< axial force, positive resisting insertion
   std::vector<std::size_t> line;  ///< 1-based line of each sample in the source file
+  std::string depth_column;       ///< header of the depth column, for messages ("" if not read)
 };
 
 /// Which CSV columns to read. An empty name picks the first column whose name (without its unit)
@@ -55,12 +56,20 @@ struct LoadingBranch {
   std::size_t end_index = 0;      ///< raw sample index of the deepest point (inclusive)
   std::size_t hold_samples = 0;   ///< samples cut after the deepest point while travel stays there
   std::size_t retraction_samples = 0;  ///< samples cut after the hold
-  std::string summary;                 ///< one line saying what was kept and what was cut
+  /// Fewer than 3 samples precede contact (the force rises from about the first sample): no
+  /// baseline is removed (docs/model.md, "Curve reading").
+  bool starts_at_contact = false;
+  /// ... and the first sample is already loaded within one step of travel 0: contact is taken
+  /// at travel 0 (a curve written from the surface on, like `mneedle simulate --csv`).
+  bool contact_before_first_sample = false;
+  std::string summary;  ///< one line saying what was kept and what was cut
 };
 
-/// Detects the contact point and cuts the approach, the hold and the retraction. Throws
-/// InputError naming file:line when there is no loading branch (the force never leaves the
-/// noise, or the needle does not advance after contact).
+/// Detects the contact point and cuts the approach, the hold and the retraction. The baseline
+/// comes from the leading samples while they stay flat; a curve that rises from its first sample
+/// starts at contact. Throws InputError naming file:line when there is no loading branch: the
+/// travel decreases from the first sample (checked first, naming the depth column), the force
+/// never leaves the noise, or the needle does not advance after contact.
 LoadingBranch extract_loading_branch(const ForceCurve& raw,
                                      const LoadingBranchOptions& options = {});
 

@@ -4,6 +4,7 @@
 // second-pass constructions used when a recording has no second pass (docs/model.md).
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -51,8 +52,13 @@ DepthAlignment parse_depth_alignment(std::string_view text);  ///< "contact" | "
 
 struct ToughnessOptions {
   DepthAlignment alignment = DepthAlignment::Contact;
-  double max_depth_m = 0.0;  ///< end of the integral; 0 = the shallower pass's deepest point
+  /// End of the integral (`--max-depth`); unset = the shallower pass's deepest point.
+  std::optional<double> max_depth_m;
 };
+
+/// Fewest samples of each pass force_difference integrates over: two intervals, so that the
+/// integral follows the curve rather than one straight line between its ends.
+inline constexpr std::size_t kMinIntegrationSamples = 3;
 
 /// The two passes on one depth grid (the union of their depths, linear interpolation) and the
 /// trapezoidal integrals of F, F' and F - F' from 0 to the end depth.
@@ -68,7 +74,9 @@ struct ForceDifference {
 };
 
 /// Aligns (second shifted for DepthAlignment::Travel: zero force before its own contact) and
-/// integrates. Throws InputError when the common depth range is empty.
+/// integrates. Throws InputError when the common depth range is empty, when max_depth_m is set but
+/// not a positive finite length (naming --max-depth), and when the range keeps fewer than
+/// kMinIntegrationSamples samples of either pass (saying how many it keeps).
 ForceDifference force_difference(const InsertionPass& first, const InsertionPass& second,
                                  const ToughnessOptions& options = {});
 
