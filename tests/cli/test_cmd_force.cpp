@@ -74,6 +74,9 @@ TEST_F(ForceCommand, PluginBevelInSiliconeLoadsBetaAndFrictionOnly) {
   const CommandRun run = run_mneedle("force '" + design("silicone_phantom.toml") + "' --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const nlohmann::json out = nlohmann::json::parse(run.out);
+  // A sharp bevel has no face across the axis: no alpha load at any depth (docs/model.md, "α
+  // faces"), beta and friction once it is in.
+  for (const auto& sample : out["needles"][0]["curve"]) EXPECT_EQ(sample["alpha_N"], 0.0);
   const auto& last = out["needles"][0]["curve"].back();
   EXPECT_GT(last["beta_N"].get<double>(), 0.0);
   EXPECT_GT(last["friction_N"].get<double>(), 0.0);

@@ -1,6 +1,7 @@
 // Stiffness contrast of 1e4 and beyond between layers (1 GPa stratum corneum on 0.08 MPa
 // dermis, then 1e6 and 1e8): the answer is finite, bounded by the homogeneous blocks of either
-// material, and converges under mesh refinement; or the solve stops with a SolverError.
+// material, and converges under mesh refinement. Every contrast here solves today: a SolverError
+// would be a regression, not an acceptable answer.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -29,14 +30,7 @@ double punch_force(double top_E, double bottom_E, Fidelity fidelity, double dept
 TEST(ExtremeContrast, ContrastsToOneE8AreFiniteAndBoundedByTheHomogeneousBlocks) {
   for (double contrast : {1e4, 1e6, 1e8}) {
     const double top = kDermis * contrast;
-    double layered = 0.0;
-    try {
-      layered = punch_force(top, kDermis, Fidelity::Fast);
-    } catch (const SolverError& e) {
-      // Acceptable only with a message; an exception without one would be a bug.
-      EXPECT_NE(std::string(e.what()), "") << contrast;
-      continue;
-    }
+    const double layered = punch_force(top, kDermis, Fidelity::Fast);
     const double soft = punch_force(kDermis, kDermis, Fidelity::Fast);
     const double stiff = punch_force(top, top, Fidelity::Fast);
     std::cout << "contrast " << contrast << ": F/F_soft " << layered / soft << ", F/F_stiff "
