@@ -11,6 +11,7 @@ packages=(
   libnlopt-cxx-dev libnlopt-dev
   libsuitesparse-dev libopenblas-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang-14 libclang-rt-14-dev
   nlohmann-json3-dev libcli11-dev libtomlplusplus-dev libfmt-dev
 )
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "mneedle/base/error.h"
+#include "needle/ply_check.h"
 
 namespace mneedle {
 namespace {
@@ -140,6 +141,7 @@ void precheck_file(const std::filesystem::path& file, const std::string& extensi
     if (is_text(bytes)) fail(file, "not a mesh: neither ASCII STL ('solid ...') nor binary STL");
     check_binary_stl(file, bytes);
   }
+  if (extension == ".ply") ply::check_structure(file, bytes);
   if (extension == ".stl" && is_binary_stl_size(bytes)) {
     check_binary_stl(file, bytes);
   } else if (is_text(bytes)) {

@@ -111,7 +111,7 @@ TEST(MeshIo, PlyFaceIndexOutOfRangeIsAnErrorNotACrash) {
        {"bad_index_ascii.ply", "negative_index_ascii.ply", "bad_index_binary.ply"}) {
     const std::string message = load_error(asset(name));
     EXPECT_TRUE(starts_with(message, asset(name).string() + ": ")) << message;
-    EXPECT_TRUE(contains(message, "a face refers to vertices the file does not hold")) << message;
+    EXPECT_TRUE(contains(message, "refers to vertex")) << message;
   }
 }
 
