@@ -17,6 +17,7 @@
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
+#include "mneedle/insertion/insertion_run.h"
 #include "mneedle/insertion/surface_loads.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
@@ -82,10 +83,13 @@ ForceResult compute(const ForceOptions& options) {
   // Plugins are searched only when a needle needs one, so STL-only scenes run without them.
   const PluginRegistry registry =
       needs_plugins(scene) ? PluginRegistry::discover(options.plugin_dirs) : PluginRegistry();
-  for (const NeedleSpec& spec : scene.needles) {
-    const NeedleSource needle = needle_from_scene(registry, spec);
+  // The same placement checks as `simulate`: a needle wider than the block or two needles on
+  // the same tissue would otherwise give curves for a scene that cannot exist.
+  const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene);
+  check_needle_placement(scene, needles);
+  for (const PreparedNeedle& needle : needles) {
     const SurfaceLoadModel model(needle.mesh, constants);
-    result.curves.push_back({spec.name, model.curve(depths), model.beta_length_m()});
+    result.curves.push_back({needle.name, model.curve(depths), model.beta_length_m()});
   }
   return result;
 }

@@ -288,6 +288,7 @@ TEST(ErrorPaths, EveryBadInputGivesOneClearLineAndNoInternalText) {
       {"force: --max-points text", "force {D}/good.toml --max-points abc", 2},
       {"force: --max-points zero", "force {D}/good.toml --max-points 0", 2},
       {"force: --max-points negative", "force {D}/good.toml --max-points=-5", 2},
+      {"force: two needles on the same tissue", "force {D}/two_needles.toml", 1},
       {"inspect: OFF cut short", "inspect {D}/short.off --unit mm", 1},
       {"force: unknown plugin in scene", "force {D}/unknown_plugin.toml", 1},
       {"force: --plugin-dir missing", "force {D}/good.toml --plugin-dir {D}/missing_dir", 1},

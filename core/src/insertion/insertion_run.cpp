@@ -549,43 +549,6 @@ std::vector<RunPoint> total_curve(const std::vector<NeedleRun>& needles) {
   return total;
 }
 
-void check_needles(const Scene& scene, const std::vector<PreparedNeedle>& needles) {
-  if (needles.size() != scene.needles.size())
-    throw InputError(scene.source_name + ": needles: " + std::to_string(scene.needles.size()) +
-                     " in the scene but " + std::to_string(needles.size()) + " prepared");
-  if (!(scene.insertion.depth > 0.0))
-    throw InputError(scene.source_name + ": insertion.depth: must be positive");
-  // What enters the tissue must fit in the block, and two needles cannot share tissue: a file
-  // read in the wrong unit (mm as m) or a copied `at` otherwise runs and reports nonsense.
-  // The same radius the planner sizes the model from: every face reaching below the depth counts
-  // whole, so a coarse mesh whose next vertex ring lies above the depth is not read as radius 0.
-  std::vector<double> radius(needles.size(), 0.0);
-  for (std::size_t i = 0; i < needles.size(); ++i) {
-    radius[i] = fe::NeedleShape(needles[i].mesh).max_radius_up_to(scene.insertion.depth);
-    const NeedleSpec& spec = scene.needles[i];
-    const std::string where =
-        scene.source_name + ":" + std::to_string(spec.line) + ": needle '" + spec.name + "': ";
-    const double half_x = 0.5 * scene.tissue.size[0], half_y = 0.5 * scene.tissue.size[1];
-    if (std::abs(needles[i].x) + radius[i] > half_x || std::abs(needles[i].y) + radius[i] > half_y)
-      throw InputError(where + format_quantity(2.0 * radius[i], Dimension::Length) + " wide at (" +
-                       format_quantity(needles[i].x, Dimension::Length) + ", " +
-                       format_quantity(needles[i].y, Dimension::Length) +
-                       "), it does not fit in the " +
-                       format_quantity(scene.tissue.size[0], Dimension::Length) + " x " +
-                       format_quantity(scene.tissue.size[1], Dimension::Length) +
-                       " block (is the mesh's unit right?)");
-    for (std::size_t j = 0; j < i; ++j)
-      if (std::hypot(needles[i].x - needles[j].x, needles[i].y - needles[j].y) <
-          radius[i] + radius[j])
-        throw InputError(
-            where + "overlaps needle '" + scene.needles[j].name + "' (axes " +
-            format_quantity(std::hypot(needles[i].x - needles[j].x, needles[i].y - needles[j].y),
-                            Dimension::Length) +
-            " apart, radii " + format_quantity(radius[i], Dimension::Length) + " and " +
-            format_quantity(radius[j], Dimension::Length) + ")");
-  }
-}
-
 // One rung of the pre-puncture model: the FE (or analytic) run for plan.horizon_m, with the
 // planner's reductions checked. Fills the run's mesh summary and crack depth.
 PreResult run_pre(RunPlan& plan, const Scene& scene, const std::vector<PreparedNeedle>& needles,
@@ -632,10 +595,47 @@ bool every_needle_crossed(const RunPlan& plan, const PreResult& pre) {
 
 }  // namespace
 
+void check_needle_placement(const Scene& scene, const std::vector<PreparedNeedle>& needles) {
+  if (needles.size() != scene.needles.size())
+    throw InputError(scene.source_name + ": needles: " + std::to_string(scene.needles.size()) +
+                     " in the scene but " + std::to_string(needles.size()) + " prepared");
+  if (!(scene.insertion.depth > 0.0))
+    throw InputError(scene.source_name + ": insertion.depth: must be positive");
+  // What enters the tissue must fit in the block, and two needles cannot share tissue: a file
+  // read in the wrong unit (mm as m) or a copied `at` otherwise runs and reports nonsense.
+  // The same radius the planner sizes the model from: every face reaching below the depth counts
+  // whole, so a coarse mesh whose next vertex ring lies above the depth is not read as radius 0.
+  std::vector<double> radius(needles.size(), 0.0);
+  for (std::size_t i = 0; i < needles.size(); ++i) {
+    radius[i] = fe::NeedleShape(needles[i].mesh).max_radius_up_to(scene.insertion.depth);
+    const NeedleSpec& spec = scene.needles[i];
+    const std::string where =
+        scene.source_name + ":" + std::to_string(spec.line) + ": needle '" + spec.name + "': ";
+    const double half_x = 0.5 * scene.tissue.size[0], half_y = 0.5 * scene.tissue.size[1];
+    if (std::abs(needles[i].x) + radius[i] > half_x || std::abs(needles[i].y) + radius[i] > half_y)
+      throw InputError(where + format_quantity(2.0 * radius[i], Dimension::Length) + " wide at (" +
+                       format_quantity(needles[i].x, Dimension::Length) + ", " +
+                       format_quantity(needles[i].y, Dimension::Length) +
+                       "), it does not fit in the " +
+                       format_quantity(scene.tissue.size[0], Dimension::Length) + " x " +
+                       format_quantity(scene.tissue.size[1], Dimension::Length) +
+                       " block (is the mesh's unit right?)");
+    for (std::size_t j = 0; j < i; ++j)
+      if (std::hypot(needles[i].x - needles[j].x, needles[i].y - needles[j].y) <
+          radius[i] + radius[j])
+        throw InputError(
+            where + "overlaps needle '" + scene.needles[j].name + "' (axes " +
+            format_quantity(std::hypot(needles[i].x - needles[j].x, needles[i].y - needles[j].y),
+                            Dimension::Length) +
+            " apart, radii " + format_quantity(radius[i], Dimension::Length) + " and " +
+            format_quantity(radius[j], Dimension::Length) + ")");
+  }
+}
+
 InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>& needles,
                            const InsertionRunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  check_needles(scene, needles);
+  check_needle_placement(scene, needles);
   // The pre-puncture model climbs the horizon ladder (docs/model.md, "Pre-puncture horizon"):
   // rung k is built for 100 um x 2^k whatever depth was asked, and the first rung on which every
   // criterion fires (or that covers the requested depth) gives the answer. The same needle and

@@ -130,4 +130,9 @@ struct InsertionRun {
 InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>& needles,
                            const InsertionRunOptions& options = {});
 
+/// What enters the tissue fits in the block and no two needles share tissue: InputError naming
+/// the scene line and the needle otherwise (a mesh read in the wrong unit, a copied `at`). Every
+/// command that puts the scene's needles in the block calls it.
+void check_needle_placement(const Scene& scene, const std::vector<PreparedNeedle>& needles);
+
 }  // namespace mneedle
