@@ -1,5 +1,5 @@
 #pragma once
-// The checks on what a plugin declares (docs/plugins.md, "What the host checks"): its descriptor
+// The checks on what a plugin declares (docs/plugins.md, "Build, load, check"): its descriptor
 // struct and every shape and parameter in it. Plain data in, InputError out; no library is loaded
 // here, so the checks can be tested and fuzzed on descriptor structs built in memory.
 

@@ -1,5 +1,5 @@
 // libFuzzer harness: the mesh loader (STL, OBJ, PLY, OFF through assimp, with the checks mneedle
-// runs before assimp sees a file; docs/cli.md, "Mesh files") and the mesh validation after it.
+// runs before assimp sees a file; docs/cli.md, "mneedle inspect") and the mesh validation after it.
 // The format is chosen from the content, as a user's file would be named, so the repository's
 // test meshes seed every format. A clean InputError is the only acceptable failure.
 #include <unistd.h>

@@ -1,5 +1,5 @@
-// libFuzzer harness: the quantity parser (docs/cli.md, "Units"). A clean InputError is the only
-// acceptable failure; any other exception, a crash or a sanitizer report is a bug.
+// libFuzzer harness: the quantity parser (docs/cli.md, introduction). A clean InputError is the
+// only acceptable failure; any other exception, a crash or a sanitizer report is a bug.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>

@@ -1,5 +1,5 @@
 // libFuzzer harness: the scene parser (docs/scene.md). A clean InputError is the only acceptable
-// failure; a scene that parses must hold only the finite, positive values its checks promise.
+// failure; any other exception, a crash or a sanitizer report is a bug.
 #include <cstddef>
 #include <cstdint>
 #include <string>

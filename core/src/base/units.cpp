@@ -139,9 +139,9 @@ struct Parsed {
   std::string unit;  // blanks collapsed; empty for a plain number
 };
 
-// number × factor, except for a submultiple whose inverse is a whole number (um, mm, mN, kPa's
-// inverse is not needed): there number ÷ inverse, which IEEE rounds correctly, so "10 um" is the
-// double nearest 1e-5 — the value a plugin's bound "10e-6" holds — not 10 × 1e-6 = 9.999…e-6.
+// number × factor, except for a submultiple whose inverse is a whole number (um, mm, mN): there
+// number ÷ inverse, which IEEE rounds correctly, so "10 um" is the double nearest 1e-5 — the value
+// a plugin's bound "10e-6" holds — not 10 × 1e-6 = 9.999…e-6.
 double to_si(double number, double factor) {
   if (factor < 1.0) {
     const double inverse = std::round(1.0 / factor);

@@ -1,7 +1,8 @@
 #pragma once
 // A PLY file's structure checked before assimp reads it: Debian's assimp 5.2 reads past the end
 // of a binary PLY whose data is shorter than its header declares (SIGSEGV, found by fuzz_mesh),
-// and it cannot be patched here, so mneedle refuses such files itself (docs/cli.md, "Mesh files").
+// and it cannot be patched here, so mneedle refuses such files itself (docs/cli.md, "mneedle
+// inspect").
 
 #include <filesystem>
 #include <string>

@@ -1,7 +1,7 @@
 #pragma once
 // Reading a user's input file and creating a user's output folder, with the one-line errors of
-// docs/cli.md ("Errors"): a folder where a file is expected, or a file where a folder is, is the
-// user's mistake (InputError naming the path), never a library exception.
+// docs/cli.md ("Exit status"): a folder where a file is expected, or a file where a folder is, is
+// the user's mistake (InputError naming the path), never a library exception.
 
 #include <filesystem>
 #include <string>
