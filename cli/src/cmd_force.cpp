@@ -31,6 +31,7 @@ struct ForceOptions {
   bool csv = false;
   std::string step = "10um";
   long max_points = 1'000'000;
+  std::size_t max_needles = kDefaultMaxNeedles;
   std::vector<std::filesystem::path> plugin_dirs;
 };
 
@@ -85,7 +86,7 @@ ForceResult compute(const ForceOptions& options) {
       needs_plugins(scene) ? PluginRegistry::discover(options.plugin_dirs) : PluginRegistry();
   // The same placement checks as `simulate`: a needle wider than the block or two needles on
   // the same tissue would otherwise give curves for a scene that cannot exist.
-  const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene);
+  const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene, options.max_needles);
   check_needle_placement(scene, needles);
   for (const PreparedNeedle& needle : needles) {
     const SurfaceLoadModel model(needle.mesh, constants);
@@ -150,6 +151,9 @@ void add_force_command(CLI::App& app) {
   cmd->add_option("--max-points", options->max_points,
                   "Largest number of depths a curve may have (default 1000000)")
       ->check(CLI::Range(1L, 1'000'000'000L));
+  cmd->add_option("--max-needles", options->max_needles, "Most needles the scene may hold")
+      ->capture_default_str()
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1'000'000}));
   cmd->add_option("--plugin-dir", options->plugin_dirs, "Extra folder to search for plugins");
   cmd->callback([options] {
     const ForceResult result = compute(*options);

@@ -232,7 +232,9 @@ void run(const SimulateOptions& o) {
   }
   const PluginRegistry registry =
       PluginRegistry::discover({o.plugin_dirs.begin(), o.plugin_dirs.end()});
-  const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene);
+  // Checked before any needle is built: the finite element limit below would otherwise come
+  // only after every mesh of a 10 000-needle scene was made.
+  const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene, o.max_needles);
   for (const PreparedNeedle& n : needles) {
     if (!n.frame_note.empty())
       std::cerr << "mneedle: needle " << n.name << ": " << n.frame_note << "\n";
@@ -278,7 +280,7 @@ void add_simulate_command(CLI::App& app) {
       "  mneedle simulate tests/assets/scenes/axisymmetric_punch.toml --csv");
   cmd->add_option("--plugin-dir", options->plugin_dirs, "Extra plugin folder (repeatable)");
   cmd->add_option("--max-needles", options->max_needles,
-                  "Most needles one finite element model may hold")
+                  "Most needles the scene may hold (each finite element model holds them all)")
       ->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
   cmd->add_flag("--no-reductions", options->no_reductions,

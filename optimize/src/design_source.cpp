@@ -193,7 +193,12 @@ bool mirror_symmetric_x0(const TriangleMesh& mesh) {
   return maps_onto_itself(mesh, {-1.0, 1.0, 1.0});
 }
 
-std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, const Scene& scene) {
+std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, const Scene& scene,
+                                            std::size_t max_needles) {
+  if (scene.needles.size() > max_needles)
+    throw InputError(scene.source_name + ": needles: " + std::to_string(scene.needles.size()) +
+                     " needles, above the limit of " + std::to_string(max_needles) +
+                     " (raise it with --max-needles)");
   std::vector<PreparedNeedle> prepared;
   for (const NeedleSpec& spec : scene.needles) {
     const std::string where =

@@ -635,3 +635,35 @@ TEST(ErrorPaths, EveryBadInputGivesOneClearLineAndNoInternalText) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(WorkLimits, SceneWithMoreNeedlesThanTheLimitIsRefusedBeforeAnyNeedleIsBuilt) {
+  // Every needle names a file that is not a mesh: had one been read before the count was
+  // checked, the error would be "not a mesh" (after minutes of work, were the meshes good).
+  const fs::path dir = fs::temp_directory_path() / ("mneedle_limits_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::string scene = kTissue;
+  for (int i = 0; i < 1001; ++i)
+    scene += "\n[[needles]]\ngeometry = { stl = \"junk.stl\", unit = \"um\" }\n";
+  write_file(dir / "many.toml", scene + kInsertion);
+  write_file(dir / "junk.stl", "hello, this is not a mesh\n");
+  const std::string file = "'" + (dir / "many.toml").string() + "'";
+  for (const std::string& command : {"force " + file, "simulate " + file + " --max-needles 1000"}) {
+    SCOPED_TRACE(command);
+    const auto run = run_mneedle(command);
+    EXPECT_EQ(run.exit_code, 1) << run.err;
+    EXPECT_NE(run.err.find("needles: 1001 needles, above the limit of 1000 (raise it with "
+                           "--max-needles)"),
+              std::string::npos)
+        << run.err;
+  }
+  // Raised far enough, the same scene gets as far as its first needle.
+  const auto raised = run_mneedle("force " + file + " --max-needles 1001");
+  EXPECT_NE(raised.err.find("junk.stl: not a mesh"), std::string::npos) << raised.err;
+  const auto fe = run_mneedle("simulate " + file);
+  EXPECT_NE(fe.err.find("1001 needles, above the limit of 16"), std::string::npos) << fe.err;
+  fs::remove_all(dir);
+}
+
+}  // namespace

@@ -2,8 +2,6 @@
 // runs before assimp sees a file; docs/cli.md, "mneedle inspect") and the mesh validation after it.
 // The format is chosen from the content, as a user's file would be named, so the repository's
 // test meshes seed every format. A clean InputError is the only acceptable failure.
-#include <unistd.h>
-
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -28,9 +26,10 @@ std::string extension_for(std::string_view text) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
-  const std::filesystem::path file =
-      std::filesystem::temp_directory_path() /
-      ("mneedle_fuzz_mesh_" + std::to_string(::getpid()) + extension_for(text));
+  // A relative name in the working folder run_fuzzer.cmake gives each harness: the error messages
+  // hold the path, and libFuzzer learns from the bytes the harness compares, so a path that held
+  // the process id or the machine's folders made runs with the same seed take different inputs.
+  const std::filesystem::path file = "fuzz_input" + std::string(extension_for(text));
   std::ofstream(file, std::ios::binary).write(text.data(), static_cast<std::streamsize>(size));
   try {
     const mneedle::TriangleMesh mesh = mneedle::load_mesh(file, 1e-3);

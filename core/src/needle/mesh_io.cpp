@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "mneedle/base/error.h"
+#include "needle/off_check.h"
 #include "needle/ply_check.h"
 
 namespace mneedle {
@@ -142,6 +143,7 @@ void precheck_file(const std::filesystem::path& file, const std::string& extensi
     check_binary_stl(file, bytes);
   }
   if (extension == ".ply") ply::check_structure(file, bytes);
+  if (extension == ".off") off::check_structure(file, bytes);
   if (extension == ".stl" && is_binary_stl_size(bytes)) {
     check_binary_stl(file, bytes);
   } else if (is_text(bytes)) {

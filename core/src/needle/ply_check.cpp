@@ -79,10 +79,13 @@ void check_face_size(const std::filesystem::path& file, std::uint64_t n, std::ui
 void check_index(const std::filesystem::path& file, double index, std::uint64_t face,
                  std::uint64_t vertices) {
   if (!(index >= 0.0 && index < static_cast<double>(vertices)) ||
-      index != static_cast<double>(static_cast<std::uint64_t>(index)))
-    fail(file, "PLY face " + std::to_string(face) + " refers to vertex " +
-                   std::to_string(static_cast<long long>(index)) + " of " +
+      index != static_cast<double>(static_cast<std::uint64_t>(index))) {
+    // Printed as written: an index like 2e99 or -1.5 has no integer to convert to.
+    std::ostringstream shown;
+    shown << index;
+    fail(file, "PLY face " + std::to_string(face) + " refers to vertex " + shown.str() + " of " +
                    std::to_string(vertices));
+  }
 }
 
 // A list's count, read in the file's byte order; negative counts are malformed.
@@ -125,8 +128,10 @@ void check_ascii(const std::filesystem::path& file, const std::string& bytes, st
         double value = 0.0;
         if (!(words >> value)) bad("fewer numbers than its properties");
         if (p.count_size == 0) continue;
-        if (!(value >= 0.0) || value != static_cast<double>(static_cast<std::uint64_t>(value)))
-          bad("a list length that is not a whole number >= 0");
+        // Range first: converting a length of 1e30 to an integer is itself undefined.
+        if (!(value >= 0.0 && value < 4294967296.0) ||
+            value != static_cast<double>(static_cast<std::uint64_t>(value)))
+          bad("a list length that is not a whole number from 0 to 2^32 - 1");
         const auto length = static_cast<std::uint64_t>(value);
         if (face_list(e.name, p)) check_face_size(file, length, i);
         for (std::uint64_t k = 0; k < length; ++k) {
@@ -148,6 +153,9 @@ void check_structure(const std::filesystem::path& file, const std::string& bytes
   if (end == std::string::npos) fail(file, "PLY header without 'end_header'");
   std::size_t data = bytes.find('\n', end);
   data = data == std::string::npos ? bytes.size() : data + 1;
+  // 'end_header' alone on its line: assimp 5.2 read for ever on one followed by other bytes.
+  if ((end > 0 && bytes[end - 1] != '\n') || bytes.find_first_not_of(" \t\r\n", end + 10) < data)
+    fail(file, "PLY 'end_header' is not alone on its line");
 
   std::istringstream header(bytes.substr(0, end));
   std::string format;

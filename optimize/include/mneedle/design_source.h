@@ -70,7 +70,14 @@ bool mirror_symmetric_y0(const TriangleMesh& mesh);
 /// The same for the image (-x, y, z): symmetric about its x = 0 plane (bodies of revolution).
 bool mirror_symmetric_x0(const TriangleMesh& mesh);
 
-/// Every needle of the scene ready for run_insertion, in the scene's order.
-std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, const Scene& scene);
+/// The number of needles a scene may hold unless the caller says otherwise: each one is a mesh
+/// to build or read and a curve to compute, so a scene of 10 000 needles would work for minutes
+/// before anything else could refuse it.
+inline constexpr std::size_t kDefaultMaxNeedles = 1000;
+
+/// Every needle of the scene ready for run_insertion, in the scene's order. Throws InputError
+/// before any needle is built when the scene holds more than `max_needles`.
+std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, const Scene& scene,
+                                            std::size_t max_needles = kDefaultMaxNeedles);
 
 }  // namespace mneedle

@@ -107,6 +107,8 @@ TEST(PlyCheck, AsciiLineShorterOrLongerThanItsPropertiesIsRefusedWithItsLine) {
             std::string::npos);
   EXPECT_NE(error_of(header + vertices + "2.5 0 1\n").find("not a whole number"),
             std::string::npos);
+  EXPECT_NE(error_of(header + vertices + "1e30 0 1 2\n").find("not a whole number from 0 to"),
+            std::string::npos);
 }
 
 }  // namespace
@@ -153,6 +155,40 @@ TEST(PlyCheck, HeaderLineWithAnUnknownKeywordIsRefused) {
       "property float z\nelemXnt face 1\nend_header\n0 0 0\n1 0 0\n0 1 0\n");
   EXPECT_NE(message.find("'elemXnt face 1' is not a PLY header keyword"), std::string::npos)
       << message;
+}
+
+}  // namespace
+
+namespace {
+
+TEST(PlyCheck, FaceIndexBeyondAnyIntegerIsRefusedAndPrintedAsWritten) {
+  // fuzz_mesh's eighth find: the error message itself converted 2e99 to an integer (undefined).
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty "
+      "float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 "
+      "0\n0 1 0\n";
+  EXPECT_NE(error_of(header + "3 0 1 2e99\n").find("PLY face 0 refers to vertex 2e+99 of 3"),
+            std::string::npos)
+      << error_of(header + "3 0 1 2e99\n");
+  EXPECT_NE(error_of(header + "3 0 1 -1e300\n").find("refers to vertex -1e+300 of 3"),
+            std::string::npos);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(PlyCheck, EndHeaderFollowedByOtherBytesOnItsLineIsRefused) {
+  // fuzz_mesh's tenth find: assimp 5.2 read for ever after 'end_header' and bytes on its line.
+  const std::string start =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty "
+      "float z\nelement face 1\nproperty list uchar int vertex_indices\n";
+  const std::string data = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  EXPECT_EQ(error_of(start + "end_header\xff\xff\n" + data),
+            "m.ply: PLY 'end_header' is not alone on its line");
+  EXPECT_EQ(error_of(start + "xend_header\n" + data),
+            "m.ply: PLY 'end_header' is not alone on its line");
+  EXPECT_EQ(error_of(start + "end_header \r\n" + data), "");  // trailing blanks are harmless
 }
 
 }  // namespace

@@ -1,0 +1,82 @@
+#include "needle/off_check.h"
+
+#include <cstdint>
+#include <regex>
+#include <sstream>
+#include <vector>
+
+#include "mneedle/base/error.h"
+
+namespace mneedle::off {
+namespace {
+
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& problem) {
+  throw InputError(file.string() + ": " + problem);
+}
+
+// The file's lines with comments ('#' to the end of the line) removed and blank lines dropped;
+// each keeps its line number for the error message.
+struct Line {
+  std::size_t number = 0;
+  std::string text;
+};
+
+std::vector<Line> content_lines(const std::string& bytes) {
+  std::vector<Line> lines;
+  std::istringstream in(bytes);
+  std::string text;
+  for (std::size_t number = 1; std::getline(in, text); ++number) {
+    text = text.substr(0, text.find('#'));
+    if (text.find_first_not_of(" \t\r\f\v") != std::string::npos) lines.push_back({number, text});
+  }
+  return lines;
+}
+
+bool is_count(const std::string& token) {
+  return !token.empty() && token.size() <= 18 &&
+         token.find_first_not_of("0123456789") == std::string::npos;
+}
+
+}  // namespace
+
+void check_structure(const std::filesystem::path& file, const std::string& bytes) {
+  const std::vector<Line> lines = content_lines(bytes);
+  // The header's tokens may share a line or not ("OFF 3 1 0" or "OFF\n3 1 0"): read tokens until
+  // the counts are complete, remembering which line the last of them is on.
+  static const std::regex keyword("(ST)?C?N?4?(n)?OFF");
+  std::vector<std::string> counts;
+  bool dimension_pending = false;
+  std::size_t header_end = 0;  // index into `lines` of the first data line
+  for (std::size_t k = 0; k < lines.size() && counts.size() < 3; ++k) {
+    std::istringstream tokens(lines[k].text);
+    std::string token;
+    while (counts.size() < 3 && tokens >> token) {
+      std::smatch match;
+      if (k == 0 && counts.empty() && !dimension_pending &&
+          std::regex_match(token, match, keyword)) {
+        dimension_pending = match[2].matched;  // "nOFF" is followed by the dimension
+        continue;
+      }
+      if (dimension_pending) {
+        dimension_pending = false;
+        continue;
+      }
+      if (!is_count(token))
+        fail(file, "OFF header line " + std::to_string(lines[k].number) + ": '" + token +
+                       "' is not a vertex, face or edge count (a whole number >= 0)");
+      counts.push_back(token);
+    }
+    if (counts.size() == 3) header_end = k + 1;
+  }
+  if (counts.size() < 3) fail(file, "OFF header ends before its vertex, face and edge counts");
+  const std::uint64_t vertices = std::stoull(counts[0]);
+  const std::uint64_t faces = std::stoull(counts[1]);
+  const std::uint64_t data_lines = lines.size() - header_end;
+  // Checked before assimp reads the file: it allocates for every declared vertex and face first.
+  if (vertices + faces > data_lines)
+    fail(file, "OFF header declares " + std::to_string(vertices) + " vertices and " +
+                   std::to_string(faces) + " faces but the data has " + std::to_string(data_lines) +
+                   " lines");
+}
+
+}  // namespace mneedle::off
