@@ -374,6 +374,24 @@ constexpr const char* kCsvColumns[] = {"design",
                                        "error",
                                        "hash"};
 
+std::string csv_header() {
+  std::string header;
+  for (const char* c : kCsvColumns) {
+    if (!header.empty()) header += ',';
+    header += c;
+  }
+  return header;
+}
+
+std::string csv_line(const json& j) {
+  std::string line;
+  for (const char* c : kCsvColumns) {
+    if (!line.empty()) line += ',';
+    line += csv_field(j, c);
+  }
+  return line;
+}
+
 class ResultWriter {
  public:
   explicit ResultWriter(const std::optional<fs::path>& out) {
@@ -383,24 +401,12 @@ class ResultWriter {
     jsonl_.open(*out / "results.jsonl", std::ios::app);
     csv_.open(*out / "results.csv", std::ios::app);
     if (!jsonl_ || !csv_) throw InputError(out->string() + ": cannot write results");
-    if (fresh_csv) {
-      std::string header;
-      for (const char* c : kCsvColumns) {
-        if (!header.empty()) header += ',';
-        header += c;
-      }
-      csv_ << header << "\n" << std::flush;
-    }
+    if (fresh_csv) csv_ << csv_header() << "\n" << std::flush;
   }
 
   void write(const ScreeningRow& row) {
     if (!jsonl_.is_open()) return;
-    const json j = json::parse(row.json);
-    std::string line;
-    for (const char* c : kCsvColumns) {
-      if (!line.empty()) line += ',';
-      line += csv_field(j, c);
-    }
+    const std::string line = csv_line(json::parse(row.json));
     // Flushed per row: a run killed half-way keeps every finished design.
     jsonl_ << row.json << "\n" << std::flush;
     csv_ << line << "\n" << std::flush;
@@ -409,6 +415,31 @@ class ResultWriter {
  private:
   std::ofstream jsonl_, csv_;
 };
+
+// results.jsonl is the record; results.csv its table. A run killed between writing a row's JSON
+// line and its CSV line would leave the CSV one design short for good (the design is resumed
+// from the JSON line and not written again), so --resume rewrites the CSV from the JSON lines,
+// through a temporary file so that a kill during the rewrite loses nothing.
+void rebuild_csv(const fs::path& out) {
+  std::error_code error;
+  if (!fs::exists(out / "results.jsonl", error)) return;
+  std::ifstream in(out / "results.jsonl");
+  const fs::path temporary = out / "results.csv.partial";
+  {
+    std::ofstream csv(temporary, std::ios::trunc);
+    csv << csv_header() << "\n";
+    for (std::string line; std::getline(in, line);) {
+      try {
+        csv << csv_line(json::parse(line)) << "\n";
+      } catch (const json::exception&) {
+        // a line that is not a row was not resumed either; the design is evaluated again
+      }
+    }
+    csv.flush();
+    if (!csv) throw InputError((out / "results.csv").string() + ": cannot write results");
+  }
+  fs::rename(temporary, out / "results.csv");
+}
 
 }  // namespace
 
@@ -449,7 +480,7 @@ std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs
   std::map<std::string, ScreeningRow> done;
   if (options.resume && options.out) {
     done = finished_rows(*options.out / "results.jsonl");
-    truncate_partial_line(*options.out / "results.csv");
+    rebuild_csv(*options.out);
   }
   ResultWriter writer(options.out);
 

@@ -2,14 +2,22 @@
 // depth, bad designs among good ones, results kept on disk, JSON with units in its keys.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <random>
 #include <sstream>
+#include <thread>
+#include <vector>
 
 #include "fe/needle_meshes.h"
 #include "mneedle/needle/mesh_io.h"
@@ -271,6 +279,114 @@ TEST(StrengthCommand, UnknownMaterialAndMissingNeedleAreClearErrors) {
   run = run_mneedle("strength --material silicon");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("either a mesh FILE or --plugin"), std::string::npos) << run.err;
+}
+
+}  // namespace
+
+namespace {
+
+// Starts mneedle with `arguments` (output discarded) and SIGKILLs it after `delay` unless it has
+// finished by then; true when it finished on its own.
+bool finished_before_kill(const std::vector<std::string>& arguments,
+                          std::chrono::microseconds delay) {
+  const std::string binary = mneedle::test::mneedle_binary();
+  std::vector<char*> argv{const_cast<char*>(binary.c_str())};
+  for (const std::string& a : arguments) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, STDOUT_FILENO);
+    ::dup2(null, STDERR_FILENO);
+    ::execv(binary.c_str(), argv.data());
+    ::_exit(127);
+  }
+  const auto end = std::chrono::steady_clock::now() + delay;
+  int status = 0;
+  while (std::chrono::steady_clock::now() < end) {
+    if (::waitpid(pid, &status, WNOHANG) == pid) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ::kill(pid, SIGKILL);
+  ::waitpid(pid, &status, 0);
+  return false;
+}
+
+std::vector<nlohmann::json> jsonl_rows(const fs::path& file) {
+  std::vector<nlohmann::json> rows;
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);) {
+    nlohmann::json row = nlohmann::json::parse(line);
+    row.erase("seconds");  // the timings are the only fields that may differ between runs
+    row.erase("insertion_seconds");
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+TEST(ScreenCommand, KilledAndResumedAgainAndAgainListsEveryDesignOnceWithUninterruptedNumbers) {
+  // SIGKILL at seeded moments (at most 20 kills), each time resumed: a kill can land inside a
+  // JSON line, between a row's JSON and CSV lines, or during the resume's own rewrite of the CSV.
+  const fs::path dir = fs::temp_directory_path() / ("mneedle_kill_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream list(dir / "designs.toml");
+  for (int i = 0; i < 48; ++i)
+    list << "[[designs]]\nname = \"cone_" << i << "\"\nplugin = \"cone\"\ndiameter = \""
+         << 150 + 5 * i << " um\"\n\n";
+  list.close();
+  const std::string scene = kRoot + "/designs/scenes/paper_a_silicone_blunt_bevel.toml";
+  const auto arguments = [&](const std::string& out) {
+    return std::vector<std::string>{"screen",  (dir / "designs.toml").string(),
+                                    "--scene", scene,
+                                    "--model", "analytic",
+                                    "--jobs",  "2",
+                                    "--out",   (dir / out).string(),
+                                    "--resume"};
+  };
+  const auto start = std::chrono::steady_clock::now();
+  ASSERT_TRUE(finished_before_kill(arguments("whole"), std::chrono::seconds(120)));
+  const auto whole_run = std::chrono::duration_cast<std::chrono::microseconds>(
+      std::chrono::steady_clock::now() - start);
+
+  // Each run lives a twentieth to a quarter of a whole one (start-up is about a twentieth), so
+  // it finishes a few designs before its kill; sooner or later one outlives its kill.
+  std::mt19937 random(2026);
+  std::uniform_int_distribution<long> delay_us(whole_run.count() / 20, whole_run.count() / 4);
+  int kills = 0;
+  while (kills < 20 &&
+         !finished_before_kill(arguments("killed"), std::chrono::microseconds(delay_us(random))))
+    ++kills;
+  EXPECT_GE(kills, 5) << "too few kills to test anything";
+  ASSERT_TRUE(finished_before_kill(arguments("killed"), std::chrono::seconds(120)));
+
+  std::map<std::string, nlohmann::json> whole;
+  for (const auto& row : jsonl_rows(dir / "whole" / "results.jsonl"))
+    whole[row["design"].get<std::string>()] = row;
+  ASSERT_EQ(whole.size(), 48u);
+  std::map<std::string, int> seen;
+  for (const auto& row : jsonl_rows(dir / "killed" / "results.jsonl")) {
+    const std::string design = row["design"].get<std::string>();
+    ++seen[design];
+    EXPECT_EQ(row, whole[design]) << design;
+  }
+  EXPECT_EQ(seen.size(), 48u);
+  for (const auto& [design, count] : seen) EXPECT_EQ(count, 1) << design;
+
+  std::ifstream csv(dir / "killed" / "results.csv");
+  std::string header;
+  ASSERT_TRUE(std::getline(csv, header));
+  const auto fields = [](const std::string& line) {
+    return std::count(line.begin(), line.end(), ',') + 1;
+  };
+  std::map<std::string, int> csv_seen;
+  for (std::string line; std::getline(csv, line);) {
+    EXPECT_EQ(fields(line), fields(header)) << line;
+    ++csv_seen[line.substr(0, line.find(','))];
+  }
+  EXPECT_EQ(csv_seen.size(), 48u);
+  for (const auto& [design, count] : csv_seen) EXPECT_EQ(count, 1) << design;
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -144,6 +144,33 @@ TEST_F(Screening, ResumeAfterAHalfWrittenLineListsEveryDesignOnceOnLinesOfTheirO
   for (const auto& [design, count] : seen) EXPECT_EQ(count, 1) << design;
 }
 
+TEST_F(Screening, ResumeAfterAKillBetweenARowsJsonAndCsvLinesListsItInTheCsv) {
+  // The JSON line is written first: a kill right after it left the design resumed from it and
+  // missing from results.csv for good. The resume now rewrites the CSV from the JSON lines.
+  mneedle::ScreeningOptions options = analytic();
+  options.out = dir_ / "out";
+  const auto designs = mneedle::collect_designs({dir_ / "in"}, 1e-3);
+  mneedle::screen_designs(designs, scene_, scene_file_, registry_, options);
+  const auto csv_lines = [&] {
+    std::vector<std::string> lines;
+    std::ifstream in(dir_ / "out" / "results.csv");
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    return lines;
+  };
+  const std::vector<std::string> whole = csv_lines();
+  ASSERT_EQ(whole.size(), 5u);  // the header and four designs
+  {
+    std::ofstream out(dir_ / "out" / "results.csv", std::ios::trunc);
+    for (std::size_t i = 0; i < 4; ++i) out << whole[i] << "\n";
+    out << whole[4].substr(0, 7);  // and a kill inside the next CSV line, for good measure
+  }
+  options.resume = true;
+  const auto again = mneedle::screen_designs(designs, scene_, scene_file_, registry_, options);
+  for (const auto& row : again) EXPECT_TRUE(row.resumed) << row.design;
+  EXPECT_EQ(csv_lines(), whole);
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "results.csv.partial"));
+}
+
 TEST_F(Screening, IdenticalMeshesUnderTwoNamesAreTwoRows) {
   fs::copy_file(dir_ / "in" / "cone.stl", dir_ / "in" / "cone_copy.stl");
   mneedle::ScreeningOptions options = analytic();
