@@ -39,11 +39,13 @@ TetMesh punch_mesh(const TissueBlockSpec& base, double radius, double depth, int
 
 // Hayes et al. 1972 correction for a flat punch on a bonded layer, nu = 0.45, a/h = 0.4.
 constexpr double kHayesNu045Ratio04 = 1.599;
-// Justified in docs/validation.md, "Frictionless flat punch vs Hayes" (measured misses plus
-// margin).
-// The standard mesh (67 um elements at the site) reads 1.28 x Hayes: discretisation stiffness at
-// the punch rim, falling to 1.13 at 30 um elements (same section).
-constexpr double kFrictionlessPunchTolerance = 0.30;
+// Frictionless punch, docs/validation.md, "Frictionless flat punch vs Hayes": a displacement
+// finite element solution is stiffer than the exact one, so F >= F_Hayes; the standard mesh
+// (67 um elements at the site) reads 1.25 x Hayes (the rim singularity), falling under
+// refinement (ExtremePoisson.Tet10FrictionlessPunchApproachesHayesFromAboveUnderRefinement).
+// The upper bound is that reading plus 4 %: a change of the contact resolution moves it more.
+constexpr double kFrictionlessPunchLowest = 1.0;
+constexpr double kFrictionlessPunchHighest = 1.30;
 
 // a = 90 um on a mesh graded for the punch: its half-integer node spacing keeps the grid lines'
 // nodes off the rim, so the captured footprint does not hinge on round-off (docs/validation.md,
@@ -57,7 +59,10 @@ void check_bonded_punch(int order, double tolerance) {
   const double expected = 2 * a * E / (1 - nu * nu) * kHayesNu045Ratio04 * d;
   ASSERT_EQ(step.needles.size(), 1U);
   EXPECT_NEAR(step.needles[0].force_N / expected, 1.0, tolerance) << "order " << order;
-  EXPECT_NEAR(step.needles[0].contact_area_m2 / (std::numbers::pi * a * a), 1.0, 0.5);
+  // Rim faces count by the fraction of their nodes held: 0.972 of pi a^2 at both orders on this
+  // grid. A ring of nodes more or fewer is a strip about 2 pi a x (spacing / 2), over half of
+  // pi a^2, so 3 % either way catches any change of the captured footprint.
+  EXPECT_NEAR(step.needles[0].contact_area_m2 / (std::numbers::pi * a * a), 0.972, 0.03);
   EXPECT_LT(std::abs(step.needles[0].lateral_force_N[0]), 0.01 * step.needles[0].force_N);
   // Linear material and a flat punch: force proportional to depth, one factorisation.
   const Step3d deeper = run.advance_to(2 * d);
@@ -90,23 +95,30 @@ TEST(Indentation3d, StVenantKirchhoffPunchReducesToLinearAtSmallDepth) {
   EXPECT_NEAR(force[1] / force[0], 1.0, 1e-2);
 }
 
-TEST(Indentation3d, NeoHookeanConeConvergesWithAdaptiveStepsAndStiffensWithDepth) {
-  // 60-degree cone, 150 um radius, on a mesh graded for 100 um: at 40 um the footprint already
-  // spans a few node rings, so the force follows the cone rather than one captured node.
+TEST(Indentation3d, NeoHookeanConeFollowsTheLayersDepthLawWhenSteppedAlongItsPath) {
+  // 60-degree cone, 150 um radius, on a 300 um layer meshed for 100 um. Sticking contact is
+  // path dependent: a node keeps the place on the cone where it was captured, so the insertion
+  // is stepped (20 um) as a real one is. Jumping to 40 um in one step captured the footprint's
+  // nodes all at 40 um, gave a shallow force about 25 % low and a ratio F(80)/F(40) of 6.09.
   const TetMesh mesh =
       punch_mesh(homogeneous_block(MaterialModel::NeoHookean, 1e5, 0.45, 450e-6, 300e-6), 100e-6,
                  80e-6, 1, Fidelity::Standard);
   Indentation3d run(mesh, {{"cone", cone_needle(std::numbers::pi / 3, 150e-6, 1e-3), 0.0, 0.0}},
                     80e-6);
-  const Step3d shallow = run.advance_to(40e-6);
-  const Step3d deep = run.advance_to(80e-6);
-  EXPECT_GT(shallow.needles[0].force_N, 0.0);
-  // A cone's force grows with the square of depth (Sneddon): the ratio for 2x depth is near 4
-  // (measured 6.09: at 40 um the footprint, radius 69 um, holds only the rings at 0, 29 and
-  // 57 um of this TET4 grid, so the shallow force is low); captured ring by ring, hence the band.
+  Step3d shallow, deep;
+  for (int k = 1; k <= 4; ++k) {
+    const Step3d step = run.advance_to(k * 20e-6);
+    if (k == 2) shallow = step;
+    if (k == 4) deep = step;
+  }
+  ASSERT_GT(shallow.needles[0].force_N, 0.0);
+  // Reference: the linear cone on this layer, fine mesh, stepped 10/20/40/80 um: 4.74 (Sneddon's
+  // half-space gives 4; the footprint, 139 um at 80 um, is half the layer's thickness, and a
+  // bonded layer stiffens as a/h grows, as in Hayes et al. 1972). At 27 % nominal strain a
+  // neo-Hookean solid stays within 10 % of it (measured 4.59 here, 4.88 on the fine mesh; the
+  // spread is the ring-by-ring capture of this TET4 grid).
   const double ratio = deep.needles[0].force_N / shallow.needles[0].force_N;
-  EXPECT_GT(ratio, 3.0);
-  EXPECT_LT(ratio, 6.5);
+  EXPECT_NEAR(ratio / 4.74, 1.0, 0.10) << ratio;
   EXPECT_GT(deep.newton_iterations, 1);
   EXPECT_GT(deep.needles[0].captured_nodes, shallow.needles[0].captured_nodes);
   EXPECT_GT(deep.strain_energy_J, shallow.strain_energy_J);
@@ -383,7 +395,8 @@ TEST(Indentation3d, FrictionlessFlatPunchMatchesHayesLayerSolution) {
   const Step3d step = run.advance_to(d);
   const double expected = 2 * a * E / (1 - nu * nu) * kHayesNu045Ratio04 * d;
   ASSERT_EQ(step.needles.size(), 1U);
-  EXPECT_NEAR(step.needles[0].force_N / expected, 1.0, kFrictionlessPunchTolerance);
+  EXPECT_GE(step.needles[0].force_N / expected, kFrictionlessPunchLowest);
+  EXPECT_LE(step.needles[0].force_N / expected, kFrictionlessPunchHighest);
   // Contact area: quadrature points with positive pressure; the rim singularity makes the
   // pressure oscillate on quadratic faces, so part of the punch face reads as separated.
   EXPECT_GT(step.needles[0].contact_area_m2, 0.1 * std::numbers::pi * a * a);
