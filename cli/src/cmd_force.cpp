@@ -63,13 +63,6 @@ std::vector<double> depth_grid(double max_depth, double step, double max_points)
   return depths;
 }
 
-bool needs_plugins(const Scene& scene) {
-  for (const NeedleSpec& n : scene.needles) {
-    if (std::holds_alternative<PluginGeometry>(n.geometry)) return true;
-  }
-  return false;
-}
-
 ForceResult compute(const ForceOptions& options) {
   ForceResult result{load_scene(options.scene), {}};
   const Scene& scene = result.scene;

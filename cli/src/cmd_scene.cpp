@@ -1,17 +1,22 @@
 // `mneedle scene check FILE [--json]`: validate a scene file and print it in SI units.
 #include <CLI/CLI.hpp>
 
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "commands.h"
 #include "json_output.h"
 #include "loads_json.h"
 #include "mneedle/base/units.h"
+#include "mneedle/design_source.h"
+#include "mneedle/insertion/insertion_run.h"
+#include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
 
 namespace mneedle::cli {
@@ -255,18 +260,25 @@ void add_scene_command(CLI::App& app) {
   struct Options {
     std::string file;
     bool json = false;
+    std::vector<std::filesystem::path> plugin_dirs;
   };
   auto opts = std::make_shared<Options>();
   auto* check = scene->add_subcommand(
       "check", "Validate a scene file and print it with every value in SI units");
   check->add_option("FILE", opts->file, "Scene file (TOML)")->required();
   check->add_flag("--json", opts->json, "Print one JSON object (keys carry their SI unit)");
+  check->add_option("--plugin-dir", opts->plugin_dirs, "Extra folder to search for plugins");
   check->footer(
       "Example:\n  mneedle scene check designs/scenes/human_skin.toml\n"
       "  mneedle scene check designs/scenes/human_skin.toml --json\n"
       "An invalid scene prints one line naming file:line, the key and the problem; exit 1.\n");
   check->callback([opts] {
     const Scene s = load_scene(opts->file);
+    // The needles are built and placed as every command that runs the scene does: a mesh that
+    // is not a closed solid, a needle wider than the block or two on the same tissue fail here.
+    const PluginRegistry registry =
+        needs_plugins(s) ? PluginRegistry::discover(opts->plugin_dirs) : PluginRegistry();
+    check_needle_placement(s, prepare_needles(registry, s));
     // The summary prints the same values as the JSON: one check covers both.
     const Json tree = scene_to_json(s);
     require_finite_json(tree, "scene " + opts->file);

@@ -17,8 +17,10 @@
 #include "json_output.h"
 #include "loads_json.h"
 #include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
 #include "mneedle/fe/tissue_mesh.h"
+#include "mneedle/insertion/energy_check.h"
 #include "mneedle/insertion/insertion_run.h"
 #include "mneedle/needle/needle_frame.h"
 #include "mneedle/plugin_host.h"
@@ -109,6 +111,16 @@ nlohmann::json curve_json(const std::vector<RunPoint>& curve,
   return c;
 }
 
+nlohmann::json energy_check_json(const std::optional<EnergyCheck>& check) {
+  if (!check) return nullptr;
+  return {{"depth_m", check->depth_m},
+          {"work_J", check->work_J},
+          {"strain_energy_J", check->strain_energy_J},
+          {"relative_difference", check->relative_difference},
+          {"tolerance", kEnergyCheckTolerance},
+          {"passes", check->passes}};
+}
+
 nlohmann::json to_json(const InsertionRun& run, const Scene& scene) {
   nlohmann::json needles = nlohmann::json::array();
   for (const NeedleRun& n : run.needles) {
@@ -153,6 +165,8 @@ nlohmann::json to_json(const InsertionRun& run, const Scene& scene) {
           {"loads", resolved_loads_json(scene)},
           {"pre_puncture_horizon_m", run.horizon_m},
           {"pre_puncture_step_m", run.first_step_m},
+          {"energy_check", energy_check_json(run.energy_check)},
+          {"peak_memory_bytes", run.peak_memory_bytes},
           {"seconds", run.seconds}};
 }
 
@@ -243,6 +257,14 @@ void run(const SimulateOptions& o) {
   // Every format prints the numbers of this tree: check them once, before anything is printed.
   const nlohmann::json tree = to_json(result, scene);
   require_finite_json(tree, o.scene.string());
+  if (result.energy_check && !result.energy_check->passes)
+    std::cerr << "mneedle: warning: " << o.scene.string() << ": the tissue stores "
+              << std::setprecision(3) << 100.0 * (1.0 + result.energy_check->relative_difference)
+              << " % of the work the needle did on it up to "
+              << format_quantity(result.energy_check->depth_m, Dimension::Length) << " (more than "
+              << 100.0 * kEnergyCheckTolerance
+              << " % apart: the contact or the mesh is not resolved; docs/model.md, \"Energy "
+                 "check\")\n";
   if (o.json)
     std::cout << tree.dump(2) << "\n";
   else if (o.csv)

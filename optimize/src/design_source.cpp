@@ -193,6 +193,12 @@ bool mirror_symmetric_x0(const TriangleMesh& mesh) {
   return maps_onto_itself(mesh, {-1.0, 1.0, 1.0});
 }
 
+bool needs_plugins(const Scene& scene) {
+  return std::any_of(scene.needles.begin(), scene.needles.end(), [](const NeedleSpec& n) {
+    return std::holds_alternative<PluginGeometry>(n.geometry);
+  });
+}
+
 std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, const Scene& scene,
                                             std::size_t max_needles) {
   if (scene.needles.size() > max_needles)

@@ -307,6 +307,17 @@ TEST(CmdSimulate, OneMaterialSplitIntoLayersPuncturesWhereTheUnsplitOneDoes) {
   const fs::path dir = fs::temp_directory_path() / ("mneedle_split_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const double whole = gel_puncture_depth(dir / "one.toml", gel_layer("gel", "", "0.2 MPa"));
+  {
+    // The run's energy ledger up to the puncture: the axisymmetric cone stores 0.7 % less than
+    // the trapezoid work (docs/model.md, "Energy check"); a sign error or a lost step is 100 %.
+    const CommandRun run = run_mneedle("simulate '" + (dir / "one.toml").string() + "' --json");
+    const auto j = nlohmann::json::parse(run.out);
+    ASSERT_TRUE(j["energy_check"].is_object()) << run.out;
+    EXPECT_TRUE(j["energy_check"]["passes"].get<bool>());
+    EXPECT_NEAR(j["energy_check"]["depth_m"].get<double>(), whole, 1e-12);
+    EXPECT_GT(j["peak_memory_bytes"].get<double>(), 1e6);
+    EXPECT_EQ(run.err, "");  // no energy warning
+  }
   ASSERT_GT(whole, 100e-6);  // 639 um: well below every split
   for (const std::string thickness : {"50 um", "150 um", "300 um"}) {
     SCOPED_TRACE(thickness);

@@ -167,6 +167,7 @@ void write_inputs(const fs::path& dir) {
       {"unknown_plugin.toml",
        kTissue + "\n[[needles]]\ngeometry = { plugin = \"no_such_shape\" }\n" + kInsertion},
       {"two_needles.toml", kTissue + kNeedle + kNeedle + kInsertion},
+      {"wide_needle.toml", kTissue + replace_all(kNeedle, "200 um", "3 mm") + kInsertion},
       {"no_friction.toml", kTissue + kNeedle + "\n[loads]\nfriction = \"none\"\n" + kInsertion},
       // meshes
       {"empty.stl", ""},
@@ -229,6 +230,8 @@ TEST(ErrorPaths, EveryBadInputGivesOneClearLineAndNoInternalText) {
       {"scene check: unknown fidelity", "scene check {D}/unknown_fidelity.toml", 1},
       {"scene check: missing STL", "scene check {D}/missing_stl.toml", 1},
       {"scene check: no FILE", "scene check", 2},
+      {"scene check: two needles on one spot", "scene check {D}/two_needles.toml", 1},
+      {"scene check: needle wider than the block", "scene check {D}/wide_needle.toml", 1},
       {"plugins: describe unknown shape", "plugins describe no_such_shape", 1},
       {"plugins: describe empty name", "plugins describe ''", 1},
       {"plugins: list missing plugin dir", "plugins list --plugin-dir {D}/missing_dir", 1},
@@ -663,6 +666,30 @@ TEST(WorkLimits, SceneWithMoreNeedlesThanTheLimitIsRefusedBeforeAnyNeedleIsBuilt
   EXPECT_NE(raised.err.find("junk.stl: not a mesh"), std::string::npos) << raised.err;
   const auto fe = run_mneedle("simulate " + file);
   EXPECT_NE(fe.err.find("1001 needles, above the limit of 16"), std::string::npos) << fe.err;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(SceneCheck, RefusesNeedlesThatDoNotFitOrShareTissueAsEveryRunDoes) {
+  const fs::path dir = fs::temp_directory_path() / ("mneedle_place_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  write_file(dir / "two.toml", kTissue + kNeedle + kNeedle + kInsertion);
+  // A mesh file in mm read as metres: only its mesh says how wide it is.
+  write_file(dir / "wide.toml", kTissue + "\n[[needles]]\ngeometry = { stl = \"" + kRoot +
+                                    "/designs/cone.stl\", unit = \"m\" }\n" + kInsertion);
+  write_file(dir / "good.toml", kTissue + kNeedle + kInsertion);
+  const auto two = run_mneedle("scene check '" + (dir / "two.toml").string() + "'");
+  EXPECT_EQ(two.exit_code, 1);
+  EXPECT_NE(two.err.find("overlaps needle"), std::string::npos) << two.err;
+  const auto wide = run_mneedle("scene check '" + (dir / "wide.toml").string() + "'");
+  EXPECT_EQ(wide.exit_code, 1);
+  EXPECT_NE(wide.err.find("does not fit in the 2 mm x 2 mm block (is the mesh's unit right?)"),
+            std::string::npos)
+      << wide.err;
+  EXPECT_EQ(run_mneedle("scene check '" + (dir / "good.toml").string() + "'").exit_code, 0);
   fs::remove_all(dir);
 }
 

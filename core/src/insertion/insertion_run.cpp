@@ -12,6 +12,7 @@
 #include "insertion/insertion_planner.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/files.h"
+#include "mneedle/base/memory.h"
 #include "mneedle/base/units.h"
 #include "mneedle/fe/indentation3d.h"
 #include "mneedle/fe/tissue_mesh.h"
@@ -697,7 +698,18 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     if (any_post) run.models_run.push_back("surface_loads");
   }
   run.total_curve = total_curve(run.needles);
+  // The energy ledger of the pre-puncture stage, up to the first needle's puncture (after it
+  // the tissue is cut and the ledger would need the fracture energy; docs/model.md).
+  std::vector<double> depth, force, energy;
+  for (const RunPoint& p : run.total_curve) {
+    if (p.stage != Stage::Pre) break;
+    depth.push_back(p.depth_m);
+    force.push_back(p.force_N);
+    energy.push_back(p.strain_energy_J);
+  }
+  run.energy_check = check_energy(depth, force, energy);
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  run.peak_memory_bytes = peak_memory_bytes();
   return run;
 }
 

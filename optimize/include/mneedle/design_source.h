@@ -70,6 +70,9 @@ bool mirror_symmetric_y0(const TriangleMesh& mesh);
 /// The same for the image (-x, y, z): symmetric about its x = 0 plane (bodies of revolution).
 bool mirror_symmetric_x0(const TriangleMesh& mesh);
 
+/// True when a needle of the scene is a plugin shape: STL-only scenes run without plugins.
+bool needs_plugins(const Scene& scene);
+
 /// The number of needles a scene may hold unless the caller says otherwise: each one is a mesh
 /// to build or read and a curve to compute, so a scene of 10 000 needles would work for minutes
 /// before anything else could refuse it.

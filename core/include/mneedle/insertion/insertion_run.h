@@ -11,6 +11,7 @@
 
 #include "mneedle/fe/axisymmetric.h"
 #include "mneedle/fe/fidelity.h"
+#include "mneedle/insertion/energy_check.h"
 #include "mneedle/needle/mesh.h"
 #include "mneedle/scene/scene.h"
 
@@ -122,6 +123,11 @@ struct InsertionRun {
   double min_dihedral_deg = 0.0;  ///< 3-D mesh quality (0 for the axisymmetric model)
   double max_aspect_ratio = 0.0;
   double seconds = 0.0;
+  /// Stored energy against the needle's work over the pre-puncture curve (empty for analytic
+  /// runs); docs/model.md, "Energy check".
+  std::optional<EnergyCheck> energy_check;
+  /// The process's peak resident memory at the end of the run (bytes; 0 where not measurable).
+  std::size_t peak_memory_bytes = 0;
 };
 
 /// Runs the scene's insertion for the prepared needles (one per scene needle, same order).
