@@ -438,7 +438,11 @@ void rebuild_csv(const fs::path& out) {
     csv.flush();
     if (!csv) throw InputError((out / "results.csv").string() + ": cannot write results");
   }
-  fs::rename(temporary, out / "results.csv");
+  std::error_code renamed;
+  fs::rename(temporary, out / "results.csv", renamed);
+  if (renamed)
+    throw InputError((out / "results.csv").string() + ": cannot replace it (" + renamed.message() +
+                     ")");
 }
 
 }  // namespace

@@ -314,7 +314,10 @@ TEST(Indentation3d, BevelTipNodeCarriesForceFromTheStepThatCapturesIt) {
   // moves the second capture cannot silently skip it.
   const double f1 = r.steps[0].needles[0].force_N, f2 = r.steps[1].needles[0].force_N;
   ASSERT_EQ(r.steps[1].needles[0].captured_nodes, r.steps[0].needles[0].captured_nodes);
-  EXPECT_NEAR(f2 / f1, 2.0, 0.05);
+  // F = k (d - d0) with d0 where the node was taken: F(2d)/F(d) = 2 + d0 / (d - d0). Measured
+  // 2 + 1.1e-5 (the tip node is taken at the surface to round-off of the grid); 1e-4 allows
+  // that, while a node taken a step late or a force carried from the wrong step is off by 0.5+.
+  EXPECT_NEAR(f2 / f1, 2.0, 1e-4);
 }
 
 TEST(Indentation3d, HalfModelRejectsNeedlesOffTheMirrorPlaneOrAsymmetric) {
