@@ -354,6 +354,15 @@ LoadingBranch extract_loading_branch(const ForceCurve& raw, const LoadingBranchO
   return b;
 }
 
+double force_at(const ForceCurve& c, double z) {
+  const auto& d = c.depth_m;
+  if (z <= d.front()) return c.force_N.front();
+  if (z >= d.back()) return c.force_N.back();
+  const auto i = static_cast<std::size_t>(std::upper_bound(d.begin(), d.end(), z) - d.begin());
+  const double t = (z - d[i - 1]) / (d[i] - d[i - 1]);
+  return c.force_N[i - 1] + t * (c.force_N[i] - c.force_N[i - 1]);
+}
+
 MonotoneCurve merge_repeated_depths(const ForceCurve& curve) {
   MonotoneCurve out;
   out.curve.source = curve.source;

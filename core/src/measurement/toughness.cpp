@@ -14,16 +14,6 @@
 namespace mneedle {
 namespace {
 
-// Linear interpolation of a strictly increasing curve; constant beyond its ends.
-double interpolate(const ForceCurve& c, double z) {
-  const auto& d = c.depth_m;
-  if (z <= d.front()) return c.force_N.front();
-  if (z >= d.back()) return c.force_N.back();
-  const auto i = static_cast<std::size_t>(std::upper_bound(d.begin(), d.end(), z) - d.begin());
-  const double t = (z - d[i - 1]) / (d[i] - d[i - 1]);
-  return c.force_N[i - 1] + t * (c.force_N[i] - c.force_N[i - 1]);
-}
-
 // Starts a pass at depth 0: clipped (interpolated) when it reaches below, else given zero force
 // at 0, since before its contact nothing touched the needle.
 ForceCurve start_at_zero(const ForceCurve& c) {
@@ -34,7 +24,7 @@ ForceCurve start_at_zero(const ForceCurve& c) {
     out.force_N.push_back(0.0);
   } else {
     out.depth_m.push_back(0.0);
-    out.force_N.push_back(interpolate(c, 0.0));
+    out.force_N.push_back(force_at(c, 0.0));
   }
   for (std::size_t i = 0; i < c.depth_m.size(); ++i) {
     if (c.depth_m[i] <= 0.0) continue;
@@ -155,8 +145,8 @@ ForceDifference force_difference(const InsertionPass& first, const InsertionPass
              grid.end());
   for (double z : grid) {
     out.depth_m.push_back(z);
-    out.first_force_N.push_back(interpolate(f, z));
-    out.second_force_N.push_back(interpolate(b, z));
+    out.first_force_N.push_back(force_at(f, z));
+    out.second_force_N.push_back(force_at(b, z));
   }
   std::vector<double> diff(grid.size());
   for (std::size_t i = 0; i < grid.size(); ++i)

@@ -214,4 +214,15 @@ TEST(ForceCurve, DigitisedLiverCurveWithoutTimeColumnIsReadable) {
   EXPECT_GT(*std::max_element(b.curve.force_N.begin(), b.curve.force_N.end()), 2.0);
 }
 
+TEST(ForceAt, InterpolatesBetweenSamplesAndHoldsTheEnds) {
+  mneedle::ForceCurve c;
+  c.depth_m = {0.0, 1e-3, 3e-3};
+  c.force_N = {0.0, 1.0, 0.0};
+  EXPECT_DOUBLE_EQ(mneedle::force_at(c, 0.5e-3), 0.5);
+  EXPECT_DOUBLE_EQ(mneedle::force_at(c, 2.5e-3), 0.25);
+  EXPECT_DOUBLE_EQ(mneedle::force_at(c, -1.0), 0.0);
+  EXPECT_DOUBLE_EQ(mneedle::force_at(c, 1e-3), 1.0);
+  EXPECT_DOUBLE_EQ(mneedle::force_at(c, 1.0), 0.0);
+}
+
 }  // namespace

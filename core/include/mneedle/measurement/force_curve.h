@@ -84,6 +84,10 @@ struct MonotoneCurve {
 
 MonotoneCurve merge_repeated_depths(const ForceCurve& curve);
 
+/// The force at `depth_m` on a curve of strictly increasing depth: linear between samples,
+/// constant beyond the ends.
+double force_at(const ForceCurve& curve, double depth_m);
+
 /// Samples of `raw` after the loading branch while the travel stays at its maximum, as
 /// (time from the end of loading, force minus baseline). Empty without a time column.
 ForceCurve hold_segment(const ForceCurve& raw, const LoadingBranch& branch);
