@@ -23,5 +23,6 @@ void add_stats_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_toughness_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
+void add_energy_command(CLI::App& app);
 
 }  // namespace mneedle::cli

@@ -50,6 +50,9 @@ constexpr std::array kUnits{
     UnitDef{"kN", 1e3, Dimension::Force},
     UnitDef{"\xC2\xB5N", 1e-6, Dimension::Force},
     UnitDef{"\xCE\xBCN", 1e-6, Dimension::Force},
+    // Energy per unit length (paper C's strain energy per unit crack length) is a force.
+    UnitDef{"J/m", 1.0, Dimension::Force},
+    UnitDef{"mJ/m", 1e-3, Dimension::Force},
     UnitDef{"m/s", 1.0, Dimension::Speed},
     UnitDef{"mm/s", 1e-3, Dimension::Speed},
     UnitDef{"um/s", 1e-6, Dimension::Speed},

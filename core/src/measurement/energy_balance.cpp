@@ -69,14 +69,16 @@ InsertionStages split_stages(const ForceCurve& c, const StageOptions& o) {
   InsertionStages s;
   // A ends at the first peak that the force falls below by the drop threshold (paper C's
   // puncture: the crack starts and the tissue relaxes).
+  const double highest = *std::max_element(F.begin(), F.end());
+  const double min_fall =
+      std::max(o.min_drop_of_max_fraction * highest, o.noise_factor * o.noise_N);
   std::size_t peak = 0, drop_at = n;
   double deepest_fall = 0.0;
   for (std::size_t i = 1; i < n; ++i) {
     if (F[i] > F[peak]) peak = i;
     const double fall = F[peak] - F[i];
     deepest_fall = std::max(deepest_fall, F[peak] > 0 ? fall / F[peak] : 0.0);
-    if (F[peak] > 0.0 && fall >= o.min_drop_fraction * F[peak] &&
-        fall >= o.noise_factor * o.noise_N) {
+    if (F[peak] > 0.0 && fall >= o.min_drop_fraction * F[peak] && fall >= min_fall) {
       drop_at = i;
       break;
     }
@@ -84,7 +86,8 @@ InsertionStages split_stages(const ForceCurve& c, const StageOptions& o) {
   if (drop_at == n) {
     std::ostringstream m;
     m << c.source << ": no puncture: the force never falls by " << 100 * o.min_drop_fraction
-      << " % below a peak (at most " << 100 * deepest_fall << " %)";
+      << " % below a peak and by " << 100 * o.min_drop_of_max_fraction
+      << " % of its highest force (at most " << 100 * deepest_fall << " %)";
     throw InputError(m.str());
   }
   s.puncture_index = peak;
@@ -96,7 +99,7 @@ InsertionStages split_stages(const ForceCurve& c, const StageOptions& o) {
       std::min_element(F.begin() + peak, F.begin() + s.peak_index + 1) - F.begin());
   // D and E: the force falls after the peak by the exit threshold and settles on a level.
   const std::size_t p = s.peak_index;
-  if (p + 1 < n) {
+  if (o.seek_exit && p + 1 < n) {
     const double lowest_after = *std::min_element(F.begin() + p + 1, F.end());
     if (F[p] - lowest_after >= o.min_exit_drop_fraction * F[p]) {
       std::vector<double> tail(F.begin() + p + 1 + (n - p - 1) / 2, F.end());
@@ -105,7 +108,13 @@ InsertionStages split_stages(const ForceCurve& c, const StageOptions& o) {
       const double band = o.sliding_band_fraction * F[p];
       std::size_t e = p + 1;
       while (e < n && F[e] > level + band) ++e;
-      if (e < n && n - e >= o.min_sliding_samples) {
+      std::vector<double> sliding(F.begin() + static_cast<std::ptrdiff_t>(e), F.end());
+      std::sort(sliding.begin(), sliding.end());
+      const auto percentile = [&](double q) {
+        return sliding[static_cast<std::size_t>(q * static_cast<double>(sliding.size() - 1))];
+      };
+      if (e < n && n - e >= o.min_sliding_samples &&
+          percentile(0.95) - percentile(0.05) <= o.max_sliding_spread_fraction * F[p]) {
         s.through = true;
         s.sliding_index = e;
         s.sliding_samples = n - e;

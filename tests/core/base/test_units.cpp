@@ -91,6 +91,9 @@ TEST(Units, ToughnessInNewtonPerMillimetreEqualsJoulePerSquareMetre) {
   EXPECT_DOUBLE_EQ(parse_quantity("19 J/m2", Dimension::Toughness), 19.0);
   EXPECT_DOUBLE_EQ(parse_quantity("0.1 kJ/m^2", Dimension::Toughness), 100.0);
   EXPECT_DOUBLE_EQ(parse_quantity("5 mJ/m^2", Dimension::Toughness), 5e-3);
+  EXPECT_DOUBLE_EQ(parse_quantity("73.2 mJ/m", Dimension::Force), 73.2e-3);
+  EXPECT_DOUBLE_EQ(parse_quantity("0.0732 J/m", Dimension::Force), 0.0732);
+  EXPECT_THROW(parse_quantity("73.2 mJ/m", Dimension::Toughness), mneedle::InputError);
 }
 
 TEST(Units, ToughnessAndStiffnessShareNewtonPerMetre) {

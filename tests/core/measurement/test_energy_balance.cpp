@@ -109,6 +109,27 @@ TEST(SplitStages, ACurveWithoutAPunctureDropIsRefusedSayingHowFarItFell) {
   EXPECT_NE(m.find("at most 3.3"), std::string::npos) << m;
 }
 
+TEST(SplitStages, ASmallEarlyDipIsNotThePuncture) {
+  // 0.50 -> 0.42 N is 16 % of its peak but 3 % of the record's 2.6 N: a layer giving way under a
+  // fraction of the load; the puncture is the 2.6 -> 1.2 N drop.
+  const auto c = piecewise({{0, 0}, {3, 0.50}, {3.2, 0.42}, {12, 2.6}, {12.2, 1.2}, {30, 2.4}}, 30);
+  const auto s = mneedle::split_stages(c);
+  EXPECT_EQ(s.puncture_index, 120u);
+  EXPECT_EQ(s.relaxed_index, 122u);
+}
+
+TEST(SplitStages, AForceThatClimbsAgainAfterADropIsNotSliding) {
+  // A second puncture (2.6 -> 1.2 N) followed by more cutting back up to 2.4 N: the spread after
+  // the drop is half the peak, far from a flat sliding force.
+  const auto c = piecewise({{0, 0}, {3, 0.50}, {3.2, 0.30}, {12, 2.6}, {12.2, 1.2}, {30, 2.4}}, 30);
+  mneedle::StageOptions o;
+  o.min_drop_of_max_fraction = 0.0;  // let the early dip be the puncture
+  const auto s = mneedle::split_stages(c, o);
+  EXPECT_EQ(s.puncture_index, 30u);
+  EXPECT_EQ(s.peak_index, 120u);
+  EXPECT_FALSE(s.through);
+}
+
 TEST(SplitStages, ADropWithinTheNoiseIsNotAPuncture) {
   const auto c = piecewise({{0, 0}, {10, 0.30}, {11, 0.15}, {50, 0.80}}, 50);
   mneedle::StageOptions o;

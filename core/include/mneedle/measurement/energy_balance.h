@@ -33,17 +33,28 @@ struct InsertionStages {
 struct StageOptions {
   /// The puncture drop: the force falls below its running peak by this fraction of the peak ...
   double min_drop_fraction = 0.1;
+  /// ... and by this fraction of the record's highest force (a small early dip, a layer giving
+  /// way under a fraction of the load, is not the puncture that starts the crack) ...
+  double min_drop_of_max_fraction = 0.05;
   /// ... and by this many baseline noise deviations (`noise_N`, from the loading branch).
   double noise_factor = 5.0;
   double noise_N = 0.0;
+  /// Look for D and E at all: only for a record the user says goes through the block (`energy
+  /// --depth`). In a layered tissue the puncture of a deeper layer followed by a steady force
+  /// looks like an exit; on the 73 phantom recordings of docs/validation.md, which never go
+  /// through, 13 would be read as through.
+  bool seek_exit = true;
   /// The exit: after the peak the force falls by at least this fraction of the peak (a smaller
   /// dip is read as scatter of the cutting force, not as the tip leaving the block).
   double min_exit_drop_fraction = 0.2;
   /// E starts where the force first comes within this fraction of the peak force of its sliding
   /// level (the median force over the second half of the samples after the peak) ...
   double sliding_band_fraction = 0.02;
-  /// ... and needs at least this many samples.
+  /// ... and needs at least this many samples, and its force must stay flat: the spread between
+  /// its 5th and 95th percentiles at most this fraction of the peak force (a force that climbs
+  /// again after a drop is a puncture followed by more cutting, not sliding after the exit).
   std::size_t min_sliding_samples = 3;
+  double max_sliding_spread_fraction = 0.1;
 };
 
 /// Cuts a loading curve into the stages. Throws InputError naming the curve's source when it has
