@@ -13,6 +13,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-14 libclang-rt-14-dev
   nlohmann-json3-dev libcli11-dev libtomlplusplus-dev libfmt-dev
+  libplplot-dev
 )
 
 missing=()

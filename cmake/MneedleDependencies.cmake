@@ -7,6 +7,10 @@ find_package(CLI11 REQUIRED)
 find_package(tomlplusplus REQUIRED)
 find_package(Threads REQUIRED)
 
+# PLplot (figures, its svg driver) ships pkg-config data, no CMake config that works on its own.
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(PLPLOT REQUIRED IMPORTED_TARGET plplot)
+
 # Debian ships two NLopt configs (nlopt, nlopt_cxx) and either may be found first;
 # NLOPT_LIBRARIES names the target of whichever it was, and both serve <nlopt.hpp>.
 find_package(NLopt REQUIRED)
