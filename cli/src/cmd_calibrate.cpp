@@ -22,6 +22,7 @@
 #include "mneedle/calibration/calibration.h"
 #include "mneedle/design_source.h"
 #include "mneedle/measurement/toughness.h"
+#include "mneedle/plot/figure.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
 #include "mneedle/scene/scene_edit.h"
@@ -160,56 +161,22 @@ void print_table(const Calibration& c, const Scene& scene) {
   }
 }
 
-// Measured (dots) against the fitted model (line), force in mN against depth in mm.
-std::string svg_plot(const Calibration& c, const std::string& title) {
-  const double w = 640, h = 420, left = 70, right = 20, top = 40, bottom = 50;
-  double dmax = 0.0, fmin = 0.0, fmax = 0.0;
+// Measured samples (dots; the held-out ones a series of their own) against the fitted model.
+plot::Figure calibrate_figure(const Calibration& c, const std::string& title) {
+  plot::Figure f;
+  f.title = title;
+  f.x.name = "depth below the surface";
+  plot::Series fitted{"measured (fitted)", {}, {}, plot::Mark::Dots};
+  plot::Series held{"measured (held out)", {}, {}, plot::Mark::Dots};
+  plot::Series model{"model", c.depth_m, c.model_N, plot::Mark::Line};
   for (std::size_t i = 0; i < c.depth_m.size(); ++i) {
-    dmax = std::max(dmax, c.depth_m[i]);
-    fmax = std::max({fmax, c.measured_N[i], c.model_N[i]});
-    fmin = std::min({fmin, c.measured_N[i], c.model_N[i]});
+    plot::Series& s = c.fitted[i] ? fitted : held;
+    s.x.push_back(c.depth_m[i]);
+    s.y.push_back(c.measured_N[i]);
   }
-  if (!(dmax > 0.0)) dmax = 1.0;
-  if (!(fmax > fmin)) fmax = fmin + 1.0;
-  const auto x = [&](double d) { return left + (w - left - right) * d / dmax; };
-  const auto y = [&](double f) {
-    return h - bottom - (h - top - bottom) * (f - fmin) / (fmax - fmin);
-  };
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(2);
-  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << w << "\" height=\"" << h
-    << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" "
-       "fill=\"white\"/>\n";
-  s << "<text x=\"" << left << "\" y=\"24\" font-size=\"14\">" << title << "</text>\n";
-  s << "<line x1=\"" << left << "\" y1=\"" << h - bottom << "\" x2=\"" << w - right << "\" y2=\""
-    << h - bottom << "\" stroke=\"black\"/>\n<line x1=\"" << left << "\" y1=\"" << top << "\" x2=\""
-    << left << "\" y2=\"" << h - bottom << "\" stroke=\"black\"/>\n";
-  for (int k = 0; k <= 5; ++k) {
-    const double d = dmax * k / 5.0, f = fmin + (fmax - fmin) * k / 5.0;
-    s << "<text x=\"" << x(d) << "\" y=\"" << h - bottom + 16 << "\" text-anchor=\"middle\">"
-      << std::setprecision(3) << d * 1e3 << "</text>\n";
-    s << "<text x=\"" << left - 6 << "\" y=\"" << y(f) + 4 << "\" text-anchor=\"end\">" << f * 1e3
-      << "</text>\n"
-      << std::setprecision(2);
-  }
-  s << "<text x=\"" << (left + w - right) / 2 << "\" y=\"" << h - 12
-    << "\" text-anchor=\"middle\">depth below the surface [mm]</text>\n";
-  s << "<text transform=\"translate(16," << (top + h - bottom) / 2
-    << ") rotate(-90)\" text-anchor=\"middle\">force [mN]</text>\n";
-  for (std::size_t i = 0; i < c.depth_m.size(); ++i) {
-    s << "<circle cx=\"" << x(c.depth_m[i]) << "\" cy=\"" << y(c.measured_N[i])
-      << "\" r=\"2\" fill=\"" << (c.fitted[i] ? "#1f77b4" : "#aaaaaa") << "\"/>\n";
-  }
-  s << "<polyline fill=\"none\" stroke=\"#d62728\" stroke-width=\"1.5\" points=\"";
-  for (std::size_t i = 0; i < c.depth_m.size(); ++i)
-    s << x(c.depth_m[i]) << "," << y(c.model_N[i]) << " ";
-  s << "\"/>\n";
-  s << "<text x=\"" << w - right - 250 << "\" y=\"" << top + 10
-    << "\" fill=\"#1f77b4\">&#9679; measured (fitted)</text>\n<text x=\"" << w - right - 250
-    << "\" y=\"" << top + 26 << "\" fill=\"#aaaaaa\">&#9679; measured (held out)</text>\n<text x=\""
-    << w - right - 250 << "\" y=\"" << top + 42 << "\" fill=\"#d62728\">&#8212; model</text>\n";
-  s << "</svg>\n";
-  return s.str();
+  for (plot::Series* s : {&fitted, &held, &model})
+    if (!s->x.empty()) f.series.push_back(std::move(*s));
+  return f;
 }
 
 void write_file(const std::filesystem::path& path, const std::string& text) {
@@ -285,7 +252,8 @@ void run(const CalibrateArgs& a) {
     write_file(a.out, edited_scene_text(a.scene, edits, a.out));
     load_scene(a.out);  // what is written must load
   }
-  if (!a.plot.empty()) write_file(a.plot, svg_plot(c, "calibrate: " + a.curve.filename().string()));
+  if (!a.plot.empty())
+    plot::write_svg(a.plot, calibrate_figure(c, "calibrate: " + a.curve.filename().string()));
   if (a.json)
     std::cout << tree.dump(2) << "\n";
   else

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -23,6 +24,7 @@
 #include "mneedle/measurement/energy_balance.h"
 #include "mneedle/measurement/force_curve.h"
 #include "mneedle/measurement/toughness.h"
+#include "mneedle/plot/figure.h"
 
 namespace mneedle::cli {
 namespace {
@@ -32,6 +34,7 @@ struct EnergyArgs {
   std::string depth, crack_width, crack_widths, needle_diameter, strain_energy, tissue,
       friction_force, block_size = "640mm";
   std::string depth_col, force_col, depth_unit, force_unit;
+  std::string plot;  // SVG of every record with its stages
   double min_drop = 0.1, exit_drop = 0.2;
   bool json = false;
 };
@@ -211,6 +214,41 @@ void print_record(const Record& r, bool balance) {
   }
 }
 
+// Every record's force against depth; one record gets its stage boundaries drawn, several their
+// punctures and peaks marked.
+plot::Figure energy_figure(const std::vector<Record>& records) {
+  plot::Figure f;
+  f.title = "energy: stages of the insertion (paper C)";
+  f.x.name = "depth from contact";
+  std::size_t drawn = 0;
+  for (const Record& r : records) {
+    if (!r.error.empty()) continue;
+    ++drawn;
+    const auto& c = r.pass.curve;
+    f.series.push_back({std::filesystem::path(r.file).filename().string(), c.depth_m, c.force_N,
+                        plot::Mark::Line});
+    f.points.push_back(
+        {"puncture", c.depth_m[r.stages.puncture_index], c.force_N[r.stages.puncture_index]});
+    f.points.push_back({"peak", c.depth_m[r.stages.peak_index], c.force_N[r.stages.peak_index]});
+  }
+  if (drawn == 1) {
+    for (const Record& r : records) {
+      if (!r.error.empty()) continue;
+      f.title = "energy: " + std::filesystem::path(r.file).filename().string();
+      const auto& c = r.pass.curve;
+      const auto& s = r.stages;
+      f.lines.push_back({"A|B", c.depth_m[s.puncture_index]});
+      f.lines.push_back({"B|C", c.depth_m[s.relaxed_index]});
+      if (s.through) {
+        f.lines.push_back({"C|D", c.depth_m[s.peak_index]});
+        f.lines.push_back({"D|E", c.depth_m[s.sliding_index]});
+      }
+      if (r.balance) f.lines.push_back({"cut from", r.balance->cut_start_m});
+    }
+  }
+  return f;
+}
+
 void run_energy(const EnergyArgs& a) {
   if (!(a.min_drop > 0.0 && a.min_drop < 1.0) || !(a.exit_drop > 0.0 && a.exit_drop < 1.0))
     throw InputError("--min-drop and --exit-drop are fractions between 0 and 1");
@@ -270,6 +308,8 @@ void run_energy(const EnergyArgs& a) {
                       &mean.strain_work_J, &mean.crack_work_J, &mean.toughness_J_per_m2})
       *v /= k;
   }
+
+  if (!a.plot.empty() && records.size() > failed) plot::write_svg(a.plot, energy_figure(records));
 
   nlohmann::json warnings = nlohmann::json::array();
   if (balance && !a.needle_diameter.empty() &&
@@ -390,6 +430,7 @@ void add_energy_command(CLI::App& app) {
   cmd->add_option("--force-col", a->force_col, "Force column (default: force*, fz*, ...)");
   cmd->add_option("--depth-unit", a->depth_unit, "Unit of the depth column (default: its name)");
   cmd->add_option("--force-unit", a->force_unit, "Unit of the force column (default: its name)");
+  cmd->add_option("--plot", a->plot, "Write every record with its stages as SVG");
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->callback([a] { run_energy(*a); });
 }

@@ -19,6 +19,7 @@
 #include "mneedle/design_source.h"
 #include "mneedle/insertion/insertion_run.h"
 #include "mneedle/insertion/surface_loads.h"
+#include "mneedle/plot/figure.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
 
@@ -30,6 +31,7 @@ struct ForceOptions {
   bool json = false;
   bool csv = false;
   std::string step = "10um";
+  std::string plot;  // SVG of force against depth
   long max_points = 1'000'000;
   std::size_t max_needles = kDefaultMaxNeedles;
   std::vector<std::filesystem::path> plugin_dirs;
@@ -148,11 +150,28 @@ void add_force_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{1'000'000}));
   cmd->add_option("--plugin-dir", options->plugin_dirs, "Extra folder to search for plugins");
+  cmd->add_option("--plot", options->plot, "Write force against depth as SVG");
   cmd->callback([options] {
     const ForceResult result = compute(*options);
     // Every format prints the same numbers: one check of the tree covers the CSV and table too.
     const nlohmann::json tree = to_json(result);
     require_finite_json(tree, "force");
+    if (!options->plot.empty()) {
+      plot::Figure f;
+      f.title = "force: " + std::filesystem::path(options->scene).filename().string() +
+                " (post-puncture loads)";
+      f.x.name = "depth below the surface";
+      for (const NeedleCurve& c : result.curves) {
+        plot::Series s;
+        s.label = c.name;
+        for (const LoadSample& p : c.curve) {
+          s.x.push_back(p.depth_m);
+          s.y.push_back(p.force_N);
+        }
+        f.series.push_back(std::move(s));
+      }
+      plot::write_svg(options->plot, f);
+    }
     if (options->json) {
       std::cout << tree.dump(2) << "\n";
     } else if (options->csv) {

@@ -23,6 +23,7 @@
 #include "mneedle/insertion/energy_check.h"
 #include "mneedle/insertion/insertion_run.h"
 #include "mneedle/needle/needle_frame.h"
+#include "mneedle/plot/figure.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
 
@@ -40,6 +41,7 @@ struct SimulateOptions {
   bool json = false;
   bool no_reductions = false;
   bool csv = false;
+  std::string plot;  // SVG of force against depth
   std::vector<std::string> plugin_dirs;
   std::size_t max_needles = 16;
 };
@@ -236,6 +238,37 @@ void print_table(const InsertionRun& run) {
   }
 }
 
+// Force against depth of every needle (and their sum), the puncture and the post-puncture force
+// marked, a line where the first puncture happens.
+plot::Figure simulate_figure(const InsertionRun& run, const std::string& title) {
+  plot::Figure f;
+  f.title = title;
+  f.x.name = "depth below the surface";
+  for (const NeedleRun& n : run.needles) {
+    plot::Series s;
+    s.label = n.name;
+    for (const RunPoint& p : n.curve) {
+      s.x.push_back(p.depth_m);
+      s.y.push_back(p.force_N);
+    }
+    f.series.push_back(std::move(s));
+    if (n.puncture) {
+      f.points.push_back({"puncture " + n.name, n.puncture->depth_m, n.puncture->force_N});
+      f.points.push_back({"after", n.puncture->depth_m, n.puncture->post_force_N});
+    }
+  }
+  if (run.needles.size() > 1) {
+    plot::Series s;
+    s.label = "total";
+    for (const RunPoint& p : run.total_curve) {
+      s.x.push_back(p.depth_m);
+      s.y.push_back(p.force_N);
+    }
+    f.series.push_back(std::move(s));
+  }
+  return f;
+}
+
 void run(const SimulateOptions& o) {
   Scene scene = load_scene(o.scene);
   if (!o.axis.empty()) {
@@ -265,6 +298,8 @@ void run(const SimulateOptions& o) {
               << 100.0 * kEnergyCheckTolerance
               << " % apart: the contact or the mesh is not resolved; docs/model.md, \"Energy "
                  "check\")\n";
+  if (!o.plot.empty())
+    plot::write_svg(o.plot, simulate_figure(result, "simulate: " + o.scene.filename().string()));
   if (o.json)
     std::cout << tree.dump(2) << "\n";
   else if (o.csv)
@@ -309,6 +344,7 @@ void add_simulate_command(CLI::App& app) {
                 "solve the whole scene: no half model, layer merge or domain cut (to check them)");
   auto* json = cmd->add_flag("--json", options->json, "print the run as JSON");
   cmd->add_flag("--csv", options->csv, "print the curves as CSV")->excludes(json);
+  cmd->add_option("--plot", options->plot, "write force against depth as SVG");
   cmd->callback([options]() { run(*options); });
 }
 

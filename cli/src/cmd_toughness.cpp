@@ -19,6 +19,7 @@
 #include "mneedle/design_source.h"
 #include "mneedle/measurement/force_curve.h"
 #include "mneedle/measurement/toughness.h"
+#include "mneedle/plot/figure.h"
 
 namespace mneedle::cli {
 namespace {
@@ -37,6 +38,7 @@ struct ToughnessArgs {
   std::string align = "contact";
   std::string max_depth;
   std::string integrand;
+  std::string plot;  // SVG of F, F' and F - F' against depth
   bool json = false;
 };
 
@@ -173,6 +175,19 @@ void run_toughness(const ToughnessArgs& a) {
   const CrackAreaChoice area = crack_area(a, d.end_depth_m);
   const double j = toughness_J_per_m2(d, area.area_m2);
   if (!a.integrand.empty()) write_integrand(a.integrand, d);
+  if (!a.plot.empty()) {
+    plot::Figure f;
+    f.title = "toughness: J = " + format_toughness(j);
+    f.x.name = "depth from contact";
+    std::vector<double> difference;
+    for (std::size_t i = 0; i < d.depth_m.size(); ++i)
+      difference.push_back(d.first_force_N[i] - d.second_force_N[i]);
+    f.series.push_back({"first pass F", d.depth_m, d.first_force_N, plot::Mark::Line});
+    f.series.push_back({"second pass F'", d.depth_m, d.second_force_N, plot::Mark::Line});
+    f.series.push_back({"F - F'", d.depth_m, difference, plot::Mark::Line});
+    if (drop) f.points.push_back({"puncture", drop->peak_depth_m, drop->peak_force_N});
+    plot::write_svg(a.plot, f);
+  }
 
   nlohmann::json warnings = nlohmann::json::array();
   if (j < 0.0)
@@ -276,6 +291,7 @@ void add_toughness_command(CLI::App& app) {
   cmd->add_option("--max-depth", a->max_depth, "End of the integral, e.g. 2mm (default: common)");
   cmd->add_option("--integrand", a->integrand,
                   "Write depth_m,first_force_N,second_force_N,difference_N to this CSV");
+  cmd->add_option("--plot", a->plot, "Write F, F' and F - F' against depth as SVG");
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->callback([a] { run_toughness(*a); });
 }

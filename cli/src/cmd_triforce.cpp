@@ -26,6 +26,7 @@
 #include "mneedle/measurement/layer_boundaries.h"
 #include "mneedle/measurement/triforce_fit.h"
 #include "mneedle/measurement/triforce_model.h"
+#include "mneedle/plot/figure.h"
 
 namespace mneedle::cli {
 namespace {
@@ -108,6 +109,7 @@ struct FitArgs {
   int starts = 8;
   bool json = false;
   std::string out_dir;
+  std::string plot;  // SVG: each curve measured (dots) and fitted (line)
 };
 
 nlohmann::json fit_json(const TriforceFit& fit, const std::vector<LoadedCurve>& curves) {
@@ -233,6 +235,19 @@ void run_fit(const FitArgs& args) {
   const auto report = fit_json(fit, curves);
   require_finite_json(report, "fit");
   if (!args.out_dir.empty()) write_fit_files(args.out_dir, report, fit, curves);
+  if (!args.plot.empty()) {
+    plot::Figure f;
+    f.title = "fit: tri-force model (paper B)";
+    f.x.name = "depth from contact";
+    const TriforceModel model(fit.params);
+    for (std::size_t i = 0; i < curves.size(); ++i) {
+      const auto& c = curves[i].curve;
+      f.series.push_back({c.name + " measured", c.depth_m, c.force_N, plot::Mark::Dots});
+      f.series.push_back({c.name + " fitted", c.depth_m,
+                          predict_loading(model, c, fit.curves[i].offset_m), plot::Mark::Line});
+    }
+    plot::write_svg(args.plot, f);
+  }
   if (args.json) {
     std::cout << report.dump(2) << "\n";
   } else {
@@ -257,6 +272,7 @@ struct PredictArgs {
   CurveArgs curve;
   bool csv = false;
   bool json = false;
+  std::string plot;  // SVG: the predicted force against depth (and --compare's curve)
 };
 
 TriforceParams read_params(const std::string& file) {
@@ -365,6 +381,21 @@ void run_predict(const PredictArgs& args) {
                 << ": RMSE " << m.rmse_N << " N, R2 " << m.r2 << ", max error " << m.max_error_N
                 << " N\n";
     }
+  }
+  if (!args.plot.empty()) {
+    plot::Figure fig;
+    fig.title = "predict: tri-force model (paper B)";
+    fig.x.name = "depth from contact";
+    plot::Series predicted{"predicted", {}, {}, plot::Mark::Line};
+    for (const auto& s : samples) {
+      predicted.x.push_back(s.depth_m);
+      predicted.y.push_back(s.force.total_N());
+    }
+    fig.series.push_back(std::move(predicted));
+    if (measured)
+      fig.series.push_back({measured->curve.name + " measured", measured->curve.depth_m,
+                            measured->curve.force_N, plot::Mark::Dots});
+    plot::write_svg(args.plot, fig);
   }
   if (args.json) {
     nlohmann::json t = nlohmann::json::array(), z = t, ph = t, f = t, fc = t, fs = t, ff = t,
@@ -505,6 +536,7 @@ void add_fit_command(CLI::App& app) {
   cmd->add_option("--starts", args->starts, "Number of Levenberg-Marquardt starts")
       ->capture_default_str();
   cmd->add_flag("--json", args->json, "Print the fit as JSON");
+  cmd->add_option("--plot", args->plot, "Write each curve measured and fitted as SVG");
   cmd->add_option("--out", args->out_dir, "Write fit.json and <curve>_fit.csv into this directory");
   cmd->callback([args] { run_fit(*args); });
 }
@@ -540,6 +572,7 @@ void add_predict_command(CLI::App& app) {
   cmd->add_option("--force-col", args->curve.force_col, "Force column of --compare");
   auto* csv = cmd->add_flag("--csv", args->csv, "CSV output (the default)");
   cmd->add_flag("--json", args->json, "JSON output")->excludes(csv);
+  cmd->add_option("--plot", args->plot, "Write the predicted force against depth as SVG");
   cmd->callback([args] { run_predict(*args); });
 }
 

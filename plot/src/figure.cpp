@@ -118,6 +118,7 @@ void write_svg(const std::filesystem::path& file, const Figure& f) {
   double y0 = to_axis(yr.lo, f.y, uy), y1 = to_axis(yr.hi, f.y, uy);
   // A force axis starts at zero unless the data go below it; a flat range gets a unit of room.
   if (!f.y.logarithmic) y0 = std::min(y0, 0.0);
+  if (!f.x.logarithmic) x0 = std::min(x0, 0.0);  // depth from the surface or contact: from 0
   if (!(x1 > x0)) x1 = x0 + 1.0;
   if (!(y1 > y0)) y1 = y0 + 1.0;
   const double pad = 0.05 * (y1 - y0);
@@ -148,7 +149,9 @@ void write_svg(const std::filesystem::path& file, const Figure& f) {
   pllab(escaped(axis_label(f.x, ux)).c_str(), escaped(axis_label(f.y, uy)).c_str(),
         escaped(f.title).c_str());
 
-  // Stage lines first, under the curves.
+  // Stage lines first, under the curves; their labels at three heights in turn, so that close
+  // lines do not print over each other.
+  int line_number = 0;
   for (const VerticalLine& v : f.lines) {
     const double x = to_axis(v.x, f.x, ux);
     if (!std::isfinite(x)) continue;
@@ -157,7 +160,9 @@ void write_svg(const std::filesystem::path& file, const Figure& f) {
     pljoin(x, y0, x, y1);
     pllsty(1);
     plschr(0, 0.7);
-    plptex(x, y1 - 0.03 * (y1 - y0), 1.0, 0.0, -0.15, escaped(v.label).c_str());
+    // Labels along the bottom: force curves rise, so the top holds the data and the legend.
+    const double height = 0.03 + 0.05 * (line_number++ % 3);
+    plptex(x, y0 + height * (y1 - y0), 1.0, 0.0, -0.15, escaped(v.label).c_str());
     plschr(0, 1.0);
   }
 
@@ -210,15 +215,17 @@ void write_svg(const std::filesystem::path& file, const Figure& f) {
     plschr(0, 1.0);
   }
 
-  if (!texts.empty()) {
+  // One curve needs no legend: the title names it.
+  if (texts.size() > 1) {
     std::vector<const char*> text_ptrs, symbol_ptrs;
     for (const auto& t : texts) text_ptrs.push_back(t.c_str());
     for (const auto& t : symbols) symbol_ptrs.push_back(t.c_str());
     PLFLT width = 0, height = 0;
     plschr(0, 0.8);
     pllegend(&width, &height, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
-             PL_POSITION_TOP | PL_POSITION_RIGHT | PL_POSITION_INSIDE, 0.02, 0.02, 0.08, 0,
-             kForeground, 1, 0, 0, static_cast<PLINT>(texts.size()), opt.data(), 1.0, 1.0, 1.5, 1.0,
+             // Top left: a force curve that rises with depth leaves that corner empty.
+             PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE, 0.02, 0.02, 0.08, 0,
+             kForeground, 1, 0, 0, static_cast<PLINT>(texts.size()), opt.data(), 1.0, 1.0, 1.5, 0.0,
              text_colour.data(), text_ptrs.data(), nullptr, nullptr, nullptr, nullptr,
              line_colour.data(), line_style.data(), line_width.data(), symbol_colour.data(),
              symbol_scale.data(), symbol_number.data(), symbol_ptrs.data());

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "../plot/svg_reader.h"
 #include "refdata.h"
 #include "run_mneedle.h"
 
@@ -186,6 +187,28 @@ TEST(CmdEnergy, PhantomRecordingsSplitIntoPunctureRelaxationAndCutting) {
     EXPECT_GT(s["relaxed"]["depth_m"].get<double>(), s["puncture"]["depth_m"].get<double>());
     EXPECT_LT(s["relaxed"]["force_N"].get<double>(), 0.9 * s["puncture"]["force_N"].get<double>());
   }
+}
+
+TEST(CmdEnergy, PlotMarksTheStagesAndTheCuttingStretch) {
+  const auto file = write_record("plot.csv", 0.90);
+  const auto svg = kWork / "stages.svg";
+  const auto run = run_mneedle(
+      "energy '" + file + "' --depth 86mm --crack-width 15mm --strain-energy 73.2mJ/m --plot '" +
+      svg.string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::string text = mneedle::test::read_svg(svg);
+  const auto t = mneedle::test::texts(text);
+  for (const char* label : {"A|B", "B|C", "C|D", "D|E", "cut from", "puncture", "peak",
+                            "depth from contact [mm]", "force [N]", "energy: plot.csv"})
+    EXPECT_TRUE(mneedle::test::has_text(t, label)) << label;
+}
+
+TEST(CmdEnergy, PlotIntoAMissingFolderIsOneErrorLine) {
+  const auto file = write_record("noplot.csv", 0.90);
+  const auto run =
+      run_mneedle("energy '" + file + "' --plot '" + (kWork / "no/such.svg").string() + "'");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("such.svg: cannot write the plot"), std::string::npos) << run.err;
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
+#include "../plot/svg_reader.h"
 #include "run_mneedle.h"
 
 #include <cmath>
@@ -146,6 +147,18 @@ TEST_F(ForceCommand, MissingSceneIsAnError) {
   const CommandRun run = run_mneedle("force '" + scene_asset("no_such_scene.toml") + "'");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("mneedle: error:"), std::string::npos) << run.err;
+}
+
+TEST_F(ForceCommand, PlotHasOneCurvePerNeedle) {
+  const auto svg = std::filesystem::temp_directory_path() /
+                   ("mneedle_force_plot_" + std::to_string(::getpid()) + ".svg");
+  const CommandRun run = run_mneedle("force '" + scene_asset("stl_needle.toml") +
+                                     "' --step 100um --plot '" + svg.string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::string text = mneedle::test::read_svg(svg);
+  std::filesystem::remove(svg);
+  EXPECT_FALSE(mneedle::test::polyline(text, "#1F77B4").empty());
+  EXPECT_FALSE(mneedle::test::texts(text).empty());
 }
 
 }  // namespace

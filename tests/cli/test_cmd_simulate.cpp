@@ -5,6 +5,7 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
+#include "../plot/svg_reader.h"
 #include "run_mneedle.h"
 
 #include <cmath>
@@ -340,6 +341,22 @@ TEST(CmdSimulate, OneMaterialSplitIntoLayersPuncturesWhereTheUnsplitOneDoes) {
     EXPECT_NEAR(near / identical, 1.0, 1e-5);
   }
   fs::remove_all(dir);
+}
+
+TEST(CmdSimulate, PlotDrawsTheCurveWithItsAxesAndUnits) {
+  const auto svg = std::filesystem::temp_directory_path() /
+                   ("mneedle_simulate_plot_" + std::to_string(::getpid()) + ".svg");
+  const CommandRun run = run_mneedle("simulate '" + scene("axisymmetric_punch.toml") +
+                                     "' --plot '" + svg.string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::string text = mneedle::test::read_svg(svg);
+  std::filesystem::remove(svg);
+  const auto t = mneedle::test::texts(text);
+  EXPECT_TRUE(mneedle::test::has_text(t, "simulate: axisymmetric_punch.toml"));
+  bool depth_axis = false;
+  for (const auto& x : t) depth_axis |= x.text.rfind("depth below the surface [", 0) == 0;
+  EXPECT_TRUE(depth_axis);
+  EXPECT_FALSE(mneedle::test::polyline(text, "#1F77B4").empty());
 }
 
 }  // namespace

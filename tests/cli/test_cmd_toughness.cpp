@@ -14,6 +14,7 @@
 #include <sstream>
 #include <string>
 
+#include "../plot/svg_reader.h"
 #include "refdata.h"
 #include "run_mneedle.h"
 
@@ -243,6 +244,19 @@ TEST(CmdToughness, PhantomRecordingRunsWithASecondPassFromItsRetraction) {
   EXPECT_GT(j["toughness_J_per_m2"].get<double>(), 0.0);
   EXPECT_GT(j["first"]["cut"]["retraction"].get<int>(), 1000);
   EXPECT_TRUE(j["warnings"].empty());
+}
+
+TEST(CmdToughness, PlotDrawsBothPassesAndTheirDifference) {
+  std::filesystem::create_directories(kWork);
+  const auto svg = kWork / "j.svg";
+  const auto run = run_mneedle(kPair + "--area 0.0415476mm^2 --plot '" + svg.string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::string text = mneedle::test::read_svg(svg);
+  const auto t = mneedle::test::texts(text);
+  for (const char* label : {"first pass F", "second pass F'", "F - F'"})
+    EXPECT_TRUE(mneedle::test::has_text(t, label)) << label;
+  for (const char* colour : {"#1F77B4", "#D62728", "#2CA02C"})
+    EXPECT_FALSE(mneedle::test::polyline(text, colour).empty()) << colour;
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
+#include "../plot/svg_reader.h"
 #include "run_mneedle.h"
 
 #include <cstdio>
@@ -150,6 +151,25 @@ TEST(CmdTriforce, BadCurveFailsWithFileAndLine) {
       run_mneedle("fit '" + std::string(MNEEDLE_TEST_ASSETS) + "/curves/text_in_number.csv'");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("text_in_number.csv:4"), std::string::npos) << run.err;
+}
+
+TEST(CmdTriforce, FitAndPredictPlotTheirCurves) {
+  const auto file = write_recording();
+  const auto fit_svg = kWork / "fit.svg", predict_svg = kWork / "predict.svg";
+  ASSERT_EQ(run_mneedle("fit '" + file + "' --starts 2 --out '" + (kWork / "q").string() +
+                        "' --plot '" + fit_svg.string() + "'")
+                .exit_code,
+            0);
+  ASSERT_EQ(run_mneedle("predict --params '" + (kWork / "q" / "fit.json").string() +
+                        "' --compare '" + file + "' --plot '" + predict_svg.string() + "'")
+                .exit_code,
+            0);
+  const auto fit = mneedle::test::texts(mneedle::test::read_svg(fit_svg));
+  EXPECT_TRUE(mneedle::test::has_text(fit, "recording.csv measured"));
+  EXPECT_TRUE(mneedle::test::has_text(fit, "recording.csv fitted"));
+  const auto predict = mneedle::test::texts(mneedle::test::read_svg(predict_svg));
+  EXPECT_TRUE(mneedle::test::has_text(predict, "predicted"));
+  EXPECT_TRUE(mneedle::test::has_text(predict, "recording.csv measured"));
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "mneedle/base/error.h"
+#include "svg_reader.h"
 
 namespace {
 
@@ -20,6 +21,9 @@ namespace fs = std::filesystem;
 using mneedle::Dimension;
 using mneedle::plot::Figure;
 using mneedle::plot::Series;
+using mneedle::test::has_text;
+using mneedle::test::polyline;
+using mneedle::test::texts;
 
 const fs::path kWork =
     fs::temp_directory_path() / ("mneedle_test_figure_" + std::to_string(::getpid()));
@@ -36,67 +40,6 @@ std::string read(const fs::path& p) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-// What PLplot's svg driver writes, read back: every text (its characters are written as
-// &#xNN; entities) with its anchor in the plot's coordinates, and every polyline of a colour.
-struct Text {
-  std::string text;
-  double x, y;
-};
-std::vector<Text> texts(const std::string& svg) {
-  std::vector<Text> out;
-  const std::regex text_re(
-      R"(matrix\([^ ]+ [^ ]+ [^ ]+ [^ ]+ ([-0-9.]+) ([-0-9.]+)\)[^>]*>\s*<tspan[^>]*>([^<]*)</tspan>)");
-  for (std::sregex_iterator it(svg.begin(), svg.end(), text_re), end; it != end; ++it) {
-    std::string decoded;
-    const std::string raw = (*it)[3];
-    for (std::size_t i = 0; i < raw.size();) {
-      if (raw.compare(i, 3, "&#x") == 0) {
-        const auto semi = raw.find(';', i);
-        const unsigned long code = std::stoul(raw.substr(i + 3, semi - i - 3), nullptr, 16);
-        if (code < 0x80) {
-          decoded += static_cast<char>(code);
-        } else {  // two-byte UTF-8 is all the labels use (µ, °)
-          decoded += static_cast<char>(0xC0 | (code >> 6));
-          decoded += static_cast<char>(0x80 | (code & 0x3F));
-        }
-        i = semi + 1;
-      } else {
-        decoded += raw[i++];
-      }
-    }
-    out.push_back({decoded, std::stod((*it)[1]), std::stod((*it)[2])});
-  }
-  return out;
-}
-
-// Plain string search: std::regex recurses per character and overflows the stack on long
-// point lists.
-std::vector<std::pair<double, double>> polyline(const std::string& svg, const std::string& colour) {
-  std::vector<std::pair<double, double>> out;
-  const std::string stroke = "stroke=\"" + colour + "\"";
-  for (auto at = svg.find(stroke); at != std::string::npos; at = svg.find(stroke, at + 1)) {
-    const auto end = svg.find('>', at);
-    const auto points = svg.find("points=\"", at);
-    if (points == std::string::npos || points > end) continue;
-    const auto close = svg.find('"', points + 8);
-    const std::string list = svg.substr(points + 8, close - points - 8);
-    // The legend's sample of the line is a polyline of 2 points in the same colour: not data.
-    if (std::count(list.begin(), list.end(), ',') <= 2) continue;
-    std::stringstream s(list);
-    for (std::string pair; s >> pair;) {
-      const auto comma = pair.find(',');
-      out.emplace_back(std::stod(pair.substr(0, comma)), std::stod(pair.substr(comma + 1)));
-    }
-  }
-  return out;
-}
-
-bool has_text(const std::vector<Text>& t, const std::string& s) {
-  for (const auto& x : t)
-    if (x.text == s) return true;
-  return false;
 }
 
 Figure force_figure() {
@@ -127,13 +70,16 @@ TEST(DisplayUnit, PicksTheUnitByMagnitude) {
 TEST(WriteSvg, AxesCarryTheirUnitsAndTheLabelsAreWritten) {
   fs::create_directories(kWork);
   const auto file = kWork / "labels.svg";
-  mneedle::plot::write_svg(file, force_figure());
+  Figure f = force_figure();
+  f.series.push_back({"analytic", {0.0, 200e-6}, {0.0, 2e-3}, mneedle::plot::Mark::Line});
+  mneedle::plot::write_svg(file, f);
   const auto t = texts(read(file));
   EXPECT_TRUE(has_text(t, "depth below the surface [um]"));
   EXPECT_TRUE(has_text(t, "force [mN]"));
   EXPECT_TRUE(has_text(t, "cone in skin"));
   EXPECT_TRUE(has_text(t, "puncture"));
   EXPECT_TRUE(has_text(t, "FE"));
+  EXPECT_TRUE(has_text(t, "analytic"));
   EXPECT_TRUE(has_text(t, "A|B"));
   EXPECT_FALSE(fs::exists(file.string() + ".tmp"));
 }
@@ -170,6 +116,13 @@ TEST(WriteSvg, CurvePointsLieWhereTheAxisTicksPutTheirValues) {
   const double y0 = line.front().second, slope = (line.back().second - y0) / 1.0;
   for (std::size_t i = 0; i < line.size(); ++i)
     EXPECT_NEAR(line[i].second, y0 + slope * std::pow(i / 40.0, 2), 0.05) << i;
+}
+
+TEST(WriteSvg, OneCurveHasNoLegend) {
+  fs::create_directories(kWork);
+  const auto file = kWork / "single.svg";
+  mneedle::plot::write_svg(file, force_figure());
+  EXPECT_FALSE(has_text(texts(read(file)), "FE"));
 }
 
 TEST(WriteSvg, GapsInTheDataSplitTheLine) {

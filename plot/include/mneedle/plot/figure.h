@@ -52,7 +52,7 @@ struct Figure {
   std::vector<VerticalLine> lines;
 };
 
-/// Writes the figure (through a temporary file in the same folder, renamed at the end, so a
+/// Writes the figure (a legend when it has two curves or more; through a temporary file in the same folder, renamed at the end, so a
 /// failed run leaves no half-written file). Throws InputError naming the file when it cannot be
 /// written, and naming the series when its x and y differ in length, it has no finite point, or a
 /// logarithmic axis meets a value <= 0. Non-finite points are left out of the lines. Safe to call
