@@ -52,11 +52,12 @@ struct Figure {
   std::vector<VerticalLine> lines;
 };
 
-/// Writes the figure (a legend when it has two curves or more; through a temporary file in the same folder, renamed at the end, so a
-/// failed run leaves no half-written file). Throws InputError naming the file when it cannot be
-/// written, and naming the series when its x and y differ in length, it has no finite point, or a
-/// logarithmic axis meets a value <= 0. Non-finite points are left out of the lines. Safe to call
-/// from several threads (PLplot's state is global: calls are serialised).
+/// Writes the figure (a legend when it has two curves or more; through a temporary file in the same
+/// folder, renamed at the end, so a failed run leaves no half-written file). Throws InputError
+/// naming the file when it cannot be written, and naming the series when its x and y differ in
+/// length, it has no finite point, or a logarithmic axis meets a value <= 0. Non-finite points are
+/// left out of the lines. Safe to call from several threads (PLplot's state is global: calls are
+/// serialised).
 void write_svg(const std::filesystem::path& file, const Figure& figure);
 
 /// The unit an axis of this dimension shows for values up to `largest_abs` (SI), and its size
