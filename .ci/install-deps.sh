@@ -14,6 +14,8 @@ packages=(
   clang-14 libclang-rt-14-dev
   nlohmann-json3-dev libcli11-dev libtomlplusplus-dev libfmt-dev
   libplplot-dev
+  libssl-dev
+  python3-meshio
 )
 
 missing=()

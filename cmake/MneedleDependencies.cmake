@@ -6,6 +6,8 @@ find_package(nlohmann_json 3.10 REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(tomlplusplus REQUIRED)
 find_package(Threads REQUIRED)
+# SHA-256 of every input in an output's provenance (core/src/base/provenance.cpp)
+find_package(OpenSSL 3 REQUIRED COMPONENTS Crypto)
 
 # PLplot (figures, its svg driver) ships pkg-config data, no CMake config that works on its own.
 find_package(PkgConfig REQUIRED)

@@ -26,6 +26,7 @@
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
 #include "mneedle/scene/scene_edit.h"
+#include "run_provenance.h"
 
 namespace mneedle::cli {
 namespace {
@@ -187,6 +188,7 @@ void write_file(const std::filesystem::path& path, const std::string& text) {
 
 void run(const CalibrateArgs& a) {
   const Scene scene = load_scene(a.scene);
+  record_scene(scene, a.scene);
   if (scene.needles.size() != 1) {
     throw InputError(a.scene.string() +
                      ": calibrate needs a scene with one needle (the one "
@@ -198,6 +200,7 @@ void run(const CalibrateArgs& a) {
   if (!a.contact_at.empty()) options.contact_travel_m = length_option("--contact-at", a.contact_at);
   const CurveColumns columns{a.depth_col, a.force_col, "", a.depth_unit, a.force_unit};
   const ForceCurve measured = read_force_curve_csv(a.curve, columns);
+  record_input("curve", a.curve);
   if (a.puncture_at == "detect") {
     // On the loading branch only: a hold or a retraction has larger drops than any puncture.
     const LoadingBranch branch = extract_loading_branch(measured);
@@ -226,6 +229,7 @@ void run(const CalibrateArgs& a) {
   const PluginRegistry registry =
       PluginRegistry::discover({a.plugin_dirs.begin(), a.plugin_dirs.end()});
   const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene);
+  record_plugin_meshes(scene, needles);
   const Calibration c = calibrate(scene, needles.front(), measured, options);
 
   const nlohmann::json tree = to_json(c, scene, a);
@@ -255,7 +259,7 @@ void run(const CalibrateArgs& a) {
   if (!a.plot.empty())
     plot::write_svg(a.plot, calibrate_figure(c, "calibrate: " + a.curve.filename().string()));
   if (a.json)
-    std::cout << tree.dump(2) << "\n";
+    std::cout << with_provenance(tree).dump(2) << "\n";
   else
     print_table(c, scene);
 }

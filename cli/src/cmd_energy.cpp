@@ -25,6 +25,7 @@
 #include "mneedle/measurement/force_curve.h"
 #include "mneedle/measurement/toughness.h"
 #include "mneedle/plot/figure.h"
+#include "run_provenance.h"
 
 namespace mneedle::cli {
 namespace {
@@ -275,6 +276,7 @@ void run_energy(const EnergyArgs& a) {
     r.file = file;
     try {
       r.pass = prepare_pass(read_force_curve_csv(file, columns));
+      record_input("curve", file);
       StageOptions o;
       o.min_drop_fraction = a.min_drop;
       o.min_exit_drop_fraction = a.exit_drop;

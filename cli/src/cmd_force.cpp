@@ -22,6 +22,7 @@
 #include "mneedle/plot/figure.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
+#include "run_provenance.h"
 
 namespace mneedle::cli {
 namespace {
@@ -82,6 +83,8 @@ ForceResult compute(const ForceOptions& options) {
   // The same placement checks as `simulate`: a needle wider than the block or two needles on
   // the same tissue would otherwise give curves for a scene that cannot exist.
   const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene, options.max_needles);
+  record_scene(scene, options.scene);
+  record_plugin_meshes(scene, needles);
   check_needle_placement(scene, needles);
   for (const PreparedNeedle& needle : needles) {
     const SurfaceLoadModel model(needle.mesh, constants);
@@ -107,6 +110,7 @@ nlohmann::json to_json(const ForceResult& result) {
 }
 
 void print_csv(const std::vector<NeedleCurve>& curves) {
+  std::cout << provenance_comment() << "\n";
   std::cout << "needle,depth_m,force_N,alpha_N,beta_N,friction_N\n" << std::setprecision(10);
   for (const NeedleCurve& c : curves) {
     for (const LoadSample& s : c.curve) {
@@ -173,7 +177,7 @@ void add_force_command(CLI::App& app) {
       plot::write_svg(options->plot, f);
     }
     if (options->json) {
-      std::cout << tree.dump(2) << "\n";
+      std::cout << with_provenance(tree).dump(2) << "\n";
     } else if (options->csv) {
       print_csv(result.curves);
     } else {

@@ -20,6 +20,7 @@
 #include "mneedle/needle/needle_frame.h"
 
 #include "json_output.h"
+#include "run_provenance.h"
 #include "surface_report_json.h"
 
 namespace mneedle::cli {
@@ -62,6 +63,7 @@ InspectResult inspect(const InspectOptions& options) {
   result.file = options.file;
   result.unit = options.unit;
   result.mesh = load_mesh(options.file, length_unit_scale(options.unit));
+  record_input("needle", options.file);
   if (options.repair) result.repair = repair_mesh(result.mesh);
   result.validation = validate_mesh(result.mesh);
   if (frame_computable(result))
@@ -159,14 +161,14 @@ void run_inspect(const InspectOptions& options) {
                                   {"valid", false},
                                   {"errors", {error.what()}},
                                   {"repairs", nlohmann::json::array()}};
-      std::cout << out.dump(2) << "\n";
+      std::cout << with_provenance(out).dump(2) << "\n";
     }
     throw;
   }
   // The text report prints numbers of the same tree: one check covers both formats.
   const nlohmann::json tree = to_json(result);
   require_finite_json(tree, "inspect " + options.file);
-  if (options.json) std::cout << tree.dump(2) << "\n";
+  if (options.json) std::cout << with_provenance(tree).dump(2) << "\n";
   if (!result.validation.valid) throw InputError(defects_line(result));
   if (!options.output.empty()) {
     // Input coordinates and unit, with the unit in the header so loaders read it back.

@@ -29,6 +29,7 @@
 #include "mneedle/plugin_host.h"
 #include "mneedle/strength/needle_material.h"
 #include "mneedle/tip_optimizer.h"
+#include "run_provenance.h"
 
 namespace mneedle::cli {
 namespace {
@@ -242,7 +243,7 @@ void write_outputs(const std::filesystem::path& dir, const TriangleMesh& best_me
                    const nlohmann::json& summary) {
   write_stl_binary(best_mesh, dir / "best.stl", 1e-3, "mneedle optimize best design unit=mm");
   require_finite_json(summary, "optimize");
-  std::ofstream(dir / "summary.json") << summary.dump(2) << "\n";
+  std::ofstream(dir / "summary.json") << with_provenance(summary).dump(2) << "\n";
 }
 
 // The optimum's place (bound, constraint, interior) and the failures, for JSON.
@@ -327,6 +328,7 @@ void print_causes(int count, int evaluations, const char* what,
 
 void run_optimize(const OptimizeArgs& a) {
   const Scene scene = load_scene(a.scene);
+  record_scene(scene, a.scene);
   const auto registry = PluginRegistry::discover({a.plugin_dirs.begin(), a.plugin_dirs.end()});
   const PluginShapeInfo& shape = registry.shape(a.plugin);
   Problem problem{scene,      registry,
@@ -354,6 +356,7 @@ void run_optimize(const OptimizeArgs& a) {
   o.starts = a.starts;
   o.max_evaluations = a.max_evals;
   o.seed = a.seed;
+  run_provenance().seed = a.seed;
   if (!a.max_time.empty()) {
     o.max_time_s = parse_quantity(a.max_time, Dimension::Time);
     if (!(o.max_time_s > 0.0))
@@ -369,6 +372,7 @@ void run_optimize(const OptimizeArgs& a) {
   std::unique_ptr<HistoryWriter> history;
   if (!a.out.empty()) {
     create_output_folder(a.out, "--out");
+    append_provenance_line(a.out);
     history = std::make_unique<HistoryWriter>(std::filesystem::path(a.out) / "history.csv", vars,
                                               objective_key);
     o.on_evaluation = [&](const EvaluationRecord& e) { history->write(e); };

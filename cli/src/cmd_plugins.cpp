@@ -14,6 +14,7 @@
 #include "json_output.h"
 #include "mneedle/base/units.h"
 #include "mneedle/plugin_host.h"
+#include "run_provenance.h"
 
 namespace mneedle::cli {
 namespace {
@@ -70,7 +71,7 @@ void run_list(const PluginsOptions& options) {
   const Json tree{{"shapes", shapes}, {"warnings", registry.warnings()}};
   require_finite_json(tree, "plugins list");
   if (options.json) {
-    std::cout << tree.dump(2) << "\n";
+    std::cout << with_provenance(tree).dump(2) << "\n";
     return;
   }
   print_warnings(registry);
@@ -91,7 +92,7 @@ void run_describe(const PluginsOptions& options) {
   const Json tree = shape_json(s);
   require_finite_json(tree, "plugins describe " + s.name);
   if (options.json) {
-    std::cout << tree.dump(2) << "\n";
+    std::cout << with_provenance(tree).dump(2) << "\n";
     return;
   }
   std::cout << s.name << ": " << s.help << "\n"

@@ -18,6 +18,7 @@
 #include "mneedle/insertion/insertion_run.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
+#include "run_provenance.h"
 
 namespace mneedle::cli {
 namespace {
@@ -278,12 +279,15 @@ void add_scene_command(CLI::App& app) {
     // is not a closed solid, a needle wider than the block or two on the same tissue fail here.
     const PluginRegistry registry =
         needs_plugins(s) ? PluginRegistry::discover(opts->plugin_dirs) : PluginRegistry();
-    check_needle_placement(s, prepare_needles(registry, s));
+    const std::vector<PreparedNeedle> needles = prepare_needles(registry, s);
+    check_needle_placement(s, needles);
+    record_scene(s, opts->file);
+    record_plugin_meshes(s, needles);
     // The summary prints the same values as the JSON: one check covers both.
     const Json tree = scene_to_json(s);
     require_finite_json(tree, "scene " + opts->file);
     if (opts->json) {
-      std::cout << tree.dump(2) << "\n";
+      std::cout << with_provenance(tree).dump(2) << "\n";
     } else {
       print_summary(std::cout, s);
     }

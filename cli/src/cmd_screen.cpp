@@ -8,9 +8,11 @@
 #include "commands.h"
 #include "json_output.h"
 #include "mneedle/base/error.h"
+#include "mneedle/base/files.h"
 #include "mneedle/base/units.h"
 #include "mneedle/needle/needle_frame.h"
 #include "mneedle/screening.h"
+#include "run_provenance.h"
 
 namespace mneedle::cli {
 namespace {
@@ -82,6 +84,7 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
 
 void run_screen(const ScreenArgs& args) {
   const Scene scene = load_scene(args.scene);
+  record_scene(scene, args.scene);
   const auto registry =
       PluginRegistry::discover({args.plugin_dirs.begin(), args.plugin_dirs.end()});
   const auto designs =
@@ -91,7 +94,11 @@ void run_screen(const ScreenArgs& args) {
   ScreeningOptions options;
   options.jobs = args.jobs;
   if (!args.material.empty()) options.material = args.material;
-  if (!args.out.empty()) options.out = args.out;
+  if (!args.out.empty()) {
+    options.out = args.out;
+    create_output_folder(args.out, "--out");
+    append_provenance_line(args.out);
+  }
   options.resume = args.resume;
   options.fidelity = args.fidelity;
   options.model = args.model;

@@ -26,6 +26,7 @@
 #include "mneedle/plot/figure.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
+#include "run_provenance.h"
 
 namespace mneedle::cli {
 namespace {
@@ -173,6 +174,7 @@ nlohmann::json to_json(const InsertionRun& run, const Scene& scene) {
 }
 
 void print_csv(const InsertionRun& run) {
+  std::cout << provenance_comment() << "\n";
   std::cout << "depth_m,force_N,stage,lateral_force_x_N,lateral_force_y_N,contact_area_m2,"
                "contact_pressure_Pa,section_area_m2,section_pressure_Pa,strain_energy_J,alpha_N,"
                "beta_N,friction_N,needle\n";
@@ -282,6 +284,8 @@ void run(const SimulateOptions& o) {
   // Checked before any needle is built: the finite element limit below would otherwise come
   // only after every mesh of a 10 000-needle scene was made.
   const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene, o.max_needles);
+  record_scene(scene, o.scene);
+  record_plugin_meshes(scene, needles);
   for (const PreparedNeedle& n : needles) {
     if (!n.frame_note.empty())
       std::cerr << "mneedle: needle " << n.name << ": " << n.frame_note << "\n";
@@ -301,7 +305,7 @@ void run(const SimulateOptions& o) {
   if (!o.plot.empty())
     plot::write_svg(o.plot, simulate_figure(result, "simulate: " + o.scene.filename().string()));
   if (o.json)
-    std::cout << tree.dump(2) << "\n";
+    std::cout << with_provenance(tree).dump(2) << "\n";
   else if (o.csv)
     print_csv(result);
   else

@@ -14,6 +14,7 @@
 #include "mneedle/needle/needle_frame.h"
 #include "mneedle/strength/needle_strength.h"
 #include "mneedle/strength/section_table.h"
+#include "run_provenance.h"
 
 namespace mneedle::cli {
 namespace {
@@ -64,6 +65,10 @@ void run_strength(const StrengthArgs& args) {
           : needle_from_file(args.file, length_unit_scale(args.unit), parse_axis_choice(args.axis));
   if (!needle.frame_note.empty())
     std::cerr << "mneedle: " << args.file << ": " << needle.frame_note << "\n";
+  if (args.file.empty())
+    record_mesh(needle.name, needle.mesh);
+  else
+    record_input("needle", args.file);
   const NeedleMaterial material = find_needle_material(args.material);
   const SectionTable table = section_table(registry, needle);
 
@@ -96,7 +101,7 @@ void run_strength(const StrengthArgs& args) {
   // Text and JSON print the same numbers: check them once, before either.
   require_finite_json(out, "strength");
   if (args.json) {
-    std::cout << out.dump(2) << "\n";
+    std::cout << with_provenance(out).dump(2) << "\n";
     return;
   }
   std::cout << needle.name << " in " << material.name << " (" << end_condition_name(options.end)

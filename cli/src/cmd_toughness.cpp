@@ -20,6 +20,7 @@
 #include "mneedle/measurement/force_curve.h"
 #include "mneedle/measurement/toughness.h"
 #include "mneedle/plot/figure.h"
+#include "run_provenance.h"
 
 namespace mneedle::cli {
 namespace {
@@ -83,6 +84,10 @@ CrackAreaChoice crack_area(const ToughnessArgs& a, double end_depth_m) {
           ? needle_from_plugin(registry, a.plugin,
                                parse_parameter_settings(registry.shape(a.plugin), a.settings))
           : needle_from_file(a.needle, length_unit_scale(a.unit));
+  if (a.needle.empty())
+    record_mesh(needle.name, needle.mesh);
+  else
+    record_input("needle", a.needle);
   out.from_mesh = needle_crack_area(needle.mesh, end_depth_m);
   out.area_m2 = out.from_mesh->area_m2;
   out.source = needle.name;
@@ -95,7 +100,9 @@ CrackAreaChoice crack_area(const ToughnessArgs& a, double end_depth_m) {
 
 InsertionPass load_pass(const std::string& file, const ToughnessArgs& a) {
   const CurveColumns columns{a.depth_col, a.force_col, "", a.depth_unit, a.force_unit};
-  return prepare_pass(read_force_curve_csv(file, columns));
+  InsertionPass pass = prepare_pass(read_force_curve_csv(file, columns));
+  record_input("curve", file);
+  return pass;
 }
 
 // --max-depth as a length; zero or negative is refused, not read as "no limit".
@@ -225,7 +232,7 @@ void run_toughness(const ToughnessArgs& a) {
   }
   require_finite_json(out, a.first);
   if (a.json) {
-    std::cout << out.dump(2) << "\n";
+    std::cout << with_provenance(out).dump(2) << "\n";
     return;
   }
   std::cout << "fracture toughness J = " << format_toughness(j) << "  (" << sig(j * 1e-3)

@@ -27,6 +27,7 @@
 #include "mneedle/measurement/triforce_fit.h"
 #include "mneedle/measurement/triforce_model.h"
 #include "mneedle/plot/figure.h"
+#include "run_provenance.h"
 
 namespace mneedle::cli {
 namespace {
@@ -62,6 +63,7 @@ LoadedCurve load_curve(const std::string& file, const CurveArgs& a) {
   const CurveColumns columns{a.depth_col, a.force_col, "", a.depth_unit, a.force_unit};
   LoadedCurve out;
   out.branch = extract_loading_branch(read_force_curve_csv(file, columns));
+  record_input("curve", file);
   out.curve.name = std::filesystem::path(file).filename().string();
   out.curve.depth_m = out.branch.curve.depth_m;
   out.curve.force_N = out.branch.curve.force_N;
@@ -178,7 +180,7 @@ void print_fit(const TriforceFit& fit, const std::vector<LoadedCurve>& curves) {
 void write_fit_files(const std::string& dir, const nlohmann::json& report, const TriforceFit& fit,
                      const std::vector<LoadedCurve>& curves) {
   std::filesystem::create_directories(dir);
-  std::ofstream(std::filesystem::path(dir) / "fit.json") << report.dump(2) << "\n";
+  std::ofstream(std::filesystem::path(dir) / "fit.json") << with_provenance(report).dump(2) << "\n";
   const TriforceModel model(fit.params);
   for (std::size_t i = 0; i < curves.size(); ++i) {
     const auto& c = curves[i].curve;
@@ -249,7 +251,7 @@ void run_fit(const FitArgs& args) {
     plot::write_svg(args.plot, f);
   }
   if (args.json) {
-    std::cout << report.dump(2) << "\n";
+    std::cout << with_provenance(report).dump(2) << "\n";
   } else {
     print_fit(fit, curves);
   }
@@ -495,7 +497,7 @@ void run_stats(const StatsArgs& args) {
     // The text report prints the same numbers: one check covers both formats.
     require_finite_json(tree, "stats");
     if (args.json) {
-      std::cout << tree.dump(2) << "\n";
+      std::cout << with_provenance(tree).dump(2) << "\n";
       return;
     }
   }

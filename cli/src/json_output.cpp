@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "mneedle/base/error.h"
+#include "run_provenance.h"
 
 namespace mneedle::cli {
 namespace {
@@ -71,13 +72,13 @@ void require_finite_row(const std::vector<double>& values, const std::vector<std
 
 void print_checked_json(std::ostream& out, const nlohmann::json& tree, std::string_view context) {
   check(tree, context);
-  out << tree.dump(2) << "\n";
+  out << with_provenance(tree).dump(2) << "\n";
 }
 
 void print_checked_json(std::ostream& out, const nlohmann::ordered_json& tree,
                         std::string_view context) {
   check(tree, context);
-  out << tree.dump(2) << "\n";
+  out << with_provenance(tree).dump(2) << "\n";
 }
 
 }  // namespace mneedle::cli

@@ -23,7 +23,8 @@ double require_finite(double value, std::string_view key, std::string_view conte
 void require_finite_row(const std::vector<double>& values, const std::vector<std::string>& columns,
                         std::string_view row, std::string_view context);
 
-/// Checks, then writes tree.dump(2) and a newline.
+/// Checks, then writes tree.dump(2) and a newline; an object gets the run's "provenance"
+/// (run_provenance.h) as its last key unless it has one.
 void print_checked_json(std::ostream& out, const nlohmann::json& tree, std::string_view context);
 void print_checked_json(std::ostream& out, const nlohmann::ordered_json& tree,
                         std::string_view context);

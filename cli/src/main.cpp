@@ -2,14 +2,18 @@
 
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include "commands.h"
 #include "mneedle/base/error.h"
+#include "run_provenance.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"mneedle: evaluate microneedle designs before fabrication"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "mneedle 0.1.0");
+  app.set_version_flag(
+      "--version", [] { return mneedle::cli::version_text(); },
+      "Print mneedle's version, source revision and library versions");
   mneedle::cli::add_scene_command(app);
   mneedle::cli::add_plugins_command(app);
   mneedle::cli::add_generate_command(app);
@@ -28,6 +32,13 @@ int main(int argc, char** argv) {
   // Exit statuses (docs/cli.md, "Exit status"): 0 success, 1 bad input, 2 bad command line,
   // 3 a solver that could not deliver, 4 an internal error (a bug: please report it).
   try {
+    // the command line as the user typed it; a word with spaces is quoted
+    std::string command;
+    for (int i = 0; i < argc; ++i) {
+      const std::string word = i == 0 ? std::string("mneedle") : std::string(argv[i]);
+      command += (i ? " " : "") + (word.find(' ') == std::string::npos ? word : "'" + word + "'");
+    }
+    mneedle::cli::run_provenance() = mneedle::start_provenance(command);
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --help, --version

@@ -1,4 +1,5 @@
 #include "mneedle/screening.h"
+#include "mneedle/base/provenance.h"
 
 #include <toml++/toml.h>
 #include <algorithm>
@@ -251,6 +252,9 @@ ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::s
     const ScreenedNeedle needle = design_needle(d, registry, o);
     row.frame_note = needle.frame_note;
     if (!needle.frame_note.empty()) j["frame_note"] = needle.frame_note;
+    // provenance of the row (docs/cli.md, "Provenance"): the file as read, the mesh as evaluated
+    if (!d.plugin) j["file_sha256"] = sha256_of_file(d.file);
+    j["mesh_sha256"] = mesh_sha256(needle.mesh);
     const DesignEvaluation e = evaluate_design(needle.mesh, scene, material, needle.options);
     row.ok = true;
     row.peak_force_n = e.peak_force_n;

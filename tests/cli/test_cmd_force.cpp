@@ -63,7 +63,9 @@ TEST_F(ForceCommand, CsvHasTheNeedleColumnAndOneRowPerDepth) {
       run_mneedle("force '" + scene_asset("stl_needle.toml") + "' --csv --step 250um");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   std::istringstream lines(run.out);
-  std::string header;
+  std::string provenance, header;
+  std::getline(lines, provenance);  // "# provenance: {...}" (docs/cli.md, "Provenance")
+  EXPECT_EQ(provenance.rfind("# provenance: ", 0), 0u) << provenance;
   std::getline(lines, header);
   EXPECT_EQ(header, "needle,depth_m,force_N,alpha_N,beta_N,friction_N");
   int rows = 0;

@@ -51,7 +51,9 @@ TEST(CmdSimulate, CsvHasOneRowPerDepth) {
   const CommandRun run = run_mneedle("simulate '" + scene("axisymmetric_punch.toml") + "' --csv");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   std::istringstream lines(run.out);
-  std::string header, row;
+  std::string provenance, header, row;
+  std::getline(lines, provenance);  // "# provenance: {...}" (docs/cli.md, "Provenance")
+  EXPECT_EQ(provenance.rfind("# provenance: ", 0), 0u) << provenance;
   std::getline(lines, header);
   EXPECT_EQ(header.rfind("depth_m,force_N,", 0), 0u);
   int rows = 0;
@@ -212,7 +214,9 @@ TEST(CmdSimulate, CsvHasAStageColumn) {
   const CommandRun run = run_mneedle("simulate '" + scene("puncture_punch.toml") + "' --csv");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   std::istringstream lines(run.out);
-  std::string header, row;
+  std::string provenance, header, row;
+  std::getline(lines, provenance);  // "# provenance: {...}" (docs/cli.md, "Provenance")
+  EXPECT_EQ(provenance.rfind("# provenance: ", 0), 0u) << provenance;
   std::getline(lines, header);
   EXPECT_EQ(header.rfind("depth_m,force_N,stage,", 0), 0u) << header;
   int post = 0;

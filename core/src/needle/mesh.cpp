@@ -1,8 +1,11 @@
 #include "mneedle/needle/mesh.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
+
+#include "mneedle/base/provenance.h"
 
 namespace mneedle {
 namespace {
@@ -55,6 +58,17 @@ double surface_area(const TriangleMesh& mesh) {
     twice_area += std::sqrt(dot(n, n));
   }
   return twice_area / 2.0;
+}
+
+std::string mesh_sha256(const TriangleMesh& mesh) {
+  static_assert(std::endian::native == std::endian::little, "the digest's bytes are little-endian");
+  std::string bytes;
+  bytes.reserve(mesh.vertices.size() * sizeof(Vec3) + mesh.triangles.size() * sizeof(Triangle));
+  for (const Vec3& v : mesh.vertices)
+    bytes.append(reinterpret_cast<const char*>(v.data()), sizeof(Vec3));
+  for (const Triangle& t : mesh.triangles)
+    bytes.append(reinterpret_cast<const char*>(t.data()), sizeof(Triangle));
+  return sha256_hex(bytes);
 }
 
 }  // namespace mneedle

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
+
 namespace {
 
 // Unit cube, outward oriented, 12 triangles.
@@ -33,6 +36,27 @@ TEST(Mesh, BoundingBoxSpansTheVertices) {
   EXPECT_DOUBLE_EQ(box.min[0], 0.0);
   EXPECT_DOUBLE_EQ(box.max[1], 3.0);
   EXPECT_DOUBLE_EQ(box.max[2], 4.0);
+}
+
+}  // namespace
+
+namespace {
+
+// The digest's byte layout (docs/cli.md, "Provenance"): the value below is Python's
+// hashlib.sha256(struct.pack('<3d', *v) for each vertex + struct.pack('<3I', *t)).hexdigest().
+TEST(MeshDigest, IsTheSha256OfLittleEndianVerticesThenTriangles) {
+  mneedle::TriangleMesh m;
+  m.vertices = {{0.0, 0.0, 0.0}, {1e-3, 0.0, 0.0}, {0.0, 2.5e-4, -3.0}};
+  m.triangles = {{0, 1, 2}};
+  EXPECT_EQ(mneedle::mesh_sha256(m),
+            "a5ba9493457cb95f461bbd45b8c59c548cd9385ea460c7073e66282d959bc130");
+}
+
+TEST(MeshDigest, MovesWhenOneCoordinateMovesByOneBit) {
+  auto cube = unit_cube();
+  const std::string before = mneedle::mesh_sha256(cube);
+  cube.vertices[6][2] = std::nextafter(1.0, 2.0);
+  EXPECT_NE(mneedle::mesh_sha256(cube), before);
 }
 
 }  // namespace

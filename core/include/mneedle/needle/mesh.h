@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace mneedle {
@@ -29,5 +30,10 @@ BoundingBox bounding_box(const TriangleMesh& mesh);
 double signed_volume(const TriangleMesh& mesh);
 
 double surface_area(const TriangleMesh& mesh);
+
+/// SHA-256 (hex) of the mesh as it is in memory: its vertices (x, y, z as little-endian IEEE
+/// doubles, metres) followed by its triangles (three little-endian uint32 each). Two meshes with
+/// the same digest are the same needle to the last bit (docs/cli.md, "Provenance").
+std::string mesh_sha256(const TriangleMesh& mesh);
 
 }  // namespace mneedle
