@@ -16,6 +16,7 @@ packages=(
   libplplot-dev
   libssl-dev
   python3-meshio
+  calculix-ccx
 )
 
 missing=()

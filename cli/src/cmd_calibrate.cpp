@@ -218,14 +218,10 @@ void run(const CalibrateArgs& a) {
     if (!from.empty()) options.fit_from_travel_m = length_option("--fit-range", from);
     if (!to.empty()) options.fit_to_travel_m = length_option("--fit-range", to);
   }
-  options.run.fidelity = scene.model.fidelity == Fidelity::Fast   ? fe::Fidelity::Fast
-                         : scene.model.fidelity == Fidelity::Fine ? fe::Fidelity::Fine
-                                                                  : fe::Fidelity::Standard;
+  options.run = scene_run_options(scene);
   if (a.fidelity == "fast") options.run.fidelity = fe::Fidelity::Fast;
   if (a.fidelity == "fine") options.run.fidelity = fe::Fidelity::Fine;
   if (a.fidelity == "standard") options.run.fidelity = fe::Fidelity::Standard;
-  options.run.contact = scene.model.contact;
-  options.run.criterion = scene.model.criterion;
   const PluginRegistry registry =
       PluginRegistry::discover({a.plugin_dirs.begin(), a.plugin_dirs.end()});
   const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene);

@@ -26,6 +26,7 @@
 #include "mneedle/plot/figure.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
+#include "progress_line.h"
 #include "run_provenance.h"
 
 namespace mneedle::cli {
@@ -42,27 +43,19 @@ struct SimulateOptions {
   bool json = false;
   bool no_reductions = false;
   bool csv = false;
-  std::string plot;  // SVG of force against depth
+  bool quiet = false;  // no progress line
+  std::string plot;    // SVG of force against depth
   std::vector<std::string> plugin_dirs;
   std::size_t max_needles = 16;
 };
 
-fe::Fidelity to_fe(Fidelity f) {
-  return f == Fidelity::Fast   ? fe::Fidelity::Fast
-         : f == Fidelity::Fine ? fe::Fidelity::Fine
-                               : fe::Fidelity::Standard;
-}
-
 InsertionRunOptions run_options(const Scene& scene, const SimulateOptions& o) {
-  InsertionRunOptions r;
-  r.fidelity = to_fe(scene.model.fidelity);
+  InsertionRunOptions r = scene_run_options(scene);
   if (o.fidelity == "fast") r.fidelity = fe::Fidelity::Fast;
   if (o.fidelity == "standard") r.fidelity = fe::Fidelity::Standard;
   if (o.fidelity == "fine") r.fidelity = fe::Fidelity::Fine;
-  r.contact = scene.model.contact;
   if (o.contact == "sticking") r.contact = Contact::Sticking;
   if (o.contact == "frictionless") r.contact = Contact::Frictionless;
-  r.criterion = scene.model.criterion;
   if (o.criterion == "pressure") r.criterion = PunctureCriterion::Pressure;
   if (o.criterion == "energy") r.criterion = PunctureCriterion::Energy;
   if (o.criterion == "stress") r.criterion = PunctureCriterion::Stress;
@@ -290,7 +283,15 @@ void run(const SimulateOptions& o) {
     if (!n.frame_note.empty())
       std::cerr << "mneedle: needle " << n.name << ": " << n.frame_note << "\n";
   }
-  const InsertionRun result = run_insertion(scene, needles, run_options(scene, o));
+  InsertionRunOptions options = run_options(scene, o);
+  if (!options.vtu_directory.empty()) options.vtu_comment = provenance_comment().substr(2);
+  ProgressLine progress(std::cerr, "simulate", stderr_is_terminal(), o.quiet);
+  options.on_progress = [&](const std::string& model, int step, int steps, double depth,
+                            double force) {
+    progress.update({model, step, steps, depth, force});
+  };
+  const InsertionRun result = run_insertion(scene, needles, options);
+  progress.finish();
   // Every format prints the numbers of this tree: check them once, before anything is printed.
   const nlohmann::json tree = to_json(result, scene);
   require_finite_json(tree, o.scene.string());
@@ -334,7 +335,8 @@ void add_simulate_command(CLI::App& app) {
                   "pre-puncture model: auto (the planner decides), analytic, axisymmetric or 3d")
       ->check(CLI::IsMember({"auto", "analytic", "axisymmetric", "3d"}))
       ->capture_default_str();
-  cmd->add_option("--vtu", options->vtu, "write step_<k>.vtu per pre-puncture depth step here");
+  cmd->add_option("--vtu", options->vtu,
+                  "write the fields of every pre-puncture step here for ParaView (steps.pvd)");
   cmd->footer(
       "Examples:\n  mneedle simulate designs/scenes/silicone_phantom.toml --fidelity fast\n"
       "  mneedle simulate designs/scenes/human_skin.toml --criterion stress --json\n"
@@ -349,6 +351,8 @@ void add_simulate_command(CLI::App& app) {
   auto* json = cmd->add_flag("--json", options->json, "print the run as JSON");
   cmd->add_flag("--csv", options->csv, "print the curves as CSV")->excludes(json);
   cmd->add_option("--plot", options->plot, "write force against depth as SVG");
+  cmd->add_flag("--quiet", options->quiet,
+                "no progress line on stderr (shown for runs longer than a second)");
   cmd->callback([options]() { run(*options); });
 }
 

@@ -24,5 +24,6 @@ void add_simulate_command(CLI::App& app);
 void add_toughness_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
 void add_energy_command(CLI::App& app);
+void add_export_command(CLI::App& app);
 
 }  // namespace mneedle::cli

@@ -44,9 +44,10 @@ namespace {
 
 // docs/cli.md promises an example in every command's help.
 TEST(Help, EveryCommandShowsAnExample) {
-  for (const char* command : {"scene check", "plugins list", "plugins describe", "generate",
-                              "inspect", "force", "strength", "screen", "optimize", "fit",
-                              "predict", "stats", "simulate", "toughness", "calibrate"}) {
+  for (const char* command :
+       {"scene check", "plugins list", "plugins describe", "generate", "inspect", "force",
+        "strength", "screen", "optimize", "fit", "predict", "stats", "simulate", "toughness",
+        "calibrate", "energy", "export"}) {
     const auto run = mneedle::test::run_mneedle(std::string(command) + " --help");
     EXPECT_EQ(run.exit_code, 0) << command << ": " << run.err;
     EXPECT_NE(run.out.find("Example"), std::string::npos) << command << " --help:\n" << run.out;

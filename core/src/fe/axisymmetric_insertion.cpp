@@ -14,6 +14,7 @@
 #include <string>
 
 #include "axisymmetric_internal.h"
+#include "fe/vtu_writer.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/files.h"
 #include "mneedle/fe/axisymmetric.h"
@@ -578,7 +579,11 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
         model.layer_materials());
     cracked = make_stepper(*cracked_model, needle, options, false);
   }
-  if (!options.vtu_directory.empty()) create_output_folder(options.vtu_directory, "--vtu");
+  std::vector<PvdEntry> collection;
+  if (!options.vtu_directory.empty()) {
+    create_output_folder(options.vtu_directory, "--vtu");
+    clear_step_files(options.vtu_directory);
+  }
   InsertionResult result;
   for (int k = 1; k <= options.output_steps; ++k) {
     const double depth = options.depth_m * k / options.output_steps;
@@ -594,11 +599,13 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
       if (options.stress_average_length_m > 0.0)
         step.tip_stress_Pa = model.averaged_max_principal_stress(
             u, Eigen::Vector2d::Zero(), options.stress_average_length_m, 0);
-      if (!options.vtu_directory.empty())
-        model.write_vtu(
-            (std::filesystem::path(options.vtu_directory) / ("step_" + std::to_string(k) + ".vtu"))
-                .string(),
-            u);
+      if (!options.vtu_directory.empty()) {
+        const std::filesystem::path dir(options.vtu_directory);
+        const std::string file = "step_" + std::to_string(k) + ".vtu";
+        model.write_vtu((dir / file).string(), u, depth, options.vtu_comment);
+        collection.push_back({depth, 0, file});
+        write_pvd((dir / "steps.pvd").string(), collection, options.vtu_comment);
+      }
     }
     require_finite(step);
     result.steps.push_back(step);
@@ -730,6 +737,7 @@ InsertionResult simulate_axisymmetric(const AxisymmetricProblem& problem) {
   options.crack_depth_m = problem.crack_depth_m;
   options.on_step = problem.on_step;
   options.vtu_directory = problem.vtu_directory;
+  options.vtu_comment = problem.vtu_comment;
   InsertionResult result = insert_needle(model, problem.needle, options);
   result.mesh_seconds = mesh_seconds;
   return result;

@@ -9,9 +9,9 @@
 #include <string>
 
 #include "axisymmetric_internal.h"
+#include "fe/vtu_writer.h"
 #include "mneedle/base/error.h"
 #include "mneedle/fe/axisymmetric.h"
-#include "vtu_writer.h"
 
 namespace mneedle::fe {
 
@@ -120,21 +120,45 @@ double AxisymmetricModel::averaged_max_principal_stress(const Eigen::VectorXd& u
   return volume > 0.0 ? weighted / volume : 0.0;
 }
 
-void AxisymmetricModel::write_vtu(const std::string& path, const Eigen::VectorXd& u) const {
-  const AxisymmetricMesh& mesh = impl_->mesh;
-  VtuFields f;
+void AxisymmetricModel::write_vtu(const std::string& path, const Eigen::VectorXd& u, double depth_m,
+                                  const std::string& comment) const {
+  const Impl& m = *impl_;
+  const AxisymmetricMesh& mesh = m.mesh;
+  VtuFile f;
+  f.comment = comment;
   // The (r, z) plane drawn as the x-z plane of a 3-D file.
   for (const auto& p : mesh.nodes) f.points_m.emplace_back(p.x(), 0.0, p.y());
   // VTK_QUADRATIC_TRIANGLE: corners, then mid-edges 0-1, 1-2, 2-0 (our order).
-  for (const auto& e : mesh.elements)
+  for (const auto& e : mesh.elements) {
     for (std::uint32_t node : e) f.connectivity.push_back(node);
-  f.nodes_per_cell = 6;
-  f.cell_type = 22;
+    f.offsets.push_back(static_cast<std::int64_t>(f.connectivity.size()));
+    f.types.push_back(22);
+  }
+  VtuArray displacement{"displacement_m", 3, {}, {}};
   for (Eigen::Index i = 0; i + 1 < u.size(); i += 2)
-    f.displacement_m.emplace_back(u(i), 0.0, u(i + 1));
-  f.von_mises_Pa = von_mises(u);
-  f.energy_density_J_per_m3 = energy_density(u);
-  f.layer = mesh.element_layer;
+    displacement.float64.insert(displacement.float64.end(), {u(i), 0.0, u(i + 1)});
+  // principal stresses of the element's mean Cauchy stress (σ_θθ is one of them)
+  VtuArray principal{"principal_stress_Pa", 3, {}, {}};
+  for (std::size_t e = 0; e < mesh.elements.size(); ++e) {
+    const Material& material = m.materials[mesh.element_layer[e]];
+    Eigen::Matrix3d mean = Eigen::Matrix3d::Zero();
+    for (int q = 0; q < kQuadrature; ++q) {
+      const Eigen::Matrix3d F =
+          deformation_gradient(m.points[e * kQuadrature + q], u, mesh.elements[e]);
+      mean += kRule[q].weight * cauchy_stress(material, F, nullptr);
+    }
+    const Eigen::Vector3d values =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(mean, Eigen::EigenvaluesOnly).eigenvalues();
+    principal.float64.insert(principal.float64.end(), {values(2), values(1), values(0)});
+  }
+  VtuArray layer{"layer", 1, {}, {}};
+  layer.int32.assign(mesh.element_layer.begin(), mesh.element_layer.end());
+  f.point_data = {displacement};
+  f.cell_data = {{"von_mises_Pa", 1, von_mises(u), {}},
+                 principal,
+                 {"energy_density_J_per_m3", 1, energy_density(u), {}},
+                 layer};
+  f.field_data = {{"depth_m", 1, {depth_m}, {}}, {"axisymmetric", 1, {}, {1}}};
   fe::write_vtu(path, f);
 }
 

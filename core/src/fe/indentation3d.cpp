@@ -11,6 +11,8 @@
 #include <sstream>
 
 #include "fe/contact3d.h"
+#include "fe/field_output3d.h"
+#include "fe/inp_writer.h"
 #include "fe/mirror_planes.h"
 #include "fe/needle_shape.h"
 #include "fe/vtu_writer.h"
@@ -430,6 +432,23 @@ struct Indentation3d::Impl {
 
   // ---- frictionless path ----------------------------------------------------------------------
   bool frictionless() const { return options.contact == ContactMode::Frictionless; }
+
+  // Nodes a needle touches now: captured (sticking) or of a face with a pressed contact point
+  // (frictionless, as the step's report counts them).
+  std::vector<char> touched_nodes() const {
+    std::vector<char> touched(mesh.nodes.size(), 0);
+    if (!frictionless()) {
+      for (const CapturedNode& c : captured) touched[static_cast<std::size_t>(c.node)] = 1;
+      return touched;
+    }
+    const auto& points = contact->points();
+    for (std::size_t q = 0; q < points.size() && q < contact_states.size(); ++q) {
+      if (contact_states[q].traction <= 0.0) continue;
+      for (int a = 0; a < contact->face_nodes(); ++a)
+        touched[static_cast<std::size_t>(points[q].nodes[static_cast<std::size_t>(a)])] = 1;
+    }
+    return touched;
+  }
 
   void setup_frictionless() {
     contact.emplace(mesh, needles, &shapes, reach);
@@ -908,21 +927,45 @@ std::string Indentation3d::solver_backend() const {
   return impl_->solver.backend();
 }
 
-void Indentation3d::write_vtu(const std::string& path) const {
-  const TetMesh& mesh = impl_->mesh;
+InpExport Indentation3d::write_inp(const std::string& path,
+                                   const std::vector<std::string>& comment) const {
+  if (impl_->frictionless())
+    throw InputError(
+        "export: the .inp deck prescribes the needle's sticking contact; the run "
+        "uses frictionless contact");
+  InpProblem problem;
+  problem.mesh = &impl_->mesh;
+  problem.comment_lines = comment;
   const Eigen::VectorXd u = displacement();
-  VtuFields f;
-  f.points_m = mesh.nodes;
-  f.nodes_per_cell = mesh.nodes_per_element();
-  f.cell_type = f.nodes_per_cell == 4 ? 10 : 24;
-  for (const auto& e : mesh.elements)
-    for (int a = 0; a < f.nodes_per_cell; ++a)
-      f.connectivity.push_back(e[static_cast<std::size_t>(a)]);
-  for (Eigen::Index i = 0; i < u.size(); i += 3) f.displacement_m.emplace_back(u.segment<3>(i));
-  f.von_mises_Pa = impl_->model.von_mises(u);
-  f.energy_density_J_per_m3 = impl_->model.energy_density(u);
-  f.layer = mesh.element_layer;
-  fe::write_vtu(path, f);
+  Eigen::VectorXd force;
+  impl_->model.assemble(u, nullptr, &force);
+  InpExport result;
+  for (const CapturedNode& c : impl_->captured) {
+    problem.prescribed_nodes.push_back(c.node);
+    problem.prescribed_u.emplace_back(u.segment<3>(3 * static_cast<Eigen::Index>(c.node)));
+    result.reaction_N += force.segment<3>(3 * static_cast<Eigen::Index>(c.node));
+  }
+  write_inp_deck(path, problem);
+  result.path = path;
+  result.depth_m = impl_->depth;
+  result.nodes = static_cast<int>(impl_->mesh.nodes.size());
+  result.elements = static_cast<int>(impl_->mesh.elements.size());
+  result.prescribed_nodes = static_cast<int>(problem.prescribed_nodes.size());
+  return result;
+}
+
+void Indentation3d::write_vtu(const std::string& path, double depth_m,
+                              const std::string& comment) const {
+  TissueStep3d step;
+  step.mesh = &impl_->mesh;
+  step.u = displacement();
+  impl_->model.assemble(step.u, nullptr, &step.internal_force);
+  step.in_contact = impl_->touched_nodes();
+  step.stress = impl_->model.cauchy_stress(step.u);
+  step.energy_density = impl_->model.energy_density(step.u);
+  VtuFile file = tissue_vtu(step, depth_m);
+  file.comment = comment;
+  fe::write_vtu(path, file);
 }
 
 namespace {
@@ -1039,7 +1082,11 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   for (double a : crack_areas) total_crack_area += whole * a;
   if (cracked_run && !(total_crack_area > 0.0))
     throw SolverError("simulate_3d: the crack opened no mesh face (crack_depth_m too small?)");
-  if (!options.vtu_directory.empty()) create_output_folder(options.vtu_directory, "--vtu");
+  std::vector<PvdEntry> collection;
+  if (!options.vtu_directory.empty()) {
+    create_output_folder(options.vtu_directory, "--vtu");
+    clear_step_files(options.vtu_directory);
+  }
   for (int k = 1; k <= steps; ++k) {
     const double depth = options.depth * k / steps;
     Step3d step = run.advance_to(depth);
@@ -1059,10 +1106,20 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
             (needles[n].y == 0.0 && mesh.mirror_y0 ? 2.0 : 1.0) * crack_areas[n];
       }
     }
-    if (!options.vtu_directory.empty())
-      run.write_vtu(
-          (std::filesystem::path(options.vtu_directory) / ("step_" + std::to_string(k) + ".vtu"))
-              .string());
+    if (!options.vtu_directory.empty()) {
+      const std::filesystem::path dir(options.vtu_directory);
+      const std::string tissue = "step_" + std::to_string(k) + ".vtu",
+                        needles_file = "needles_" + std::to_string(k) + ".vtu";
+      run.write_vtu((dir / tissue).string(), depth, options.vtu_comment);
+      VtuFile surfaces = needles_vtu(all_needles, depth);
+      surfaces.comment = options.vtu_comment;
+      write_vtu((dir / needles_file).string(), surfaces);
+      collection.push_back({depth, 0, tissue});
+      collection.push_back({depth, 1, needles_file});
+      write_pvd((dir / "steps.pvd").string(), collection, options.vtu_comment);
+    }
+    if (!options.inp_path.empty() && depth <= options.inp_depth_m * (1.0 + 1e-12))
+      result.exported = run.write_inp(options.inp_path, options.inp_comment);
     result.steps.push_back(whole_scene_step(step, selection, all_needles));
     if (options.on_step && !options.on_step(result.steps.back())) break;
   }

@@ -194,13 +194,19 @@ TetResponse tet_response(const std::vector<Eigen::Vector3d>& nodes, const Eigen:
   throw SolverError("3-D solid: a tetrahedron has 4 or 10 nodes");
 }
 
-double tet_von_mises(const std::vector<Eigen::Vector3d>& nodes, const Eigen::VectorXd& u,
-                     const Material& material, bool linear_kinematics) {
+Eigen::Matrix3d tet_cauchy_stress(const std::vector<Eigen::Vector3d>& nodes,
+                                  const Eigen::VectorXd& u, const Material& material,
+                                  bool linear_kinematics) {
   const QuadraturePoint centroid{{0.25, 0.25, 0.25, 0.25}, 1.0 / 6.0};
   const PointKinematics k = kinematics(nodes, u, centroid);
   const MaterialResponse m = evaluate_checked(material, k.F, linear_kinematics);
-  if (linear_kinematics) return von_mises_of(m.S);
-  return von_mises_of(k.F * m.S * k.F.transpose() / k.F.determinant());
+  if (linear_kinematics) return m.S;
+  return k.F * m.S * k.F.transpose() / k.F.determinant();
+}
+
+double tet_von_mises(const std::vector<Eigen::Vector3d>& nodes, const Eigen::VectorXd& u,
+                     const Material& material, bool linear_kinematics) {
+  return von_mises_of(tet_cauchy_stress(nodes, u, material, linear_kinematics));
 }
 
 SolidModel::SolidModel(const TetMesh& mesh) : mesh_(&mesh) {
@@ -358,6 +364,17 @@ std::vector<double> SolidModel::von_mises(const Eigen::VectorXd& u) const {
                                    layer_materials_[static_cast<std::size_t>(
                                        mesh_->element_layer[static_cast<std::size_t>(e)])],
                                    linear_));
+  return result;
+}
+
+std::vector<Eigen::Matrix3d> SolidModel::cauchy_stress(const Eigen::VectorXd& u) const {
+  std::vector<Eigen::Matrix3d> result;
+  result.reserve(mesh_->elements.size());
+  for (int e = 0; e < static_cast<int>(mesh_->elements.size()); ++e)
+    result.push_back(tet_cauchy_stress(element_nodes(e), element_displacement(e, u),
+                                       layer_materials_[static_cast<std::size_t>(
+                                           mesh_->element_layer[static_cast<std::size_t>(e)])],
+                                       linear_));
   return result;
 }
 

@@ -1,45 +1,147 @@
 #include "fe/vtu_writer.h"
 
+#include <array>
+#include <charconv>
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <regex>
 
 #include "mneedle/base/error.h"
 
 namespace mneedle::fe {
+namespace {
 
-void write_vtu(const std::string& path, const VtuFields& f) {
-  std::ofstream out(path);
+std::string comment_text(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '-' && !out.empty() && out.back() == '-')
+      out += "\\u002d";
+    else
+      out += c;
+  }
+  if (!out.empty() && out.back() == '-') out += ' ';  // "--->" would end the comment badly
+  return out;
+}
+
+// The shortest text that reads back as the same double.
+std::string shortest(double v) {
+  std::array<char, 32> text{};
+  const auto end = std::to_chars(text.data(), text.data() + text.size(), v).ptr;
+  return std::string(text.data(), end);
+}
+
+// The appended block: each array as a UInt64 byte count followed by its raw bytes.
+class Appended {
+ public:
+  template <class T>
+  std::size_t add(const T* data, std::size_t count) {
+    const std::size_t offset = bytes_.size();
+    const std::uint64_t size = count * sizeof(T);
+    bytes_.append(reinterpret_cast<const char*>(&size), sizeof size);
+    bytes_.append(reinterpret_cast<const char*>(data), size);
+    return offset;
+  }
+  const std::string& bytes() const { return bytes_; }
+
+ private:
+  std::string bytes_;
+};
+
+std::string array_tag(const VtuArray& a, std::size_t offset) {
+  return std::string("<DataArray type=\"") + (a.int32.empty() ? "Float64" : "Int32") +
+         "\" Name=\"" + a.name + "\" NumberOfComponents=\"" + std::to_string(a.components) +
+         "\" format=\"appended\" offset=\"" + std::to_string(offset) + "\"/>\n";
+}
+
+void check_size(const VtuArray& a, std::size_t tuples, const std::string& where) {
+  const std::size_t n = a.int32.empty() ? a.float64.size() : a.int32.size();
+  if (a.components < 1 || n != tuples * static_cast<std::size_t>(a.components))
+    throw SolverError("VTU writer: " + where + " array '" + a.name + "' has " + std::to_string(n) +
+                      " values for " + std::to_string(tuples) + " tuples");
+}
+
+std::string arrays(const std::vector<VtuArray>& list, Appended* block) {
+  std::string xml;
+  for (const VtuArray& a : list)
+    xml += array_tag(a, a.int32.empty() ? block->add(a.float64.data(), a.float64.size())
+                                        : block->add(a.int32.data(), a.int32.size()));
+  return xml;
+}
+
+}  // namespace
+
+void write_vtu(const std::string& path, const VtuFile& f) {
+  const std::size_t points = f.points_m.size(), cells = f.types.size();
+  if (f.offsets.size() != cells ||
+      (cells > 0 && static_cast<std::size_t>(f.offsets.back()) != f.connectivity.size()))
+    throw SolverError("VTU writer: offsets do not match the cells");
+  for (const VtuArray& a : f.point_data) check_size(a, points, "point");
+  for (const VtuArray& a : f.cell_data) check_size(a, cells, "cell");
+  for (const VtuArray& a : f.field_data) check_size(a, 1, "field");
+
+  Appended block;
+  std::string xml =
+      "<?xml version=\"1.0\"?>\n"
+      "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+      "header_type=\"UInt64\">\n";
+  if (!f.comment.empty()) xml += "<!-- " + comment_text(f.comment) + " -->\n";
+  xml += "<UnstructuredGrid>\n";
+  if (!f.field_data.empty())
+    xml += "<FieldData>\n" + arrays(f.field_data, &block) + "</FieldData>\n";
+  xml += "<Piece NumberOfPoints=\"" + std::to_string(points) + "\" NumberOfCells=\"" +
+         std::to_string(cells) + "\">\n<PointData>\n" + arrays(f.point_data, &block) +
+         "</PointData>\n<CellData>\n" + arrays(f.cell_data, &block) + "</CellData>\n<Points>\n";
+  std::vector<double> xyz;
+  xyz.reserve(3 * points);
+  for (const auto& p : f.points_m) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
+  xml +=
+      array_tag({"Points", 3, {}, {}}, block.add(xyz.data(), xyz.size())) + "</Points>\n<Cells>\n";
+  xml += "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"appended\" offset=\"" +
+         std::to_string(block.add(f.connectivity.data(), f.connectivity.size())) + "\"/>\n";
+  xml += "<DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"" +
+         std::to_string(block.add(f.offsets.data(), f.offsets.size())) + "\"/>\n";
+  xml += "<DataArray type=\"UInt8\" Name=\"types\" format=\"appended\" offset=\"" +
+         std::to_string(block.add(f.types.data(), f.types.size())) + "\"/>\n";
+  xml += "</Cells>\n</Piece>\n</UnstructuredGrid>\n<AppendedData encoding=\"raw\">\n_";
+
+  std::ofstream out(path, std::ios::binary);
   if (!out) throw InputError(path + ": cannot open for writing");
-  out.precision(9);
-  const std::size_t cells = f.von_mises_Pa.size();
-  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
-      << "<UnstructuredGrid><Piece NumberOfPoints=\"" << f.points_m.size() << "\" NumberOfCells=\""
-      << cells << "\">\n<Points>\n"
-      << "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const auto& p : f.points_m) out << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
-  out << "</DataArray>\n</Points>\n<Cells>\n"
-      << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (std::size_t i = 0; i < f.connectivity.size(); ++i)
-    out << f.connectivity[i]
-        << ((i + 1) % static_cast<std::size_t>(f.nodes_per_cell) == 0 ? '\n' : ' ');
-  out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (std::size_t e = 1; e <= cells; ++e)
-    out << e * static_cast<std::size_t>(f.nodes_per_cell) << '\n';
-  out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  for (std::size_t e = 0; e < cells; ++e) out << f.cell_type << '\n';
-  out << "</DataArray>\n</Cells>\n<PointData Vectors=\"displacement_m\">\n"
-      << "<DataArray type=\"Float64\" Name=\"displacement_m\" NumberOfComponents=\"3\" "
-         "format=\"ascii\">\n";
-  for (const auto& u : f.displacement_m) out << u.x() << ' ' << u.y() << ' ' << u.z() << '\n';
-  out << "</DataArray>\n</PointData>\n<CellData>\n"
-      << "<DataArray type=\"Float64\" Name=\"von_mises_Pa\" format=\"ascii\">\n";
-  for (double s : f.von_mises_Pa) out << s << '\n';
-  out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"energy_density_J_per_m3\" "
-         "format=\"ascii\">\n";
-  for (double w : f.energy_density_J_per_m3) out << w << '\n';
-  out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"layer\" format=\"ascii\">\n";
-  for (int layer : f.layer) out << layer << '\n';
-  out << "</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+  out << xml;
+  out.write(block.bytes().data(), static_cast<std::streamsize>(block.bytes().size()));
+  out << "\n</AppendedData>\n</VTKFile>\n";
   if (!out) throw InputError(path + ": write failed");
+}
+
+void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries,
+               const std::string& comment) {
+  const std::string temporary = path + ".part";
+  {
+    std::ofstream out(temporary);
+    if (!out) throw InputError(path + ": cannot open for writing");
+    out << "<?xml version=\"1.0\"?>\n";
+    if (!comment.empty()) out << "<!-- " << comment_text(comment) << " -->\n";
+    out << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+           "<Collection>\n";
+    for (const PvdEntry& e : entries)
+      out << "<DataSet timestep=\"" << shortest(e.time) << "\" group=\"\" part=\"" << e.part
+          << "\" file=\"" << e.file << "\"/>\n";
+    out << "</Collection>\n</VTKFile>\n";
+    if (!out) throw InputError(path + ": write failed");
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) throw InputError(path + ": cannot write (" + ec.message() + ")");
+}
+
+void clear_step_files(const std::string& directory) {
+  static const std::regex step(R"((step|needles)_[0-9]+\.vtu|steps\.pvd)");
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(directory, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_regular_file() && std::regex_match(name, step))
+      std::filesystem::remove(entry.path(), ec);
+  }
 }
 
 }  // namespace mneedle::fe

@@ -210,6 +210,10 @@ RunPlan plan_insertion(const Scene& scene, const std::vector<PreparedNeedle>& ne
   plan.full_block_x_m = plan.block_x_m;
   plan.full_block_y_m = plan.block_y_m;
   plan.vtu_directory = options.vtu_directory;
+  plan.vtu_comment = options.vtu_comment;
+  plan.inp_path = options.inp_path;
+  plan.inp_depth_m = options.inp_depth_m;
+  plan.inp_comment = options.inp_comment;
   for (const PreparedNeedle& n : needles)
     plan.needle_radius_m = std::max(plan.needle_radius_m, max_radius_below(n.mesh, plan.horizon_m));
 

@@ -33,6 +33,10 @@ struct RunPlan {
   int steps = 0;           ///< pre-puncture depth steps over the horizon
   double needle_radius_m = 0.0;  ///< largest needle radius reaching the horizon
   std::string vtu_directory;
+  std::string vtu_comment;  ///< the run's provenance, into every VTU file
+  std::string inp_path;     ///< InsertionRunOptions::inp_path (3-D model only)
+  double inp_depth_m = 0.0;
+  std::vector<std::string> inp_comment;
   std::vector<Reduction> reductions;
 };
 

@@ -62,6 +62,7 @@ struct PreResult {
   double min_dihedral_deg = 0.0;
   double max_aspect_ratio = 0.0;
   std::string model;
+  std::optional<fe::InpExport> exported;
 };
 
 fe::ContactMode to_fe(Contact c) {
@@ -129,6 +130,10 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
   o.depth = plan.horizon_m;
   o.steps = plan.steps;
   o.vtu_directory = plan.vtu_directory;
+  o.vtu_comment = plan.vtu_comment;
+  o.inp_path = plan.inp_path;
+  o.inp_depth_m = plan.inp_depth_m;
+  o.inp_comment = plan.inp_comment;
   o.contact = to_fe(options.contact);
   o.overrides = options.overrides;
   o.half_model = plan.half_model;
@@ -138,10 +143,17 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
   if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
     o.crack_depth_m = crack_depth;
   CrossingWatch watch(needles.size(), plan);
+  int step_index = 0;
   o.on_step = [&](const fe::Step3d& step) {
     bool more = true;
-    for (std::size_t i = 0; i < step.needles.size(); ++i)
+    double force = 0.0;
+    for (std::size_t i = 0; i < step.needles.size(); ++i) {
       more = watch.keep_going(i, sample_of(step.depth_m, step.needles[i], areas[i])) && more;
+      force += step.needles[i].force_N;
+    }
+    if (options.on_progress)
+      options.on_progress("fe_3d", ++step_index, o.overrides.steps.value_or(o.steps), step.depth_m,
+                          force);
     return more;
   };
   const fe::Simulation3dResult r = fe::simulate_3d(block, fe_needles, o);
@@ -170,6 +182,7 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
   out.min_dihedral_deg = r.quality.min_dihedral_deg;
   out.max_aspect_ratio = r.quality.max_aspect_ratio;
   out.model = "fe_3d";
+  out.exported = r.exported;
   return out;
 }
 
@@ -201,12 +214,17 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
   p.output_steps = plan.steps;
   p.overrides = options.overrides;
   p.vtu_directory = plan.vtu_directory;
+  p.vtu_comment = plan.vtu_comment;
   if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Stress)
     p.stress_average_length_m = plan.threshold->average_length_m;
   if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
     p.crack_depth_m = crack_depth;
   CrossingWatch watch(1, plan);
+  int step_index = 0;
   p.on_step = [&](const fe::InsertionStep& step) {
+    if (options.on_progress)
+      options.on_progress("fe_axisymmetric", ++step_index,
+                          p.overrides.steps.value_or(p.output_steps), step.depth_m, step.force_N);
     return watch.keep_going(0, sample_of(step.depth_m, step, area));
   };
   const fe::InsertionResult r = fe::simulate_axisymmetric(p);
@@ -633,6 +651,16 @@ void check_needle_placement(const Scene& scene, const std::vector<PreparedNeedle
   }
 }
 
+InsertionRunOptions scene_run_options(const Scene& scene) {
+  InsertionRunOptions r;
+  r.fidelity = scene.model.fidelity == Fidelity::Fast   ? fe::Fidelity::Fast
+               : scene.model.fidelity == Fidelity::Fine ? fe::Fidelity::Fine
+                                                        : fe::Fidelity::Standard;
+  r.contact = scene.model.contact;
+  r.criterion = scene.model.criterion;
+  return r;
+}
+
 InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>& needles,
                            const InsertionRunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -684,6 +712,7 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     run.first_step_m = plan.horizon_m / std::max(plan.steps, 1);
     run.models_run.push_back(pre.model);
     run.nodes = pre.nodes;
+    run.exported = pre.exported;
     run.elements = pre.elements;
     run.order = pre.order;
     run.axisymmetric = pre.axisymmetric;

@@ -9,6 +9,7 @@
 
 #include "mneedle/base/error.h"
 #include "needle_meshes.h"
+#include "small_skin.h"
 
 namespace {
 
@@ -154,7 +155,7 @@ TEST(Indentation3d, WritesVtuThatNamesEveryField) {
   Indentation3d run(mesh, {{"punch", cylinder_needle(a, 1e-3), 0.0, 0.0}}, d);
   run.advance_to(d);
   const auto path = std::filesystem::temp_directory_path() / "mneedle_test_indentation3d.vtu";
-  run.write_vtu(path.string());
+  run.write_vtu(path.string(), d);
   std::ifstream in(path);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   for (const char* field : {"displacement_m", "von_mises_Pa", "energy_density_J_per_m3", "layer"})
@@ -196,13 +197,7 @@ TEST(Indentation3d, SimulateThreeDimensionalReportsMeshAndCurve) {
 }
 
 // A soft two-layer block for the options tests: small enough for a fraction of a second.
-TissueBlockSpec small_skin() {
-  TissueBlockSpec block;
-  block.size_x = block.size_y = 800e-6;
-  block.layers = {{"top", 20e-6, {MaterialModel::Linear, 2e6, 0.4, 0.0, 0.0}},
-                  {"bottom", 300e-6, {MaterialModel::Linear, 0.1e6, 0.4, 0.0, 0.0}}};
-  return block;
-}
+using mneedle::test::small_skin;
 
 Simulation3dOptions small_options() {
   Simulation3dOptions options;

@@ -130,10 +130,13 @@ class AxisymmetricModel {
   /// Returns 0 when no part of the layer is within reach.
   double averaged_max_principal_stress(const Eigen::VectorXd& u, const Eigen::Vector2d& point_m,
                                        double length_m, int layer) const;
-  /// ASCII VTU (ParaView): the (r, z) mesh as quadratic triangles in the plane y = 0 (x = r,
+  /// Binary VTU (ParaView): the (r, z) mesh as quadratic triangles in the plane y = 0 (x = r,
   /// z = z), point data displacement_m (u_r, 0, u_z), cell data von_mises_Pa,
-  /// energy_density_J_per_m3 and layer. Throws InputError when the file cannot be written.
-  void write_vtu(const std::string& path, const Eigen::VectorXd& u) const;
+  /// principal_stress_Pa (largest first, σ_θθ among them), energy_density_J_per_m3 and layer;
+  /// field data depth_m and axisymmetric = 1; `comment` as an XML comment. Throws InputError
+  /// when the file cannot be written.
+  void write_vtu(const std::string& path, const Eigen::VectorXd& u, double depth_m,
+                 const std::string& comment = "") const;
 
   /// Internal force vector at displacement u; tangent stiffness when `tangent` is not null.
   /// Throws SolverError on an inverted element.
@@ -185,9 +188,10 @@ struct InsertionOptions {
   double crack_depth_m = 0.0;
   /// Called after each output step; returning false stops the insertion there.
   std::function<bool(const InsertionStep&)> on_step;
-  /// When set, step_<k>.vtu (k = 1..output steps) is written there: the (r, z) mesh as
-  /// quadratic triangles with displacement, von Mises stress, strain energy density, layer id.
+  /// When set, step_<k>.vtu (k = 1..output steps) is written there (AxisymmetricModel::write_vtu)
+  /// and steps.pvd updated (the collection, depth as time); an earlier run's files go first.
   std::string vtu_directory;
+  std::string vtu_comment;  ///< written into every VTU and the .pvd (the run's provenance)
 };
 
 struct InsertionResult {
@@ -223,6 +227,7 @@ struct AxisymmetricProblem {
   double crack_depth_m = 0.0;            ///< as InsertionOptions
   std::function<bool(const InsertionStep&)> on_step;
   std::string vtu_directory;
+  std::string vtu_comment;
 };
 
 InsertionResult simulate_axisymmetric(const AxisymmetricProblem& problem);

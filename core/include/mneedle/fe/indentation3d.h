@@ -7,6 +7,7 @@
 #include <array>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,18 @@ struct Indentation3dOptions {
   double tolerance = 1e-8;  ///< Newton: free residual / reaction force
 };
 
+/// What write_inp wrote: the depth, and the sum of the tissue's internal forces at the
+/// prescribed nodes — the reaction an independent solver of the deck must reproduce (N, meshed
+/// part only: a half model's is half the needle's).
+struct InpExport {
+  std::string path;
+  double depth_m = 0.0;
+  Eigen::Vector3d reaction_N = Eigen::Vector3d::Zero();
+  int nodes = 0;
+  int elements = 0;
+  int prescribed_nodes = 0;
+};
+
 /// Repeated solves on one mesh: advance_to() a growing sequence of depths.
 /// Linear materials: the stiffness is factorised once; contact is solved on the captured
 /// surface nodes through their condensed compliance (columns of K⁻¹ added as nodes are
@@ -94,8 +107,15 @@ class Indentation3d {
   Eigen::VectorXd displacement() const;
   const Timing3d& timing() const;
   std::string solver_backend() const;
-  /// Writes an ASCII VTU (displacement, von Mises stress, strain energy density, layer id).
-  void write_vtu(const std::string& path) const;
+  /// Writes the problem of the last depth as a CalculiX/Abaqus deck (fe/inp_writer.h): mesh,
+  /// linear layers, fixed faces, mirror planes and every captured node's displacement
+  /// prescribed. Sticking contact only (InputError otherwise); `comment` as "** " lines.
+  InpExport write_inp(const std::string& path, const std::vector<std::string>& comment) const;
+  /// Writes the tissue at the last depth as a binary VTU of the whole block (a half or quarter
+  /// model reflected back): displacement, contact force, traction and pressure, von Mises and
+  /// principal stresses, strain energy density, layer (docs/cli.md, "Fields"). `comment` goes
+  /// into the file as an XML comment (the run's provenance).
+  void write_vtu(const std::string& path, double depth_m, const std::string& comment = "") const;
 
  private:
   struct Impl;
@@ -104,10 +124,13 @@ class Indentation3d {
 
 struct Simulation3dOptions {
   Fidelity fidelity = Fidelity::Standard;
-  int order = 2;              ///< 1: TET4, 2: TET10 (overrides.order wins when set)
-  double depth = 0.0;         ///< final tip depth below the undeformed surface (m)
-  int steps = 10;             ///< equal output steps in depth (overrides.steps wins when set)
-  std::string vtu_directory;  ///< when set, step_<k>.vtu is written there for every step
+  int order = 2;       ///< 1: TET4, 2: TET10 (overrides.order wins when set)
+  double depth = 0.0;  ///< final tip depth below the undeformed surface (m)
+  int steps = 10;      ///< equal output steps in depth (overrides.steps wins when set)
+  /// When set, every step writes step_<k>.vtu (tissue) and needles_<k>.vtu there and updates
+  /// steps.pvd (the collection, depth as time); files of an earlier run are removed first.
+  std::string vtu_directory;
+  std::string vtu_comment;  ///< written into every VTU and the .pvd (the run's provenance)
   ContactMode contact = ContactMode::Sticking;
   /// Honoured: order, tip_size_m, growth, domain_scale (block size x and y), tolerance, steps,
   /// elements_through_top.
@@ -124,6 +147,11 @@ struct Simulation3dOptions {
   double crack_depth_m = 0.0;
   /// Called after each output step; returning false stops the insertion there.
   std::function<bool(const Step3d&)> on_step;
+  /// When set, the problem at the last step not deeper than inp_depth_m is written there
+  /// as a CalculiX/Abaqus deck (Indentation3d::write_inp; linear layers, sticking contact).
+  std::string inp_path;
+  double inp_depth_m = 0.0;
+  std::vector<std::string> inp_comment;  ///< "** " lines of the deck (the run's provenance)
 };
 
 struct Simulation3dResult {
@@ -134,6 +162,7 @@ struct Simulation3dResult {
   MeshQuality quality;
   Timing3d timing;
   std::string solver_backend;
+  std::optional<InpExport> exported;  ///< set when options.inp_path was written
 };
 
 /// One call for the CLI: meshes `block` graded toward every needle (sites, fidelity, order and

@@ -23,6 +23,10 @@ TetResponse tet_response(const std::vector<Eigen::Vector3d>& nodes, const Eigen:
                          const Material& material, bool linear_kinematics);
 
 /// Von Mises stress (Pa) at the element centroid: Cauchy stress from S and F.
+/// Cauchy stress (Pa) of the element at its centroid.
+Eigen::Matrix3d tet_cauchy_stress(const std::vector<Eigen::Vector3d>& nodes,
+                                  const Eigen::VectorXd& u, const Material& material,
+                                  bool linear_kinematics);
 double tet_von_mises(const std::vector<Eigen::Vector3d>& nodes, const Eigen::VectorXd& u,
                      const Material& material, bool linear_kinematics);
 
@@ -50,6 +54,8 @@ class SolidModel {
   void add_block(int row, int column, const Eigen::Matrix3d& block,
                  Eigen::SparseMatrix<double>* stiffness) const;
   std::vector<double> von_mises(const Eigen::VectorXd& u) const;
+  /// Cauchy stress (Pa) per element at its centroid: the von Mises value above is of this tensor.
+  std::vector<Eigen::Matrix3d> cauchy_stress(const Eigen::VectorXd& u) const;
   /// Strain energy density (J/m^3) per element (mean over its quadrature points).
   std::vector<double> energy_density(const Eigen::VectorXd& u) const;
 

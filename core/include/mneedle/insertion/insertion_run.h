@@ -5,12 +5,14 @@
 // asked for, axisymmetric or half models where the geometry allows, FE only up to puncture when
 // only the puncture is asked for) and reports what it decided. SI units throughout.
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "mneedle/fe/axisymmetric.h"
 #include "mneedle/fe/fidelity.h"
+#include "mneedle/fe/indentation3d.h"
 #include "mneedle/insertion/energy_check.h"
 #include "mneedle/needle/mesh.h"
 #include "mneedle/scene/scene.h"
@@ -48,6 +50,20 @@ struct InsertionRunOptions {
   /// InputError (a 10 x 10 array needs GBs of memory and tens of minutes at fast).
   std::size_t max_fe_needles = 16;
   std::string vtu_directory;  ///< fields per step when set (or when the scene asks for them)
+  std::string vtu_comment;    ///< written into every VTU file and the .pvd (provenance)
+  /// When set (3-D model, linear layers, sticking contact), the problem of the last FE step not
+  /// deeper than inp_depth_m is written there as a CalculiX/Abaqus deck (docs/cli.md,
+  /// "mneedle export"); InsertionRun::exported says what was written.
+  std::string inp_path;
+  double inp_depth_m = 0.0;
+  std::vector<std::string> inp_comment;
+  /// Called after every step of a pre-puncture FE model, the reference runs that check a
+  /// reduction included (each starts again at step 1); not by the closed form, which takes
+  /// milliseconds. Gives the model's name
+  /// ("fe_3d", "fe_axisymmetric"), the step and the number planned, its depth and the total
+  /// force on the needles.
+  std::function<void(const std::string& model, int step, int steps, double depth_m, double force_N)>
+      on_progress;
 };
 
 enum class Stage { Pre, Post };
@@ -128,7 +144,13 @@ struct InsertionRun {
   std::optional<EnergyCheck> energy_check;
   /// The process's peak resident memory at the end of the run (bytes; 0 where not measurable).
   std::size_t peak_memory_bytes = 0;
+  /// What InsertionRunOptions::inp_path received (3-D model only).
+  std::optional<fe::InpExport> exported;
 };
+
+/// The scene's [model] choices as run options: fidelity, contact and criterion (every other
+/// option at its default). Commands start from this and apply their command line on top.
+InsertionRunOptions scene_run_options(const Scene& scene);
 
 /// Runs the scene's insertion for the prepared needles (one per scene needle, same order).
 /// Throws InputError for a scene that cannot be run as asked and SolverError (naming the depth)
