@@ -232,6 +232,12 @@ plot::Figure energy_figure(const std::vector<Record>& records) {
         {"puncture", c.depth_m[r.stages.puncture_index], c.force_N[r.stages.puncture_index]});
     f.points.push_back({"peak", c.depth_m[r.stages.peak_index], c.force_N[r.stages.peak_index]});
   }
+  // Past three records the words would pile up on each other: the circles stay, the title says
+  // what they are.
+  if (drawn > 3) {
+    for (plot::Point& p : f.points) p.label.clear();
+    f.title = "energy: " + std::to_string(drawn) + " records (circles: puncture and peak)";
+  }
   if (drawn == 1) {
     for (const Record& r : records) {
       if (!r.error.empty()) continue;

@@ -23,6 +23,8 @@ constexpr int kPalette[10][3] = {{31, 119, 180},  {214, 39, 40}, {44, 160, 44}, 
                                  {148, 103, 189}, {140, 86, 75}, {227, 119, 194}, {127, 127, 127},
                                  {188, 189, 34},  {23, 190, 207}};
 constexpr int kForeground = 15, kGrey = 14;
+// Legend lines that fit beside a rising curve in the top-left corner of the default figure.
+constexpr std::size_t kMaxLegendEntries = 8;
 
 // PLplot reads '#' as its escape character in text.
 std::string escaped(const std::string& text) {
@@ -124,6 +126,15 @@ void write_svg(const std::filesystem::path& file, const Figure& f) {
   const double pad = 0.05 * (y1 - y0);
   y1 += pad;
   if (y0 < 0.0 || f.y.logarithmic) y0 -= pad;
+  // Headroom for the legend (top left, about 5.5 % of the height a line, 3 % of frame) so that
+  // it sits above the data instead of on them.
+  const auto labelled = static_cast<std::size_t>(std::count_if(
+      f.series.begin(), f.series.end(), [](const Series& s) { return !s.label.empty(); }));
+  if (labelled > 1 && !f.y.logarithmic) {
+    const double covered =
+        0.03 + 0.055 * static_cast<double>(std::min(labelled, kMaxLegendEntries));
+    y1 = y0 + (y1 - y0) / (1.0 - covered);
+  }
 
   std::error_code ec;
   const auto tmp = std::filesystem::path(file.string() + ".tmp");
@@ -215,6 +226,20 @@ void write_svg(const std::filesystem::path& file, const Figure& f) {
     plschr(0, 1.0);
   }
 
+  // A legend longer than the plot is tall hides the curves: past kMaxLegendEntries the rest are
+  // counted in one line (their curves are still drawn).
+  if (texts.size() > kMaxLegendEntries) {
+    const std::size_t hidden = texts.size() - (kMaxLegendEntries - 1);
+    for (auto* v : {&text_colour, &line_colour, &symbol_colour, &symbol_number, &line_style})
+      v->resize(kMaxLegendEntries);
+    opt.resize(kMaxLegendEntries);
+    texts.resize(kMaxLegendEntries);
+    symbols.resize(kMaxLegendEntries);
+    line_width.resize(kMaxLegendEntries);
+    symbol_scale.resize(kMaxLegendEntries);
+    opt.back() = PL_LEGEND_NONE;
+    texts.back() = "and " + std::to_string(hidden) + " more";
+  }
   // One curve needs no legend: the title names it.
   if (texts.size() > 1) {
     std::vector<const char*> text_ptrs, symbol_ptrs;

@@ -203,6 +203,21 @@ TEST(CmdEnergy, PlotMarksTheStagesAndTheCuttingStretch) {
     EXPECT_TRUE(mneedle::test::has_text(t, label)) << label;
 }
 
+// Four records: every curve named in the legend, the punctures and peaks circled without words
+// (eight labels would pile up), the title saying what the circles are.
+TEST(CmdEnergy, PlotOfManyRecordsCirclesWithoutWords) {
+  std::string files;
+  for (int k = 0; k < 4; ++k)
+    files += " '" + write_record("many" + std::to_string(k) + ".csv", 0.90 + 0.01 * k) + "'";
+  const auto svg = kWork / "many.svg";
+  const auto run = run_mneedle("energy" + files + " --plot '" + svg.string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto t = mneedle::test::texts(mneedle::test::read_svg(svg));
+  EXPECT_TRUE(mneedle::test::has_text(t, "energy: 4 records (circles: puncture and peak)"));
+  EXPECT_TRUE(mneedle::test::has_text(t, "many3.csv"));
+  EXPECT_FALSE(mneedle::test::has_text(t, "puncture"));
+}
+
 TEST(CmdEnergy, PlotIntoAMissingFolderIsOneErrorLine) {
   const auto file = write_record("noplot.csv", 0.90);
   const auto run =

@@ -125,6 +125,27 @@ TEST(WriteSvg, OneCurveHasNoLegend) {
   EXPECT_FALSE(has_text(texts(read(file)), "FE"));
 }
 
+// 30 records in one figure (mneedle energy rec*.csv): the legend keeps 7 names and counts the
+// rest in its last line instead of covering the curves; every curve is still drawn.
+TEST(WriteSvg, LongLegendCountsWhatItDoesNotName) {
+  fs::create_directories(kWork);
+  Figure f = force_figure();
+  f.series.clear();
+  for (int k = 0; k < 30; ++k) {
+    Series s;
+    s.label = "record " + std::to_string(k);
+    s.x = {0.0, 1e-4};
+    s.y = {0.0, 1e-3 * (k + 1)};
+    f.series.push_back(s);
+  }
+  const auto file = kWork / "many.svg";
+  mneedle::plot::write_svg(file, f);
+  const auto labels = texts(read(file));
+  EXPECT_TRUE(has_text(labels, "record 6"));
+  EXPECT_FALSE(has_text(labels, "record 7"));
+  EXPECT_TRUE(has_text(labels, "and 23 more"));
+}
+
 TEST(WriteSvg, GapsInTheDataSplitTheLine) {
   fs::create_directories(kWork);
   const auto file = kWork / "gap.svg";
