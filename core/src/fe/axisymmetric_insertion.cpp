@@ -601,9 +601,14 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
             u, Eigen::Vector2d::Zero(), options.stress_average_length_m, 0);
       if (!options.vtu_directory.empty()) {
         const std::filesystem::path dir(options.vtu_directory);
-        const std::string file = "step_" + std::to_string(k) + ".vtu";
+        const std::string file = "step_" + std::to_string(k) + ".vtu",
+                          needle_file = "needles_" + std::to_string(k) + ".vtu";
         model.write_vtu((dir / file).string(), u, depth, options.vtu_comment);
+        VtuFile profile = axi::needle_profile_vtu(needle, depth);
+        profile.comment = options.vtu_comment;
+        write_vtu((dir / needle_file).string(), profile);
         collection.push_back({depth, 0, file});
+        collection.push_back({depth, 1, needle_file});
         write_pvd((dir / "steps.pvd").string(), collection, options.vtu_comment);
       }
     }

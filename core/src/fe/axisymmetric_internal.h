@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "fe/vtu_writer.h"
 #include "mneedle/fe/axisymmetric.h"
 #include "mneedle/fe/material.h"
 #include "mneedle/fe/sparse_solver.h"
@@ -97,6 +98,10 @@ inline std::string format_depth(double depth_m) {
 // sparsity pattern (and its symbolic factorisation) stays the same for every constraint set.
 void constrain(Eigen::SparseMatrix<double>& K, const std::vector<char>& is_constrained,
                double diagonal);
+
+/// The needle's outer outline at `depth_m` in the x-z plane (x = r, tip on the axis at
+/// z = -depth) as line segments, cell data none, field data depth_m: part 1 of the collection.
+VtuFile needle_profile_vtu(const AxisymmetricNeedle& needle, double depth_m);
 
 }  // namespace mneedle::fe::axi
 

@@ -120,6 +120,21 @@ double AxisymmetricModel::averaged_max_principal_stress(const Eigen::VectorXd& u
   return volume > 0.0 ? weighted / volume : 0.0;
 }
 
+VtuFile axi::needle_profile_vtu(const AxisymmetricNeedle& needle, double depth_m) {
+  VtuFile f;
+  f.points_m.emplace_back(0.0, 0.0, -depth_m);  // the tip on the axis
+  for (std::size_t i = 0; i < needle.heights_m.size(); ++i)
+    f.points_m.emplace_back(needle.radii_m[i], 0.0, needle.heights_m[i] - depth_m);
+  for (std::size_t i = 0; i + 1 < f.points_m.size(); ++i) {
+    f.connectivity.insert(f.connectivity.end(),
+                          {static_cast<std::int64_t>(i), static_cast<std::int64_t>(i + 1)});
+    f.offsets.push_back(static_cast<std::int64_t>(f.connectivity.size()));
+    f.types.push_back(3);  // VTK_LINE
+  }
+  f.field_data = {{"depth_m", 1, {depth_m}, {}}};
+  return f;
+}
+
 void AxisymmetricModel::write_vtu(const std::string& path, const Eigen::VectorXd& u, double depth_m,
                                   const std::string& comment) const {
   const Impl& m = *impl_;

@@ -224,6 +224,16 @@ TEST(AxisymmetricVtu, WritesOneParaViewFilePerStepWithAllFields) {
               r.steps[static_cast<std::size_t>(k - 1)].depth_m);
   }
   EXPECT_FALSE(std::filesystem::exists(dir / "step_3.vtu"));
+  // the needle's outline at step 2: from its tip on the axis at minus the depth, line segments
+  const auto outline = mneedle::test::read_vtu((dir / "needles_2.vtu").string());
+  for (double type : outline.arrays.at("types").values) EXPECT_EQ(type, 3.0);
+  EXPECT_EQ(outline.arrays.at("Points").values[0], 0.0);
+  EXPECT_EQ(outline.arrays.at("Points").values[2], -r.steps[1].depth_m);
+  std::ifstream pvd(dir / "steps.pvd");
+  std::stringstream collection;
+  collection << pvd.rdbuf();
+  EXPECT_NE(collection.str().find("part=\"1\" file=\"needles_2.vtu\""), std::string::npos)
+      << collection.str();
   std::filesystem::remove_all(dir);
 }
 
