@@ -26,6 +26,7 @@
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
 #include "mneedle/scene/scene_edit.h"
+#include "progress_line.h"
 #include "run_provenance.h"
 
 namespace mneedle::cli {
@@ -44,6 +45,7 @@ struct CalibrateArgs {
   std::string fidelity;
   std::vector<std::string> plugin_dirs;
   bool json = false;
+  bool quiet = false;  // no progress line
 };
 
 std::vector<CalibratedConstant> parse_fit_list(const std::string& text) {
@@ -226,7 +228,13 @@ void run(const CalibrateArgs& a) {
       PluginRegistry::discover({a.plugin_dirs.begin(), a.plugin_dirs.end()});
   const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene);
   record_plugin_meshes(scene, needles);
+  ProgressLine progress(std::cerr, "calibrate", stderr_is_terminal(), a.quiet);
+  options.run.on_progress = [&](const std::string& model, int step, int steps, double depth,
+                                double force) {
+    progress.update({model, step, steps, depth, force});
+  };
   const Calibration c = calibrate(scene, needles.front(), measured, options);
+  progress.finish();
 
   const nlohmann::json tree = to_json(c, scene, a);
   require_finite_json(tree, "calibrate");
@@ -297,6 +305,8 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--force-unit", a->force_unit, "Unit of the force column (default: its name)");
   cmd->add_option("--plugin-dir", a->plugin_dirs, "Extra plugin folder (repeatable)");
   cmd->add_flag("--json", a->json, "Print JSON");
+  cmd->add_flag("--quiet", a->quiet,
+                "no progress line on stderr (shown for runs longer than a second)");
   cmd->callback([a] { run(*a); });
 }
 
