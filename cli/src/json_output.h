@@ -24,7 +24,7 @@ void require_finite_row(const std::vector<double>& values, const std::vector<std
                         std::string_view row, std::string_view context);
 
 /// Checks, then writes tree.dump(2) and a newline; an object gets the run's "provenance"
-/// (run_provenance.h) as its last key unless it has one.
+/// (run_provenance.h) as a top-level key unless it has one.
 void print_checked_json(std::ostream& out, const nlohmann::json& tree, std::string_view context);
 void print_checked_json(std::ostream& out, const nlohmann::ordered_json& tree,
                         std::string_view context);

@@ -39,7 +39,17 @@ int main(int argc, char** argv) {
       const std::string word = i == 0 ? std::string("mneedle") : std::string(argv[i]);
       command += (i ? " " : "") + (word.find(' ') == std::string::npos ? word : "'" + word + "'");
     }
-    mneedle::cli::run_provenance() = mneedle::start_provenance(command);
+    // A malformed SOURCE_DATE_EPOCH is an error for a run, not for --help or --version.
+    bool asks_help = false;
+    for (int i = 1; i < argc; ++i) {
+      const std::string word(argv[i]);
+      asks_help = asks_help || word == "--help" || word == "-h" || word == "--version";
+    }
+    try {
+      mneedle::cli::run_provenance() = mneedle::start_provenance(mneedle::cli::valid_utf8(command));
+    } catch (const mneedle::InputError&) {
+      if (!asks_help) throw;
+    }
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --help, --version

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <iomanip>
 #include <sstream>
 
 #include "mneedle/base/units.h"
@@ -30,11 +31,11 @@ ProgressLine::ProgressLine(std::ostream& out, std::string command, bool terminal
 
 std::string ProgressLine::text(const ProgressState& s, double elapsed_s) const {
   std::ostringstream line;
-  line.precision(3);
   line << command_ << ": " << s.model << " step " << s.step;
   if (s.steps > 0) line << "/" << s.steps;
   line << ", depth " << format_quantity(s.depth_m, Dimension::Length) << ", force "
-       << format_quantity(s.force_N, Dimension::Force) << ", " << elapsed_s << " s";
+       << format_quantity(s.force_N, Dimension::Force) << ", " << std::fixed << std::setprecision(1)
+       << elapsed_s << " s";
   return line.str();
 }
 

@@ -28,9 +28,13 @@ class ProgressLine {
   void update(const ProgressState& state);
   /// Ends a redrawn line with a newline so that what follows starts on its own line.
   void finish();
+  /// finish(): an error that ends the run starts on its own line too.
+  ~ProgressLine() { finish(); }
+  ProgressLine(const ProgressLine&) = delete;
+  ProgressLine& operator=(const ProgressLine&) = delete;
 
   /// The text of one update, without line control: "simulate: fe_3d step 7/20, depth 35 um,
-  /// force 1.23 mN, 2.1 s".
+  /// force 1.23 mN, 2.1 s" (seconds since the progress line was made, one decimal).
   std::string text(const ProgressState& state, double elapsed_s) const;
 
  private:

@@ -28,8 +28,14 @@ Provenance& run_provenance() {
   return p;
 }
 
+std::string valid_utf8(const std::string& text) {
+  const std::string quoted =
+      nlohmann::json(text).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  return nlohmann::json::parse(quoted).get<std::string>();
+}
+
 void record_input(const std::string& role, const std::filesystem::path& file) {
-  run_provenance().inputs.push_back({role, file.string(), sha256_of_file(file)});
+  run_provenance().inputs.push_back({role, valid_utf8(file.string()), sha256_of_file(file)});
 }
 
 void record_scene(const Scene& scene, const std::filesystem::path& file) {
@@ -40,7 +46,8 @@ void record_scene(const Scene& scene, const std::filesystem::path& file) {
 }
 
 void record_mesh(const std::string& name, const TriangleMesh& mesh) {
-  run_provenance().inputs.push_back({"needle mesh " + name, name, mesh_sha256(mesh)});
+  run_provenance().inputs.push_back(
+      {valid_utf8("needle mesh " + name), valid_utf8(name), mesh_sha256(mesh)});
 }
 
 void record_plugin_meshes(const Scene& scene, const std::vector<PreparedNeedle>& needles) {

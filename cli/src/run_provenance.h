@@ -22,6 +22,10 @@ namespace mneedle::cli {
 /// Started by main() with argv; commands add to it.
 Provenance& run_provenance();
 
+/// `text` with every byte that is not valid UTF-8 replaced by U+FFFD: JSON holds only UTF-8, and a
+/// Latin-1 file name on the command line must not fail the output after the run.
+std::string valid_utf8(const std::string& text);
+
 /// Adds a file with the SHA-256 of its bytes; InputError when it cannot be read.
 void record_input(const std::string& role, const std::filesystem::path& file);
 
@@ -38,8 +42,8 @@ void record_plugin_meshes(const Scene& scene, const std::vector<PreparedNeedle>&
 
 nlohmann::ordered_json provenance_json();
 
-/// `tree` with the run's provenance as its last key when it is an object without one; what every
-/// command prints or writes as JSON goes through this.
+/// `tree` with the run's provenance as a top-level key when it is an object without one (last in
+/// an ordered_json, in key order in a json); what every command prints or writes goes through this.
 template <class Json>
 Json with_provenance(Json tree) {
   if (tree.is_object() && !tree.contains("provenance")) tree["provenance"] = provenance_json();

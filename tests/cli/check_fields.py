@@ -91,6 +91,14 @@ def main():
                            t[:, 3] - t[:, 0])
         if not np.all(volume > 0):
             fail(f"{path}: {np.sum(volume <= 0)} cells are inverted")
+        # every mid-edge node at the middle of its edge (VTK's order 01 12 20 03 13 23), the
+        # mirrored cells included
+        cells = mesh.cells[0].data
+        for k, (i, j) in enumerate(((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))):
+            middle = 0.5 * (mesh.points[cells[:, i]] + mesh.points[cells[:, j]])
+            off = np.abs(mesh.points[cells[:, 4 + k]] - middle).max()
+            if off > 1e-12:
+                fail(f"{path}: mid-edge node {4 + k} is {off} m off its edge's middle")
         # the needle's force at this depth is the sum of the nodal contact forces (the solver's
         # residual, 1e-8 of the force, bounds the difference)
         force = force_at.get(round(depth * 1e12))

@@ -44,6 +44,9 @@ TEST(ProgressLine, PipedPrintsOneLinePerStepWithDepthForceAndTime) {
   EXPECT_EQ(err.str(),
             "simulate: fe_3d step 7/20, depth 35 um, force 1.23 mN, 2.1 s\n"
             "simulate: fe_3d step 8/20, depth 40 um, force 1.5 mN, 2.6 s\n");
+  t.now += 1234.56;  // a long fine run: still seconds, one decimal
+  line.update(kStep);
+  EXPECT_NE(err.str().find(", 1237.2 s\n"), std::string::npos) << err.str();
 }
 
 TEST(ProgressLine, TerminalRedrawsOneLineAndEndsIt) {
@@ -56,6 +59,19 @@ TEST(ProgressLine, TerminalRedrawsOneLineAndEndsIt) {
   line.finish();
   const std::string text = "simulate: fe_3d step 7/20, depth 35 um, force 1.23 mN, 1.5 s";
   EXPECT_EQ(err.str(), "\r\033[K" + text + "\r\033[K" + text + "\n");
+}
+
+// A run that throws leaves through the destructor: the error starts on its own line.
+TEST(ProgressLine, LeavingTheScopeEndsTheRedrawnLine) {
+  FakeClock t;
+  std::ostringstream err;
+  {
+    ProgressLine line(err, "simulate", true, false, t.clock());
+    t.now += 1.5;
+    line.update(kStep);
+  }
+  ASSERT_FALSE(err.str().empty());
+  EXPECT_EQ(err.str().back(), '\n');
 }
 
 TEST(ProgressLine, QuietPrintsNothing) {

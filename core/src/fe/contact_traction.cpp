@@ -81,12 +81,13 @@ std::vector<Eigen::Vector3d> recover_traction(const std::vector<Eigen::Vector3d>
 }
 
 std::vector<Eigen::Vector3d> face_normals_at_points(const std::vector<Eigen::Vector3d>& points,
+                                                    const std::vector<Eigen::Vector3d>& reference,
                                                     const std::vector<std::array<int, 6>>& faces,
                                                     int face_nodes) {
   std::vector<Eigen::Vector3d> normal(points.size(), Eigen::Vector3d::Zero());
   for (const auto& f : faces) {
     Eigen::Vector3d a = area_vector(points, f);
-    if (a.z() < 0.0) a = -a;
+    if (area_vector(reference, f).z() < 0.0) a = -a;
     for (int i = 0; i < face_nodes; ++i)
       normal[static_cast<std::size_t>(f[static_cast<std::size_t>(i)])] += a;
   }

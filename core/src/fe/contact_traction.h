@@ -22,9 +22,12 @@ std::vector<Eigen::Vector3d> recover_traction(const std::vector<Eigen::Vector3d>
                                               int face_nodes,
                                               const std::vector<Eigen::Vector3d>& nodal_force);
 
-/// Unit normal of each point: the area-weighted mean of the normals of its faces, oriented to
-/// +z (the tissue's outward normal before it is pushed in); zero at points of no face.
+/// Unit normal of each point: the area-weighted mean of the normals of its faces at `points`
+/// (current positions), each oriented as its face's normal at `reference` points +z (the top
+/// faces' outward normal before the needle pushed them, so a face tilted past vertical under a
+/// tip keeps its side); zero at points of no face.
 std::vector<Eigen::Vector3d> face_normals_at_points(const std::vector<Eigen::Vector3d>& points,
+                                                    const std::vector<Eigen::Vector3d>& reference,
                                                     const std::vector<std::array<int, 6>>& faces,
                                                     int face_nodes);
 

@@ -164,9 +164,15 @@ VtuFile tissue_vtu(const TissueStep3d& s, double depth_m) {
     current[i] = f.points_m[i] + Eigen::Vector3d(uu[3 * i], uu[3 * i + 1], uu[3 * i + 2]);
     whole_force[i] = Eigen::Vector3d(ff[3 * i], ff[3 * i + 1], ff[3 * i + 2]);
   }
-  const std::vector<Eigen::Vector3d> traction =
-      recover_traction(current, faces, face_nodes, whole_force);
-  const std::vector<Eigen::Vector3d> normal = face_normals_at_points(current, faces, face_nodes);
+  // A contact face crushed to no area leaves M singular: the file then carries no traction (zero),
+  // rather than losing the whole run after its solve; the forces are still there.
+  std::vector<Eigen::Vector3d> traction(whole, Eigen::Vector3d::Zero());
+  try {
+    traction = recover_traction(current, faces, face_nodes, whole_force);
+  } catch (const SolverError&) {
+  }
+  const std::vector<Eigen::Vector3d> normal =
+      face_normals_at_points(current, f.points_m, faces, face_nodes);
   std::vector<double> pressure(whole, 0.0);
   for (std::size_t i = 0; i < whole; ++i) pressure[i] = -traction[i].dot(normal[i]);
   f.point_data.push_back(vector_array("contact_traction_Pa", traction));

@@ -48,10 +48,13 @@ class Appended {
   std::string bytes_;
 };
 
-std::string array_tag(const VtuArray& a, std::size_t offset) {
+// NumberOfTuples is required by VTK's reader for field data (without it ParaView reads the array
+// as empty); it is written on every array, where it is harmless.
+std::string array_tag(const VtuArray& a, std::size_t tuples, std::size_t offset) {
   return std::string("<DataArray type=\"") + (a.int32.empty() ? "Float64" : "Int32") +
          "\" Name=\"" + a.name + "\" NumberOfComponents=\"" + std::to_string(a.components) +
-         "\" format=\"appended\" offset=\"" + std::to_string(offset) + "\"/>\n";
+         "\" NumberOfTuples=\"" + std::to_string(tuples) + "\" format=\"appended\" offset=\"" +
+         std::to_string(offset) + "\"/>\n";
 }
 
 void check_size(const VtuArray& a, std::size_t tuples, const std::string& where) {
@@ -63,9 +66,12 @@ void check_size(const VtuArray& a, std::size_t tuples, const std::string& where)
 
 std::string arrays(const std::vector<VtuArray>& list, Appended* block) {
   std::string xml;
-  for (const VtuArray& a : list)
-    xml += array_tag(a, a.int32.empty() ? block->add(a.float64.data(), a.float64.size())
-                                        : block->add(a.int32.data(), a.int32.size()));
+  for (const VtuArray& a : list) {
+    const std::size_t values = a.int32.empty() ? a.float64.size() : a.int32.size();
+    xml += array_tag(a, values / static_cast<std::size_t>(a.components),
+                     a.int32.empty() ? block->add(a.float64.data(), a.float64.size())
+                                     : block->add(a.int32.data(), a.int32.size()));
+  }
   return xml;
 }
 
@@ -95,8 +101,8 @@ void write_vtu(const std::string& path, const VtuFile& f) {
   std::vector<double> xyz;
   xyz.reserve(3 * points);
   for (const auto& p : f.points_m) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
-  xml +=
-      array_tag({"Points", 3, {}, {}}, block.add(xyz.data(), xyz.size())) + "</Points>\n<Cells>\n";
+  xml += array_tag({"Points", 3, {}, {}}, points, block.add(xyz.data(), xyz.size())) +
+         "</Points>\n<Cells>\n";
   xml += "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"appended\" offset=\"" +
          std::to_string(block.add(f.connectivity.data(), f.connectivity.size())) + "\"/>\n";
   xml += "<DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"" +
@@ -127,20 +133,34 @@ void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries,
       out << "<DataSet timestep=\"" << shortest(e.time) << "\" group=\"\" part=\"" << e.part
           << "\" file=\"" << e.file << "\"/>\n";
     out << "</Collection>\n</VTKFile>\n";
-    if (!out) throw InputError(path + ": write failed");
+    if (!out) {
+      out.close();
+      std::error_code ignored;
+      std::filesystem::remove(temporary, ignored);
+      throw InputError(path + ": write failed");
+    }
   }
   std::error_code ec;
   std::filesystem::rename(temporary, path, ec);
-  if (ec) throw InputError(path + ": cannot write (" + ec.message() + ")");
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw InputError(path + ": cannot write (" + ec.message() + ")");
+  }
 }
 
 void clear_step_files(const std::string& directory) {
   static const std::regex step(R"((step|needles)_[0-9]+\.vtu|steps\.pvd)");
+  // Every call takes an error code: a folder that changes under us is not worth an exception.
   std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(directory, ec)) {
-    const std::string name = entry.path().filename().string();
-    if (entry.is_regular_file() && std::regex_match(name, step))
-      std::filesystem::remove(entry.path(), ec);
+  std::filesystem::directory_iterator it(directory, ec), end;
+  for (; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    std::error_code type_ec;
+    if (it->is_regular_file(type_ec) && !type_ec && std::regex_match(name, step)) {
+      std::error_code ignored;
+      std::filesystem::remove(it->path(), ignored);
+    }
   }
 }
 

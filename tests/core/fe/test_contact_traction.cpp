@@ -100,8 +100,15 @@ TEST(ContactTraction, UniformPressureOnLinearFacesIsRecoveredExactly) {
     for (int i = 0; i < 3; ++i) force[f[i]].z() -= p * third;
   const Points t = recover_traction(points, faces, 3, force);
   for (const auto& ti : t) EXPECT_NEAR(ti.z(), -p, 1e-9 * p);
-  const Points normal = mneedle::fe::face_normals_at_points(points, faces, 3);
+  const Points normal = mneedle::fe::face_normals_at_points(points, points, faces, 3);
   for (const auto& n : normal) EXPECT_NEAR(n.z(), 1.0, 1e-15);
+  // Turned 120 degrees about x (past vertical, as the wall under a sharp tip can be): the normal
+  // turns with the face, (0, -sin 120, cos 120), instead of being flipped back towards +z.
+  Points turned = points;
+  for (auto& q : turned) q = Eigen::Vector3d(q.x(), -0.5 * q.y(), std::sqrt(0.75) * q.y());
+  const Points after = mneedle::fe::face_normals_at_points(turned, points, faces, 3);
+  EXPECT_NEAR(after[0].y(), -std::sqrt(0.75), 1e-12);
+  EXPECT_NEAR(after[0].z(), -0.5, 1e-12);
 }
 
 TEST(ContactTraction, NoFacesGiveZeroEverywhere) {

@@ -4,7 +4,9 @@
 #include "fe/field_output3d.h"
 
 #include <gtest/gtest.h>
+
 #include <unistd.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <filesystem>
@@ -125,7 +127,23 @@ TEST(FieldOutput3d, HalfModelIsWrittenAsTheWholeBlock) {
       ASSERT_NEAR(uh[3 * i + c], uf[3 * it->second + c], 1e-6 * u_max) << "point " << i;
     ASSERT_NEAR(ph[i], pf[it->second], 1e-6 * p_max) << "point " << i;
   }
-  // every cell positive: the mirror image keeps the orientation (cells are compared by volume sum)
+  // Every TET10 of the reflected file, mirror images included: positive corner volume, and each
+  // mid-edge node at the middle of its edge in VTK's order (01 12 20 03 13 23) — a wrong
+  // permutation of the mirrored cells fails here.
+  const auto& conn = half.arrays.at("connectivity").values;
+  auto at = [&](double node) {
+    const auto i = static_cast<std::size_t>(node);
+    return Eigen::Vector3d(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
+  };
+  constexpr int kEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+  for (std::size_t e = 0; e < half.cells; ++e) {
+    const double* c = &conn[10 * e];
+    const Eigen::Vector3d a = at(c[0]), b = at(c[1]), d = at(c[2]), t = at(c[3]);
+    ASSERT_GT((b - a).cross(d - a).dot(t - a), 0.0) << "cell " << e;
+    for (int k = 0; k < 6; ++k)
+      ASSERT_LT((at(c[4 + k]) - 0.5 * (at(c[kEdge[k][0]]) + at(c[kEdge[k][1]]))).norm(), 1e-12)
+          << "cell " << e << " mid-edge " << k;
+  }
   EXPECT_NE(half.header.find("test half"), std::string::npos);
 }
 

@@ -58,6 +58,12 @@ TEST(VtuWriter, EveryArrayReadsBackBitForBit) {
   EXPECT_EQ(r.arrays.at("layer").type, "Int32");
   EXPECT_EQ(r.arrays.at("layer").values, (std::vector<double>{7}));
   EXPECT_EQ(r.arrays.at("depth_m").values, (std::vector<double>{2.5e-5}));
+  // VTK's reader takes a field array without NumberOfTuples as empty (ParaView shows nothing)
+  EXPECT_NE(r.header.find("Name=\"depth_m\" NumberOfComponents=\"1\" NumberOfTuples=\"1\""),
+            std::string::npos)
+      << r.header;
+  EXPECT_NE(r.header.find("Name=\"displacement_m\" NumberOfComponents=\"3\" NumberOfTuples=\"4\""),
+            std::string::npos);
   fs::remove_all(file.parent_path());
 }
 
