@@ -27,6 +27,7 @@
 #include "mneedle/needle/mesh_io.h"
 #include "mneedle/optimum_report.h"
 #include "mneedle/plugin_host.h"
+#include "mneedle/screening.h"
 #include "mneedle/strength/needle_material.h"
 #include "mneedle/tip_optimizer.h"
 #include "run_provenance.h"
@@ -292,6 +293,40 @@ std::string optimum_text(const OptimumReport& report) {
   return text;
 }
 
+// The varied parameters and their bounds (SI), in the order of the search.
+nlohmann::json variables_json(const std::vector<DesignVariable>& vars) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const DesignVariable& v : vars)
+    list.push_back({{"name", v.name}, {"lower", v.lower}, {"upper", v.upper}});
+  return list;
+}
+
+// Every distinct design the search evaluated, in order (the JSON twin of history.csv; the report
+// draws it). A failed or impossible point has no objective or constraints: null.
+nlohmann::json history_json(const std::vector<EvaluationRecord>& history) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const EvaluationRecord& e : history) {
+    const bool valued = !e.failed && !e.impossible;
+    nlohmann::json constraints = nlohmann::json::object();
+    for (int i = 0; i < kConstraints; ++i)
+      constraints[kConstraintNames[i]] =
+          valued && i < static_cast<int>(e.constraints.size()) && std::isfinite(e.constraints[i])
+              ? nlohmann::json(e.constraints[i])
+              : nlohmann::json(nullptr);
+    rows.push_back({{"values", e.values},
+                    {"objective", valued && std::isfinite(e.objective) ? nlohmann::json(e.objective)
+                                                                       : nlohmann::json(nullptr)},
+                    {"constraints", constraints},
+                    {"feasible", e.feasible},
+                    {"failed", e.failed},
+                    {"impossible", e.impossible},
+                    {"start", e.start},
+                    {"seconds", e.seconds},
+                    {"error", e.error}});
+  }
+  return rows;
+}
+
 nlohmann::json number_or_null(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
@@ -407,7 +442,10 @@ void run_optimize(const OptimizeArgs& a) {
         {"capacity_N", e.strength.capacity_n},
         {"margin", number_or_null(e.margin)},
         {"safety_factor", e.safety_factor},
-        {"models_run", e.models_run}}},
+        {"models_run", e.models_run},
+        {"curve", curve_json(e.curve)}}},
+      {"plugin", a.plugin},
+      {"variables", variables_json(vars)},
       {"objective", objective_key},
       {"evaluations", r.evaluations},
       {"feasible", r.feasible},
@@ -420,7 +458,8 @@ void run_optimize(const OptimizeArgs& a) {
       {"fidelity", a.fidelity},
       {"tip_element_size_m", *problem.evaluation.overrides.tip_size_m},
       {"material", problem.material},
-      {"optimum", optimum_json(report)}};
+      {"optimum", optimum_json(report)},
+      {"history", history_json(r.history)}};
   if (!a.out.empty()) write_outputs(a.out, best.mesh, summary);
   if (a.json) {
     print_checked_json(std::cout, summary, "optimize");

@@ -75,13 +75,9 @@ InsertionRunOptions run_options(const Scene& scene, const SimulateOptions& o) {
   return r;
 }
 
-const char* stage_name(Stage s) {
-  return s == Stage::Pre ? "pre" : "post";
-}
-
 nlohmann::json point_json(const RunPoint& p, std::optional<PunctureCriterion> criterion) {
   nlohmann::json j = {
-      {"depth_m", p.depth_m}, {"force_N", p.force_N}, {"stage", stage_name(p.stage)}};
+      {"depth_m", p.depth_m}, {"force_N", p.force_N}, {"stage", std::string(to_string(p.stage))}};
   if (p.stage == Stage::Pre) {
     j["lateral_force_N"] = {p.lateral_force_N[0], p.lateral_force_N[1]};
     j["contact_area_m2"] = p.contact_area_m2;
@@ -174,7 +170,7 @@ void print_csv(const InsertionRun& run) {
   std::cout << std::setprecision(9);
   auto rows = [](const std::vector<RunPoint>& curve, const std::string& name) {
     for (const RunPoint& p : curve)
-      std::cout << p.depth_m << "," << p.force_N << "," << stage_name(p.stage) << ","
+      std::cout << p.depth_m << "," << p.force_N << "," << to_string(p.stage) << ","
                 << p.lateral_force_N[0] << "," << p.lateral_force_N[1] << "," << p.contact_area_m2
                 << "," << p.contact_pressure_Pa << "," << p.section_area_m2 << ","
                 << p.section_pressure_Pa << "," << p.strain_energy_J << "," << p.alpha_N << ","
@@ -222,7 +218,7 @@ void print_table(const InsertionRun& run) {
               << "\n";
     for (const RunPoint& p : n.curve) {
       std::cout << std::setprecision(2) << std::setw(12) << p.depth_m * 1e6 << "  " << std::setw(5)
-                << stage_name(p.stage) << std::setprecision(4) << std::setw(13) << p.force_N * 1e3
+                << to_string(p.stage) << std::setprecision(4) << std::setw(13) << p.force_N * 1e3
                 << std::setw(16) << p.section_pressure_Pa * 1e-6;
       if (stress && p.stage == Stage::Pre) std::cout << std::setw(19) << p.tip_stress_Pa * 1e-6;
       if (energy && p.stage == Stage::Pre)

@@ -88,7 +88,10 @@ void add_insertion(DesignEvaluation& e, const TriangleMesh& mesh, const Scene& s
   for (const auto& r : run.reductions) e.reductions.push_back(r.name);
   e.insertion_seconds = run.seconds;
   for (const RunPoint& p : n.curve)
-    if (p.depth_m <= e.depth_m * (1.0 + 1e-9)) e.peak_force_n = std::max(e.peak_force_n, p.force_N);
+    if (p.depth_m <= e.depth_m * (1.0 + 1e-9)) {
+      e.peak_force_n = std::max(e.peak_force_n, p.force_N);
+      e.curve.push_back({p.depth_m, p.force_N, p.stage});
+    }
   if (!n.curve.empty()) e.force_at_depth_n = n.curve.back().force_N;
   if (n.puncture && n.puncture->depth_m <= e.depth_m * (1.0 + 1e-9)) {
     e.puncture = PunctureSummary{n.puncture->depth_m, n.puncture->force_N, n.puncture->post_force_N,

@@ -193,6 +193,7 @@ json evaluation_json(const DesignEvaluation& e) {
           {"depth_m", e.depth_m},
           {"force_at_depth_N", e.force_at_depth_n},
           {"peak_force_N", e.peak_force_n},
+          {"curve", curve_json(e.curve)},
           {"puncture", e.puncture ? json{{"depth_m", e.puncture->depth_m},
                                          {"force_N", e.puncture->force_N},
                                          {"post_force_N", e.puncture->post_force_N},
@@ -228,8 +229,9 @@ json evaluation_json(const DesignEvaluation& e) {
 std::string row_hash(const DesignInput& d, const std::string& scene_hash,
                      const std::string& fidelity, const std::string& material) {
   // Version 3 rows hash the design's name and full-precision values and carry
-  // puncture_at_first_contact; older rows are redone.
-  constexpr const char* kRowVersion = "3";
+  // puncture_at_first_contact; version 4 rows carry the force curve (the report plots it); older
+  // rows are redone.
+  constexpr const char* kRowVersion = "4";
   std::string fingerprint;
   try {
     fingerprint = design_fingerprint(d);
@@ -551,6 +553,15 @@ std::vector<ScreeningRow> rank_rows(std::vector<ScreeningRow> rows) {
     return a.peak_force_n < b.peak_force_n;
   });
   return rows;
+}
+
+nlohmann::json curve_json(const std::vector<CurveSample>& curve) {
+  json points = json::array();
+  for (const CurveSample& p : curve)
+    points.push_back({{"depth_m", p.depth_m},
+                      {"force_N", p.force_N},
+                      {"stage", std::string(to_string(p.stage))}});
+  return points;
 }
 
 }  // namespace mneedle

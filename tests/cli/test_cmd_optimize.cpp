@@ -96,6 +96,23 @@ TEST(OptimizeCommand, PunctureDepthIsTheDefaultObjectiveAndTheSummaryHasItsKeys)
   std::getline(history, header);
   EXPECT_NE(header.find("puncture_depth_m"), std::string::npos) << header;
   EXPECT_NE(header.find("target_depth_constraint"), std::string::npos) << header;
+  // The JSON has the same history as history.csv: one entry per evaluation, in order.
+  EXPECT_EQ(j["plugin"], "sharp_bevel");
+  ASSERT_EQ(j["variables"].size(), 1u);
+  EXPECT_EQ(j["variables"][0]["name"], "bevel_angle");
+  const auto& h = j["history"];
+  ASSERT_EQ(h.size(), j["evaluations"].get<std::size_t>());
+  std::size_t csv_rows = 0;
+  for (std::string line; std::getline(history, line);) ++csv_rows;
+  EXPECT_EQ(csv_rows, h.size());
+  for (const auto& e : h) {
+    EXPECT_TRUE(e["values"].contains("bevel_angle"));
+    EXPECT_TRUE(e["constraints"].contains("strength_constraint"));
+  }
+  // The best design's curve peaks at its peak force.
+  double peak = 0.0;
+  for (const auto& p : best["curve"]) peak = std::max(peak, p["force_N"].get<double>());
+  EXPECT_DOUBLE_EQ(peak, best["peak_force_N"].get<double>());
   fs::remove_all(dir);
 }
 

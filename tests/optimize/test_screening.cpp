@@ -234,6 +234,32 @@ TEST_F(Screening, RowsCarryThePunctureWithUnitsInTheirKeys) {
     EXPECT_TRUE(j.contains(key)) << key;
 }
 
+TEST_F(Screening, RowsCarryTheForceCurveWhosePeakIsThePeakForce) {
+  const auto designs = mneedle::collect_designs({dir_ / "list.toml"}, 1e-3);
+  const auto rows = mneedle::screen_designs(designs, scene_, scene_file_, registry_, analytic());
+  ASSERT_EQ(rows.size(), 1u);
+  ASSERT_TRUE(rows[0].ok) << rows[0].error;
+  const auto j = nlohmann::json::parse(rows[0].json);
+  const auto& curve = j.at("curve");
+  ASSERT_GE(curve.size(), 2u);
+  double peak = 0.0, last_depth = 0.0;
+  bool post = false;
+  for (const auto& p : curve) {
+    // Depths increase, but for the drop: pre and post force at the puncture depth.
+    const bool drop = !post && p.at("stage") == "post";
+    if (drop)
+      EXPECT_GE(p.at("depth_m").get<double>(), last_depth);
+    else
+      EXPECT_GT(p.at("depth_m").get<double>(), last_depth);
+    last_depth = p.at("depth_m").get<double>();
+    peak = std::max(peak, p.at("force_N").get<double>());
+    post = post || p.at("stage") == "post";
+  }
+  EXPECT_TRUE(post);  // it punctures (RowsCarryThePuncture...): the curve goes on after it
+  EXPECT_DOUBLE_EQ(peak, j.at("peak_force_N").get<double>());
+  EXPECT_LE(last_depth, j.at("target_depth_m").get<double>() * (1.0 + 1e-9));
+}
+
 TEST(ScreeningRank, PuncturedByDepthThenForceUnpuncturedThenErrors) {
   auto row = [](const char* name, std::optional<double> depth, double force, bool ok = true) {
     mneedle::ScreeningRow r;

@@ -742,4 +742,8 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
   return run;
 }
 
+std::string_view to_string(Stage s) {
+  return s == Stage::Pre ? "pre" : "post";
+}
+
 }  // namespace mneedle

@@ -40,11 +40,20 @@ struct PunctureSummary {
   bool at_first_contact = false;
 };
 
+/// One point of the two-stage force curve as screening and optimisation report it (the full
+/// RunPoint stays inside run_insertion: a row keeps what a reader plots).
+struct CurveSample {
+  double depth_m = 0.0;
+  double force_N = 0.0;
+  Stage stage = Stage::Pre;
+};
+
 struct DesignEvaluation {
   DesignGeometry geometry;
-  double depth_m = 0.0;           // target depth (requirements.target_depth, else insertion.depth)
-  double force_at_depth_n = 0.0;  // two-stage curve at depth_m
-  double peak_force_n = 0.0;      // largest force of the two-stage curve up to depth_m
+  double depth_m = 0.0;            // target depth (requirements.target_depth, else insertion.depth)
+  double force_at_depth_n = 0.0;   // two-stage curve at depth_m
+  double peak_force_n = 0.0;       // largest force of the two-stage curve up to depth_m
+  std::vector<CurveSample> curve;  // the two-stage curve up to depth_m, as run_insertion gave it
   std::optional<PunctureSummary> puncture;  // empty: no puncture up to depth_m
   /// The puncture depth, or, without a puncture, a value beyond depth_m that falls as the
   /// criterion comes closer to firing: depth_m (2 − r), r = max criterion value / threshold (< 1;

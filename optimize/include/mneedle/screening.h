@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -40,6 +41,10 @@ struct ScreeningOptions {
   std::string axis = "auto";      // mesh files: auto | x | y | z | a,b,c (parse_axis_choice)
   bool repair = false;            // mesh files: repair_mesh before validation
 };
+
+/// A two-stage curve as screening rows and optimize's summary write it: [{depth_m, force_N,
+/// stage}], SI, stage "pre" or "post".
+nlohmann::json curve_json(const std::vector<CurveSample>& curve);
 
 /// One row of a screening: an evaluation or the reason there is none. `json` is the row as
 /// written to results.jsonl (with units in its keys), which is what --resume reads back.

@@ -8,6 +8,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "mneedle/fe/axisymmetric.h"
@@ -67,6 +68,7 @@ struct InsertionRunOptions {
 };
 
 enum class Stage { Pre, Post };
+std::string_view to_string(Stage s);  ///< "pre", "post"
 
 struct RunPoint {
   double depth_m = 0.0;
