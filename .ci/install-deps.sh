@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Installs every Debian package that mneedle's build, tests and benchmarks need.
-# Idempotent: packages already present are skipped; nothing is downloaded but Debian packages.
+# Installs every Debian package that mneedle's build, tests and benchmarks need, and the report's
+# npm packages (report/package-lock.json: three.js, esbuild, and playwright-core with pngjs for
+# the browser test) with the machine's Node.js. Idempotent: what is already present is skipped;
+# nothing is downloaded but Debian and npm-registry packages.
 set -euo pipefail
 
 packages=(
@@ -17,6 +19,7 @@ packages=(
   libssl-dev
   python3-meshio
   calculix-ccx
+  chromium fonts-liberation libgl1-mesa-dri
 )
 
 missing=()
@@ -28,12 +31,26 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages present"
-  exit 0
+else
+  echo "install-deps: installing ${missing[*]}"
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-echo "install-deps: installing ${missing[*]}"
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# The report's JavaScript packages, exactly as locked; again only when the lock changed.
+report="$(cd "$(dirname "$0")/.." && pwd)/report"
+if ! command -v npm > /dev/null; then
+  echo "install-deps: npm not found: the HTML report needs Node.js 18 or later with npm" >&2
+  exit 1
+fi
+if [ -f "$report/node_modules/.package-lock.json" ] &&
+   [ "$report/node_modules/.package-lock.json" -nt "$report/package-lock.json" ]; then
+  echo "install-deps: report/node_modules matches its lock file"
+else
+  # --ignore-scripts: esbuild finds its binary in its platform package; its postinstall only
+  # checks that, and npm 11 would hold it back anyway.
+  npm ci --prefix "$report" --no-audit --no-fund --ignore-scripts
+fi

@@ -30,6 +30,7 @@
 #include "mneedle/screening.h"
 #include "mneedle/strength/needle_material.h"
 #include "mneedle/tip_optimizer.h"
+#include "report_needles.h"
 #include "run_provenance.h"
 
 namespace mneedle::cli {
@@ -54,6 +55,7 @@ struct OptimizeArgs {
   unsigned seed = 1;
   std::string min_feature = "5um";
   std::string out;
+  std::string report;  // folder for result.json and report.html
   bool json = false;
 };
 
@@ -293,6 +295,13 @@ std::string optimum_text(const OptimumReport& report) {
   return text;
 }
 
+// Each parameter's SI unit as the plugin declares it ("m", "rad", "1").
+nlohmann::json parameter_units(const PluginShapeInfo& shape) {
+  nlohmann::json units = nlohmann::json::object();
+  for (const auto& p : shape.parameters) units[p.name] = p.unit;
+  return units;
+}
+
 // The varied parameters and their bounds (SI), in the order of the search.
 nlohmann::json variables_json(const std::vector<DesignVariable>& vars) {
   nlohmann::json list = nlohmann::json::array();
@@ -445,6 +454,7 @@ void run_optimize(const OptimizeArgs& a) {
         {"models_run", e.models_run},
         {"curve", curve_json(e.curve)}}},
       {"plugin", a.plugin},
+      {"parameter_units", parameter_units(shape)},
       {"variables", variables_json(vars)},
       {"objective", objective_key},
       {"evaluations", r.evaluations},
@@ -461,6 +471,7 @@ void run_optimize(const OptimizeArgs& a) {
       {"optimum", optimum_json(report)},
       {"history", history_json(r.history)}};
   if (!a.out.empty()) write_outputs(a.out, best.mesh, summary);
+  if (!a.report.empty()) write_report_folder(a.report, summary, a.plugin_dirs);
   if (a.json) {
     print_checked_json(std::cout, summary, "optimize");
     return;
@@ -545,6 +556,8 @@ void add_optimize_command(CLI::App& app) {
   cmd->add_option("--min-feature", a->min_feature, "Smallest manufacturable wall")
       ->capture_default_str();
   cmd->add_option("--out", a->out, "Folder for best.stl (mm), history.csv and summary.json");
+  cmd->add_option("--report", a->report,
+                  "Folder for result.json and report.html (history, curve, 3-D best design)");
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->callback([a] { run_optimize(*a); });
 }

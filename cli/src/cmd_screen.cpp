@@ -12,6 +12,7 @@
 #include "mneedle/base/units.h"
 #include "mneedle/needle/needle_frame.h"
 #include "mneedle/screening.h"
+#include "report_needles.h"
 #include "run_provenance.h"
 
 namespace mneedle::cli {
@@ -28,6 +29,7 @@ struct ScreenArgs {
   bool repair = false;
   int jobs = 1;
   std::string out;
+  std::string report;
   bool json = false;
   bool resume = false;
   std::vector<std::string> plugin_dirs;
@@ -116,7 +118,7 @@ void run_screen(const ScreenArgs& args) {
       }));
   std::size_t failed = 0;
   for (const auto& r : rows) failed += r.ok ? 0 : 1;
-  if (args.json) {
+  if (args.json || !args.report.empty()) {
     nlohmann::json out = {{"scene", args.scene},
                           {"fidelity", options.fidelity},
                           {"model", options.model},
@@ -127,8 +129,11 @@ void run_screen(const ScreenArgs& args) {
       j["resumed"] = r.resumed;
       out["designs"].push_back(j);
     }
-    print_checked_json(std::cout, out, "screen");
-  } else {
+    // The report first: a design that failed still leaves every finished row in it.
+    if (!args.report.empty()) write_report_folder(args.report, out, args.plugin_dirs);
+    if (args.json) print_checked_json(std::cout, out, "screen");
+  }
+  if (!args.json) {
     std::string material = args.material;
     for (const auto& r : rows)
       if (r.ok && material.empty()) material = nlohmann::json::parse(r.json)["material"];
@@ -181,6 +186,9 @@ void add_screen_command(CLI::App& app) {
   cmd->add_flag("--resume", args->resume, "Skip designs already in --out for the same inputs");
   cmd->add_option("--plugin-dir", args->plugin_dirs, "Extra plugin folder (repeatable)");
   cmd->add_flag("--json", args->json, "Print one JSON object");
+  cmd->add_option(
+      "--report", args->report,
+      "Write result.json and report.html (ranking, curves, 3-D needles) to this folder");
   cmd->callback([args] { run_screen(*args); });
 }
 

@@ -22,11 +22,13 @@
 #include "mneedle/fe/tissue_mesh.h"
 #include "mneedle/insertion/energy_check.h"
 #include "mneedle/insertion/insertion_run.h"
+#include "mneedle/needle/mesh.h"
 #include "mneedle/needle/needle_frame.h"
 #include "mneedle/plot/figure.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
 #include "progress_line.h"
+#include "report_needles.h"
 #include "run_provenance.h"
 
 namespace mneedle::cli {
@@ -45,6 +47,7 @@ struct SimulateOptions {
   bool csv = false;
   bool quiet = false;  // no progress line
   std::string plot;    // SVG of force against depth
+  std::string report;  // folder for result.json and report.html
   std::vector<std::string> plugin_dirs;
   std::size_t max_needles = 16;
 };
@@ -289,7 +292,11 @@ void run(const SimulateOptions& o) {
   const InsertionRun result = run_insertion(scene, needles, options);
   progress.finish();
   // Every format prints the numbers of this tree: check them once, before anything is printed.
-  const nlohmann::json tree = to_json(result, scene);
+  nlohmann::json tree = to_json(result, scene);
+  // What lets a report rebuild and check each needle: its mesh's hash and the axis override.
+  for (std::size_t i = 0; i < needles.size() && i < tree["needles"].size(); ++i)
+    tree["needles"][i]["mesh_sha256"] = mesh_sha256(needles[i].mesh);
+  if (!o.axis.empty()) tree["axis"] = o.axis;
   require_finite_json(tree, o.scene.string());
   if (result.energy_check && !result.energy_check->passes)
     std::cerr << "mneedle: warning: " << o.scene.string() << ": the tissue stores "
@@ -301,6 +308,7 @@ void run(const SimulateOptions& o) {
                  "check\")\n";
   if (!o.plot.empty())
     plot::write_svg(o.plot, simulate_figure(result, "simulate: " + o.scene.filename().string()));
+  if (!o.report.empty()) write_report_folder(o.report, tree, o.plugin_dirs);
   if (o.json)
     std::cout << with_provenance(tree).dump(2) << "\n";
   else if (o.csv)
@@ -347,6 +355,8 @@ void add_simulate_command(CLI::App& app) {
   auto* json = cmd->add_flag("--json", options->json, "print the run as JSON");
   cmd->add_flag("--csv", options->csv, "print the curves as CSV")->excludes(json);
   cmd->add_option("--plot", options->plot, "write force against depth as SVG");
+  cmd->add_option("--report", options->report,
+                  "write result.json and report.html (tables, plots, 3-D needle) to this folder");
   cmd->add_flag("--quiet", options->quiet,
                 "no progress line on stderr (shown for runs longer than a second)");
   cmd->callback([options]() { run(*options); });

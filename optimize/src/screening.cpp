@@ -135,7 +135,8 @@ std::string design_fingerprint(const DesignInput& d) {
 struct ScreenedNeedle {
   TriangleMesh mesh;
   EvaluationOptions options;
-  std::string frame_note;  // how a mesh file's axis, tip and holder were found
+  std::string frame_note;                // how a mesh file's axis, tip and holder were found
+  std::map<std::string, double> params;  // plugin designs: the shape's parameters, SI
 };
 
 ScreenedNeedle design_needle(const DesignInput& d, const PluginRegistry& registry,
@@ -148,6 +149,7 @@ ScreenedNeedle design_needle(const DesignInput& d, const PluginRegistry& registr
           : needle_from_file(d.file, d.metres_per_unit, parse_axis_choice(o.axis), o.repair);
   ScreenedNeedle n;
   n.frame_note = source.frame_note;
+  n.params = source.params;
   n.options.fidelity = parse_fidelity(o.fidelity);
   n.options.model = parse_pre_model(o.model);
   n.options.axisymmetric = axisymmetric_profile(registry, source, where);
@@ -254,6 +256,16 @@ ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::s
     const ScreenedNeedle needle = design_needle(d, registry, o);
     row.frame_note = needle.frame_note;
     if (!needle.frame_note.empty()) j["frame_note"] = needle.frame_note;
+    // What rebuilds the mesh (the report's 3-D view): the plugin and its parameters, or the
+    // file with its unit, axis and repair.
+    if (d.plugin) {
+      j["plugin"] = *d.plugin;
+      j["params"] = needle.params;
+    } else {
+      j["metres_per_unit"] = d.metres_per_unit;
+      j["axis"] = o.axis;
+      j["repair"] = o.repair;
+    }
     // provenance of the row (docs/cli.md, "Provenance"): the file as read, the mesh as evaluated
     if (!d.plugin) j["file_sha256"] = sha256_of_file(d.file);
     j["mesh_sha256"] = mesh_sha256(needle.mesh);

@@ -3,11 +3,15 @@
 #include <plplot/plplot.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <mutex>
+#include <sstream>
 #include <system_error>
+
+#include <unistd.h>
 
 #include "mneedle/base/error.h"
 
@@ -263,6 +267,25 @@ void write_svg(const std::filesystem::path& file, const Figure& f) {
     std::filesystem::remove(tmp, ec);
     throw InputError(file.string() + ": cannot write the plot (" + ec.message() + ")");
   }
+}
+
+std::string svg_element(const Figure& figure) {
+  // PLplot writes only to files: one of our own per call (process id and a counter), removed
+  // at once.
+  static std::atomic<unsigned> counter{0};
+  const auto file = std::filesystem::temp_directory_path() /
+                    ("mneedle-figure-" + std::to_string(::getpid()) + "-" +
+                     std::to_string(counter.fetch_add(1)) + ".svg");
+  write_svg(file, figure);
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  std::error_code ec;
+  std::filesystem::remove(file, ec);
+  std::string svg = text.str();
+  const auto start = svg.find("<svg");
+  if (start == std::string::npos) throw InputError("plot: PLplot wrote no <svg> element");
+  return svg.substr(start);
 }
 
 }  // namespace mneedle::plot

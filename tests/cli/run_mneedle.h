@@ -45,4 +45,12 @@ inline CommandRun run_mneedle(const std::string& arguments) {
   return run;
 }
 
+/// A whole output file as text ("" when it is missing).
+inline std::string file_text(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
 }  // namespace mneedle::test

@@ -60,6 +60,10 @@ struct Figure {
 /// serialised).
 void write_svg(const std::filesystem::path& file, const Figure& figure);
 
+/// The same figure as SVG text for embedding in a page: the <svg> element alone (no XML prolog
+/// or DOCTYPE), drawn through a private temporary file. Throws as write_svg.
+std::string svg_element(const Figure& figure);
+
 /// The unit an axis of this dimension shows for values up to `largest_abs` (SI), and its size
 /// in SI: Length 1e-3 m -> ("mm", 1e-3). Used by write_svg; exposed for tests and tables.
 struct DisplayUnit {
