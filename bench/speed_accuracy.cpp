@@ -364,7 +364,7 @@ int main(int argc, char** argv) {
     fs::create_directories(options.out);
     write(options.out / "speed-accuracy.md",
           markdown(runs, options, total, load_before, load_average()));
-    write(options.out / "speed-accuracy.svg", bench::svg_plot(runs));
+    plot::write_svg(options.out / "speed-accuracy.svg", bench::speed_accuracy_figure(runs));
     std::fprintf(stderr, "total %.1f s; wrote %s\n", total,
                  (options.out / "speed-accuracy.md").c_str());
   } catch (const std::exception& e) {

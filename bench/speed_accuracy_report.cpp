@@ -31,104 +31,11 @@ std::string cell(std::string text) {
   return text;
 }
 
-std::string escape_xml(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '&')
-      out += "&amp;";
-    else if (c == '"')
-      out += "&quot;";
-    else
-      out += c;
-  }
-  return out;
-}
-
 std::string value_cells(const RunOutcome& r) {
   const std::string depth =
       r.puncture_depth_m ? scaled(r.puncture_depth_m, 1e6, "%.1f") : std::string("none");
   return depth + " | " + scaled(r.puncture_force_N, 1e3, "%.3g") + " | " +
          scaled(r.probe_force_N, 1e3, "%.4g");
-}
-
-// Plot layout (px).
-constexpr double kWidth = 820.0, kHeight = 520.0;
-constexpr double kLeft = 70.0, kRight = 250.0, kTop = 30.0, kBottom = 60.0;
-
-struct LogAxis {
-  double lo = 0.0, hi = 1.0;  // decades (log10)
-  double to_px(double value, double px_lo, double px_hi) const {
-    return px_lo + (std::log10(value) - lo) / (hi - lo) * (px_hi - px_lo);
-  }
-};
-
-LogAxis axis_for(const std::vector<double>& values) {
-  double lo = std::log10(*std::min_element(values.begin(), values.end()));
-  double hi = std::log10(*std::max_element(values.begin(), values.end()));
-  LogAxis a{std::floor(lo), std::ceil(hi)};
-  if (a.hi <= a.lo) a.hi = a.lo + 1.0;
-  return a;
-}
-
-const char* needle_colour(const std::string& needle) {
-  if (needle == "sharp_bevel") return "#1f77b4";
-  if (needle == "blunt_bevel") return "#d62728";
-  if (needle == "cylinder") return "#2ca02c";
-  return "#7f7f7f";
-}
-
-// One marker of `group`'s shape centred on (x, y); class "run" marks it for counting.
-std::string marker(const std::string& group, double x, double y, const std::string& colour,
-                   bool filled, const std::string& title) {
-  const std::string style = "fill=\"" + (filled ? colour : std::string("white")) + "\" stroke=\"" +
-                            colour + "\" stroke-width=\"1.6\"";
-  const std::string t = title.empty() ? "" : "<title>" + escape_xml(title) + "</title>";
-  std::ostringstream s;
-  s.precision(5);
-  const double r = 5.5;
-  if (group == "fast") {
-    s << "<polygon class=\"run\" points=\"" << x << "," << y - r << " " << x + r << ","
-      << y + r * 0.8 << " " << x - r << "," << y + r * 0.8 << "\" " << style << ">" << t
-      << "</polygon>";
-  } else if (group == "fine") {
-    s << "<rect class=\"run\" x=\"" << x - r * 0.85 << "\" y=\"" << y - r * 0.85 << "\" width=\""
-      << 1.7 * r << "\" height=\"" << 1.7 * r << "\" " << style << ">" << t << "</rect>";
-  } else if (group == "analytic") {
-    s << "<polygon class=\"run\" points=\"" << x << "," << y - r << " " << x + r << "," << y << " "
-      << x << "," << y + r << " " << x - r << "," << y << "\" " << style << ">" << t
-      << "</polygon>";
-  } else if (group == "unreduced") {
-    s << "<polygon class=\"run\" points=\"" << x << "," << y + r << " " << x + r << ","
-      << y - r * 0.8 << " " << x - r << "," << y - r * 0.8 << "\" " << style << ">" << t
-      << "</polygon>";
-  } else if (group == "override") {  // a line shape: plus when filled, cross when hollow
-    const double d = filled ? 0.0 : r * 0.75;
-    const double a = filled ? r : r * 0.75;
-    s << "<path class=\"run\" d=\"M" << x - a << "," << y - d << "L" << x + a << "," << y + d << "M"
-      << x + d << "," << y - a << "L" << x - d << "," << y + a << "\" fill=\"none\" stroke=\""
-      << colour << "\" stroke-width=\"2.2\">" << t << "</path>";
-  } else {  // standard
-    s << "<circle class=\"run\" cx=\"" << x << "\" cy=\"" << y << "\" r=\"" << r << "\" " << style
-      << ">" << t << "</circle>";
-  }
-  return s.str();
-}
-
-std::string text(double x, double y, const std::string& body, const char* anchor = "start") {
-  std::ostringstream s;
-  s.precision(5);
-  s << "<text x=\"" << x << "\" y=\"" << y << "\" text-anchor=\"" << anchor << "\">"
-    << escape_xml(body) << "</text>";
-  return s.str();
-}
-
-std::string decade_label(double decade) {
-  const double v = std::pow(10.0, decade);
-  return format(v >= 1.0 ? "%.0f" : decade >= -3 ? "%g" : "%.0e", v);
 }
 
 struct PlotPoint {
@@ -148,44 +55,6 @@ std::vector<PlotPoint> plot_points(const std::vector<RunOutcome>& runs) {
     points.push_back({r.seconds, std::max(*worst, kPlotErrorFloor), &r});
   }
   return points;
-}
-
-// Legend markers are not runs: class "key" keeps them out of a count of runs.
-std::string as_key(std::string m) {
-  return m.replace(m.find("class=\"run\""), 11, "class=\"key\"");
-}
-
-std::string legend(double x0) {
-  std::ostringstream s;
-  double y = kTop + 10.0;
-  s << text(x0, y, "colour: needle") << "\n";
-  for (const char* n : {"sharp_bevel", "blunt_bevel", "cylinder"}) {
-    y += 18.0;
-    s << as_key(marker("standard", x0 + 8.0, y - 4.0, needle_colour(n), true, ""))
-      << text(x0 + 20.0, y, n) << "\n";
-  }
-  y += 26.0;
-  s << text(x0, y, "shape: level") << "\n";
-  const std::pair<const char*, const char*> groups[] = {{"analytic", "analytic (no FE)"},
-                                                        {"fast", "fast"},
-                                                        {"standard", "standard"},
-                                                        {"fine", "fine"},
-                                                        {"unreduced", "reduction switched off"},
-                                                        {"override", "override (TET4, domain)"}};
-  for (const auto& [g, name] : groups) {
-    y += 18.0;
-    s << as_key(marker(g, x0 + 8.0, y - 4.0, "#333333", true, "")) << text(x0 + 20.0, y, name)
-      << "\n";
-  }
-  y += 26.0;
-  s << text(x0, y, "filled: human skin") << "\n";
-  s << text(x0, y + 18.0, "hollow: silicone phantom") << "\n";
-  s << text(x0, y + 36.0, "(override: + skin, x silicone)") << "\n";
-  s << text(x0, y + 62.0, "error: worst of puncture") << "\n";
-  s << text(x0, y + 80.0, "depth, puncture force and") << "\n";
-  s << text(x0, y + 98.0, "F(200 um) vs the reference;") << "\n";
-  s << text(x0, y + 116.0, "below 0.01 % drawn at 0.01 %") << "\n";
-  return s.str();
 }
 
 }  // namespace
@@ -271,49 +140,29 @@ std::string markdown_table(const std::vector<RunOutcome>& runs) {
   return s.str();
 }
 
-std::string svg_plot(const std::vector<RunOutcome>& runs) {
+plot::Figure speed_accuracy_figure(const std::vector<RunOutcome>& runs) {
+  plot::Figure f;
+  f.title = "speed against accuracy (paper A needles, skin and silicone)";
+  f.x = {"wall time of the run", Dimension::Time, "", true};
+  f.y = {"worst error against the reference", Dimension::Dimensionless, "%", true};
+  // One series per level or reduction, in the order a reader compares them.
+  const std::pair<const char*, const char*> groups[] = {{"analytic", "analytic (no FE)"},
+                                                        {"fast", "fast"},
+                                                        {"standard", "standard"},
+                                                        {"fine", "fine"},
+                                                        {"unreduced", "reduction switched off"},
+                                                        {"override", "override (TET4, domain)"}};
   const std::vector<PlotPoint> points = plot_points(runs);
-  std::vector<double> times{1e-3, 1.0}, errors{kPlotErrorFloor, 1.0};
-  for (const PlotPoint& p : points) {
-    times.push_back(p.seconds);
-    errors.push_back(p.error);
+  for (const auto& [group, label] : groups) {
+    plot::Series s{label, {}, {}, plot::Mark::Dots};
+    for (const PlotPoint& p : points)
+      if (p.run->group == group) {
+        s.x.push_back(p.seconds);
+        s.y.push_back(100.0 * p.error);
+      }
+    if (!s.x.empty()) f.series.push_back(std::move(s));
   }
-  const LogAxis tx = axis_for(times), ey = axis_for(errors);
-  const double x0 = kLeft, x1 = kWidth - kRight, y0 = kHeight - kBottom, y1 = kTop;
-  std::ostringstream s;
-  s.precision(5);
-  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << kWidth << "\" height=\"" << kHeight
-    << "\" viewBox=\"0 0 " << kWidth << " " << kHeight
-    << "\" font-family=\"sans-serif\" font-size=\"12\">\n";
-  s << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  // Decade grid and labels.
-  for (double d = tx.lo; d <= tx.hi + 1e-9; d += 1.0) {
-    const double x = tx.to_px(std::pow(10.0, d), x0, x1);
-    s << "<line x1=\"" << x << "\" y1=\"" << y0 << "\" x2=\"" << x << "\" y2=\"" << y1
-      << "\" stroke=\"#dddddd\"/>" << text(x, y0 + 16.0, decade_label(d), "middle") << "\n";
-  }
-  for (double d = ey.lo; d <= ey.hi + 1e-9; d += 1.0) {
-    const double y = ey.to_px(std::pow(10.0, d), y0, y1);
-    s << "<line x1=\"" << x0 << "\" y1=\"" << y << "\" x2=\"" << x1 << "\" y2=\"" << y
-      << "\" stroke=\"#dddddd\"/>" << text(x0 - 6.0, y + 4.0, decade_label(d + 2.0), "end") << "\n";
-  }
-  s << "<rect x=\"" << x0 << "\" y=\"" << y1 << "\" width=\"" << x1 - x0 << "\" height=\""
-    << y0 - y1 << "\" fill=\"none\" stroke=\"black\"/>\n";
-  s << text((x0 + x1) / 2.0, kHeight - 18.0, "wall time of the run [s]", "middle") << "\n";
-  s << "<text x=\"18\" y=\"" << (y0 + y1) / 2.0
-    << "\" text-anchor=\"middle\" transform=\"rotate(-90 18 " << (y0 + y1) / 2.0
-    << ")\">worst error against the reference [%]</text>\n";
-  s << text((x0 + x1) / 2.0, 18.0, "mneedle: speed against accuracy (paper A needles)", "middle")
-    << "\n";
-  for (const PlotPoint& p : points) {
-    const RunOutcome& r = *p.run;
-    s << marker(r.group, tx.to_px(p.seconds, x0, x1), ey.to_px(p.error, y0, y1),
-                needle_colour(r.needle), r.scene == "skin",
-                r.scene + ", " + r.needle + ", " + r.label)
-      << "\n";
-  }
-  s << legend(x1 + 20.0) << "</svg>\n";
-  return s.str();
+  return f;
 }
 
 }  // namespace mneedle::bench

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "mneedle/plot/figure.h"
+
 namespace mneedle::bench {
 
 /// Depth at which the "force at depth" column is read (paper A's 200 um array target).
@@ -65,9 +67,9 @@ const RunOutcome* reference_for(const std::vector<RunOutcome>& runs, const RunOu
 /// Markdown table: one row per run (the reference first in its block, with its values).
 std::string markdown_table(const std::vector<RunOutcome>& runs);
 
-/// Log-log SVG of the worst error (%) against wall time (s): one marker (class "run") per
-/// successful non-reference run that has an error, colour by needle, shape by group, filled for
-/// skin and hollow for silicone, with a legend.
-std::string svg_plot(const std::vector<RunOutcome>& runs);
+/// Log-log figure of the worst error (%) against wall time (s): one point per successful
+/// non-reference run that has an error (below kPlotErrorFloor drawn on it), one series per group
+/// (analytic, fast, standard, fine, reduction switched off, override), drawn by plot/.
+plot::Figure speed_accuracy_figure(const std::vector<RunOutcome>& runs);
 
 }  // namespace mneedle::bench

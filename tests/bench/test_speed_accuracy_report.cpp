@@ -87,16 +87,27 @@ TEST(SpeedAccuracyReport, TableNamesTheReferenceTheFailureAndTheNonPuncture) {
   EXPECT_EQ(table.find("nan"), std::string::npos);
 }
 
-TEST(SpeedAccuracyReport, SvgHasOneMarkerPerPlottedRunAndNoNaN) {
+TEST(SpeedAccuracyReport, FigureHasOnePointPerComparedRunInPercentByLevel) {
   const std::vector<RunOutcome> runs = sample_runs();
-  const std::string svg = svg_plot(runs);
+  const plot::Figure f = speed_accuracy_figure(runs);
   // Plotted: fast, analytic, fine (exact: drawn on the floor); not the reference or the failure.
-  EXPECT_EQ(count(svg, "class=\"run\""), 3u);
-  EXPECT_EQ(count(svg, "<title>"), 3u);
-  EXPECT_GE(count(svg, "class=\"key\""), 9u);  // legend: three needles, six shapes
-  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
-  EXPECT_NE(svg.find("</svg>"), std::string::npos);
-  for (const char* bad : {"nan", "NaN", "inf"}) EXPECT_EQ(svg.find(bad), std::string::npos) << bad;
+  std::size_t points = 0;
+  for (const plot::Series& s : f.series) {
+    points += s.x.size();
+    EXPECT_EQ(s.mark, plot::Mark::Dots);
+    for (double y : s.y) EXPECT_GE(y, 100.0 * kPlotErrorFloor);
+  }
+  EXPECT_EQ(points, 3u);
+  ASSERT_EQ(f.series.size(), 3u);
+  EXPECT_EQ(f.series[0].label, "analytic (no FE)");
+  EXPECT_DOUBLE_EQ(f.series[0].y[0], 50.0);  // only the probe, 50 % off
+  EXPECT_EQ(f.series[1].label, "fast");
+  EXPECT_NEAR(f.series[1].y[0], 20.0, 1e-12);  // 20 % off in each
+  EXPECT_EQ(f.series[2].label, "fine");
+  EXPECT_DOUBLE_EQ(f.series[2].y[0], 100.0 * kPlotErrorFloor);  // exact: on the floor
+  EXPECT_TRUE(f.x.logarithmic);
+  EXPECT_TRUE(f.y.logarithmic);
+  EXPECT_EQ(f.y.unit, "%");
 }
 
 }  // namespace
