@@ -197,14 +197,15 @@ std::string objective_text(const std::string& objective, double value) {
 }
 
 // history.csv, one row per distinct design as soon as it is evaluated (flushed), so a killed run
-// keeps every design it paid for; full precision, so the history compares with the summary.
+// keeps every design it paid for; full precision, so the history compares with the summary. The
+// first line is the run's provenance as a comment (docs/cli.md, "Provenance").
 class HistoryWriter {
  public:
   HistoryWriter(const std::filesystem::path& file, const std::vector<DesignVariable>& vars,
                 const std::string& objective_key)
       : file_(file), out_(file), vars_(vars) {
     if (!out_) throw InputError("--out: cannot write '" + file.string() + "'");
-    out_ << std::setprecision(17);
+    out_ << provenance_comment() << "\n" << std::setprecision(17);
     for (const auto& v : vars_) out_ << v.name << "_SI,";
     out_ << objective_key;
     for (const char* c : kConstraintNames) out_ << "," << c;

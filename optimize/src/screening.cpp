@@ -410,6 +410,17 @@ std::string csv_line(const json& j) {
   return line;
 }
 
+// The CSV's first lines: one "# provenance: {...}" per run that wrote into the folder (the lines
+// of provenance.jsonl, which the CLI appends before it screens; docs/cli.md, "Provenance"), then
+// the header. mneedle's CSV reader and pandas' comment='#' skip them.
+std::string csv_preamble(const fs::path& out) {
+  std::string text;
+  std::ifstream runs(out / "provenance.jsonl");
+  for (std::string line; std::getline(runs, line);)
+    if (!line.empty()) text += "# provenance: " + line + "\n";
+  return text + csv_header() + "\n";
+}
+
 class ResultWriter {
  public:
   explicit ResultWriter(const std::optional<fs::path>& out) {
@@ -419,7 +430,7 @@ class ResultWriter {
     jsonl_.open(*out / "results.jsonl", std::ios::app);
     csv_.open(*out / "results.csv", std::ios::app);
     if (!jsonl_ || !csv_) throw InputError(out->string() + ": cannot write results");
-    if (fresh_csv) csv_ << csv_header() << "\n" << std::flush;
+    if (fresh_csv) csv_ << csv_preamble(*out) << std::flush;
   }
 
   void write(const ScreeningRow& row) {
@@ -437,7 +448,8 @@ class ResultWriter {
 // results.jsonl is the record; results.csv its table. A run killed between writing a row's JSON
 // line and its CSV line would leave the CSV one design short for good (the design is resumed
 // from the JSON line and not written again), so --resume rewrites the CSV from the JSON lines,
-// through a temporary file so that a kill during the rewrite loses nothing.
+// through a temporary file so that a kill during the rewrite loses nothing. Every later run into
+// the folder rewrites it too, so that its preamble names every run whose rows it holds.
 void rebuild_csv(const fs::path& out) {
   std::error_code error;
   if (!fs::exists(out / "results.jsonl", error)) return;
@@ -445,7 +457,7 @@ void rebuild_csv(const fs::path& out) {
   const fs::path temporary = out / "results.csv.partial";
   {
     std::ofstream csv(temporary, std::ios::trunc);
-    csv << csv_header() << "\n";
+    csv << csv_preamble(out);
     for (std::string line; std::getline(in, line);) {
       try {
         csv << csv_line(json::parse(line)) << "\n";
@@ -500,10 +512,8 @@ std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs
   parse_pre_model(options.model);
   const std::string scene_hash = hex(fnv1a(read_bytes(scene_file)));
   std::map<std::string, ScreeningRow> done;
-  if (options.resume && options.out) {
-    done = finished_rows(*options.out / "results.jsonl");
-    rebuild_csv(*options.out);
-  }
+  if (options.resume && options.out) done = finished_rows(*options.out / "results.jsonl");
+  if (options.out) rebuild_csv(*options.out);
   ResultWriter writer(options.out);
 
   std::vector<ScreeningRow> rows(designs.size());

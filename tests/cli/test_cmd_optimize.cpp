@@ -93,6 +93,8 @@ TEST(OptimizeCommand, PunctureDepthIsTheDefaultObjectiveAndTheSummaryHasItsKeys)
   EXPECT_TRUE(fs::exists(dir / "summary.json"));
   std::ifstream history(dir / "history.csv");
   std::string header;
+  std::getline(history, header);  // the run's provenance first (docs/cli.md, "Provenance")
+  EXPECT_EQ(header.rfind("# provenance: {", 0), 0u) << header;
   std::getline(history, header);
   EXPECT_NE(header.find("puncture_depth_m"), std::string::npos) << header;
   EXPECT_NE(header.find("target_depth_constraint"), std::string::npos) << header;
@@ -130,7 +132,8 @@ TEST(OptimizeCommand, PeakForceObjectiveReportsTheLowestFeasiblePeakForceOfItsHi
   // history.csv: bevel_angle_SI, peak_force_N, 3 constraints, feasible, ...
   std::ifstream history(dir / "history.csv");
   std::string line;
-  std::getline(history, line);
+  std::getline(history, line);  // provenance
+  std::getline(history, line);  // header
   double lowest = 1e300;
   int rows = 0;
   while (std::getline(history, line)) {
@@ -226,7 +229,7 @@ TEST(OptimizeCommand, SummarySaysWhereTheOptimumIsAndHowManyEvaluationsFailed) {
   EXPECT_EQ(optimum["failed_evaluations"], 0) << optimum.dump();
   EXPECT_EQ(optimum["impossible_designs"], 0) << optimum.dump();
   std::ifstream history(dir / "history.csv");
-  int rows = -1;
+  int rows = -2;  // provenance and header
   for (std::string line; std::getline(history, line);) ++rows;
   EXPECT_EQ(rows, j["evaluations"].get<int>());
   const auto text = run_mneedle(common);
@@ -262,11 +265,13 @@ TEST(OptimizeCommand, KilledRunKeepsEveryEvaluatedDesignInItsHistory) {
       "' >/dev/null 2>&1 & pid=$!; for i in $(seq 1200); do "
       "[ -f '" +
       history + "' ] && [ $(wc -l < '" + history +
-      "') -ge 2 ] && break; sleep 0.1; done; kill -9 $pid; wait $pid 2>/dev/null; true";
+      "') -ge 3 ] && break; sleep 0.1; done; kill -9 $pid; wait $pid 2>/dev/null; true";
   ASSERT_EQ(std::system(script.c_str()), 0);
   std::ifstream in(history);
   std::string header;
   ASSERT_TRUE(std::getline(in, header)) << "no history after the kill";
+  EXPECT_EQ(header.rfind("# provenance: ", 0), 0u) << header;
+  ASSERT_TRUE(std::getline(in, header)) << "no header after the kill";
   const auto fields = [](const std::string& line) {
     return std::count(line.begin(), line.end(), ',') + 1;
   };

@@ -375,7 +375,15 @@ TEST(ScreenCommand, KilledAndResumedAgainAndAgainListsEveryDesignOnceWithUninter
 
   std::ifstream csv(dir / "killed" / "results.csv");
   std::string header;
+  // One provenance line per run that wrote into the folder (the killed one and the resume), as
+  // in provenance.jsonl, then the header.
+  std::ifstream runs(dir / "killed" / "provenance.jsonl");
+  for (std::string run; std::getline(runs, run);) {
+    ASSERT_TRUE(std::getline(csv, header));
+    EXPECT_EQ(header, "# provenance: " + run);
+  }
   ASSERT_TRUE(std::getline(csv, header));
+  EXPECT_EQ(header.rfind("design,", 0), 0u) << header;
   const auto fields = [](const std::string& line) {
     return std::count(line.begin(), line.end(), ',') + 1;
   };
