@@ -265,7 +265,8 @@ std::string screen_body(const json& r, const ReportInput& in) {
       for (const json& n : d.value("notes", json::array())) notes += esc(text_of(n)) + " ";
       rows.push_back({std::to_string(rank), esc(name),
                       d.value("passes", false) ? "passes" : "fails",
-                      quantity(d, "puncture_depth_m", Dimension::Length),
+                      quantity(d, "puncture_depth_m", Dimension::Length) +
+                          (d.value("puncture_at_first_contact", false) ? " (first step)" : ""),
                       quantity(d, "puncture_force_N", Dimension::Force),
                       quantity(d, "peak_force_N", Dimension::Force),
                       quantity(d, "capacity_N", Dimension::Force), plain_number(d, "margin"),

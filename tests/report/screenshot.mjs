@@ -19,7 +19,9 @@ try {
   await p.goto('file://' + path.resolve(page));
   await p.waitForFunction(() => document.body.dataset.viewer === 'rendered', null, { timeout: 30000 });
   const view = await p.locator('#needles').boundingBox();
-  await p.screenshot({ path: out, clip: { x: 0, y: 0, width: 1200, height: view.y + view.height } });
+  await p.screenshot({
+    path: out, fullPage: true, clip: { x: 0, y: 0, width: 1200, height: view.y + view.height },
+  });
 } finally {
   await browser.close();
 }
