@@ -445,18 +445,25 @@ ResultKind result_kind(const json& r, const std::string& where) {
 }
 
 std::vector<plot::Figure> report_figures(const json& r, const std::string& where) {
-  switch (result_kind(r, where)) {
-    case ResultKind::Simulate:
-      return simulate_figures(r, where);
-    case ResultKind::Screen:
-      return screen_figures(r, where);
-    case ResultKind::Optimize:
-      return optimize_figures(r, where);
+  try {
+    switch (result_kind(r, where)) {
+      case ResultKind::Simulate:
+        return simulate_figures(r, where);
+      case ResultKind::Screen:
+        return screen_figures(r, where);
+      case ResultKind::Optimize:
+        return optimize_figures(r, where);
+    }
+  } catch (const json::exception& e) {
+    // A key of the wrong type (a file edited by hand, or not ours): the user's input, not a bug.
+    throw InputError(where + ": malformed result (" + e.what() + ")");
   }
   return {};
 }
 
-std::string html_report(const ReportInput& in) {
+namespace {
+
+std::string page_of(const ReportInput& in) {
   const json& r = in.result;
   const ResultKind kind = result_kind(r, in.source);
   const char* kind_name = kind == ResultKind::Simulate ? "simulate"
@@ -508,6 +515,16 @@ std::string html_report(const ReportInput& in) {
   page += detail::viewer_script();
   page += "\n</script>\n</body>\n</html>\n";
   return page;
+}
+
+}  // namespace
+
+std::string html_report(const ReportInput& in) {
+  try {
+    return page_of(in);
+  } catch (const json::exception& e) {
+    throw InputError(in.source + ": malformed result (" + e.what() + ")");
+  }
 }
 
 void write_report(const std::filesystem::path& file, const ReportInput& input) {

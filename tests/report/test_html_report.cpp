@@ -95,6 +95,19 @@ TEST(ReportFigures, MalformedCurvePointIsNamedByItsPath) {
   }
 }
 
+TEST(HtmlReport, KeyOfTheWrongTypeIsAMalformedResultNotACrash) {
+  ReportInput in;
+  in.result = screen_result();
+  in.source = "edited.json";
+  in.result["designs"][0]["ok"] = "yes";  // a string where a boolean belongs
+  try {
+    mneedle::report::html_report(in);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("edited.json: malformed result (", 0), 0u) << e.what();
+  }
+}
+
 TEST(ReportFigures, OptimizationPlotsFeasibleAndInfeasibleEvaluationsApart) {
   json r = {
       {"objective", "puncture_depth_m"},
