@@ -42,8 +42,14 @@ fi
 
 # The report's JavaScript packages, exactly as locked; again only when the lock changed.
 report="$(cd "$(dirname "$0")/.." && pwd)/report"
-if ! command -v npm > /dev/null; then
-  echo "install-deps: npm not found: the HTML report needs Node.js 18 or later with npm" >&2
+# playwright-core (the browser test) needs Node.js 20; the machines this runs on carry it.
+if ! command -v npm > /dev/null || ! command -v node > /dev/null; then
+  echo "install-deps: node/npm not found: the HTML report needs Node.js 20 or later with npm" >&2
+  exit 1
+fi
+node_major="$(node -p 'process.versions.node.split(".")[0]')"
+if [ "$node_major" -lt 20 ]; then
+  echo "install-deps: Node.js $(node --version) is too old: the report's tests need 20 or later" >&2
   exit 1
 fi
 if [ -f "$report/node_modules/.package-lock.json" ] &&

@@ -6,11 +6,15 @@ string(FIND "${text}" ")mneedle_embed\"" clash)
 if(NOT clash EQUAL -1)
   message(FATAL_ERROR "${INPUT} contains the raw-string delimiter )mneedle_embed\"")
 endif()
-# The text goes inside an inline <script>: it must not end that element early.
-string(FIND "${text}" "</script" early_end)
-if(NOT early_end EQUAL -1)
-  message(FATAL_ERROR "${INPUT} contains </script and cannot be inlined in the report")
-endif()
+# The text goes inside an inline <script>: it must not end that element early ("</script" in any
+# case) or change how the browser finds its end ("<!--").
+string(TOLOWER "${text}" lower)
+foreach(bad "</script" "<!--")
+  string(FIND "${lower}" "${bad}" at)
+  if(NOT at EQUAL -1)
+    message(FATAL_ERROR "${INPUT} contains ${bad} and cannot be inlined in the report")
+  endif()
+endforeach()
 file(WRITE "${OUTPUT}.tmp"
   "// Generated from ${INPUT} by cmake/embed_text.cmake: do not edit.\n"
   "#include <string_view>\n\nnamespace ${NAMESPACE} {\n\n"

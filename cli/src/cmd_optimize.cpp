@@ -24,6 +24,7 @@
 #include "mneedle/design_source.h"
 #include "mneedle/fe/tissue_mesh.h"
 #include "mneedle/geometry/cross_section.h"
+#include "mneedle/needle/mesh.h"
 #include "mneedle/needle/mesh_io.h"
 #include "mneedle/optimum_report.h"
 #include "mneedle/plugin_host.h"
@@ -453,7 +454,8 @@ void run_optimize(const OptimizeArgs& a) {
         {"margin", number_or_null(e.margin)},
         {"safety_factor", e.safety_factor},
         {"models_run", e.models_run},
-        {"curve", curve_json(e.curve)}}},
+        {"curve", curve_json(e.curve)},
+        {"mesh_sha256", mesh_sha256(best.mesh)}}},
       {"plugin", a.plugin},
       {"parameter_units", parameter_units(shape)},
       {"variables", variables_json(vars)},

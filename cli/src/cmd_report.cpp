@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/files.h"
+#include "mneedle/report/html_report.h"
 #include "report_needles.h"
 #include "run_provenance.h"
 
@@ -30,9 +31,11 @@ void run(const ReportArgs& a) {
   nlohmann::json result;
   try {
     result = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
+    // parse_error, and out_of_range for a number beyond a double (1e999)
     throw InputError(a.result.string() + ": not JSON (" + e.what() + ")");
   }
+  report::result_kind(result, a.result.string());  // named before any needle is rebuilt
   write_report_file(a.out, result, a.result.string(), a.result.parent_path(), a.plugin_dirs);
   std::cout << "wrote " << a.out.string() << "\n";
 }

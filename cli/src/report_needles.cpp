@@ -74,14 +74,16 @@ void simulate_needles(const json& r, const std::filesystem::path& dir,
   for (std::size_t i = 0; i < needles.size(); ++i) {
     const json hash = i < recorded.size() ? recorded[i].value("mesh_sha256", json()) : json();
     if (same_mesh(needles[i].mesh, hash, "needle " + needles[i].name, out.notes))
-      out.views.push_back({needles[i].name, needles[i].mesh});
+      out.views.push_back({needles[i].name, needles[i].mesh, static_cast<int>(i)});
   }
 }
 
 void screen_needles(const json& r, const std::filesystem::path& dir,
                     const std::vector<std::string>& plugin_dirs, RebuiltNeedles& out) {
   std::optional<PluginRegistry> registry;
-  for (const json& d : r.value("designs", json::array())) {
+  const json designs = r.value("designs", json::array());
+  for (std::size_t k = 0; k < designs.size(); ++k) {
+    const json& d = designs[k];
     if (!d.value("ok", false)) continue;  // an error row has no needle to show
     const std::string name = d.value("design", "");
     try {
@@ -103,7 +105,7 @@ void screen_needles(const json& r, const std::filesystem::path& dir,
                              parse_axis_choice(d.value("axis", "auto")), d.value("repair", false));
       }
       if (same_mesh(source.mesh, d.value("mesh_sha256", json()), "design " + name, out.notes))
-        out.views.push_back({name, std::move(source.mesh)});
+        out.views.push_back({name, std::move(source.mesh), static_cast<int>(k)});
     } catch (const std::exception& e) {
       out.notes.push_back("design " + name + ": not shown in 3-D (" + e.what() + ")");
     }
@@ -120,7 +122,8 @@ void optimize_needles(const json& r, const std::vector<std::string>& plugin_dirs
   const NeedleSource source =
       needle_from_plugin(registry_of(plugin_dirs), r.at("plugin").get<std::string>(),
                          best.at("params").get<std::map<std::string, double>>());
-  out.views.push_back({"best design", source.mesh});
+  if (same_mesh(source.mesh, best.value("mesh_sha256", json()), "the best design", out.notes))
+    out.views.push_back({"best design", source.mesh, -1});
 }
 
 }  // namespace

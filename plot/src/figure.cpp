@@ -273,9 +273,10 @@ std::string svg_element(const Figure& figure) {
   // PLplot writes only to files: one of our own per call (process id and a counter), removed
   // at once.
   static std::atomic<unsigned> counter{0};
-  const auto file = std::filesystem::temp_directory_path() /
-                    ("mneedle-figure-" + std::to_string(::getpid()) + "-" +
-                     std::to_string(counter.fetch_add(1)) + ".svg");
+  const unsigned number = counter.fetch_add(1);
+  const auto file =
+      std::filesystem::temp_directory_path() /
+      ("mneedle-figure-" + std::to_string(::getpid()) + "-" + std::to_string(number) + ".svg");
   write_svg(file, figure);
   std::ifstream in(file, std::ios::binary);
   std::ostringstream text;
@@ -285,7 +286,14 @@ std::string svg_element(const Figure& figure) {
   std::string svg = text.str();
   const auto start = svg.find("<svg");
   if (start == std::string::npos) throw InputError("plot: PLplot wrote no <svg> element");
-  return svg.substr(start);
+  svg = svg.substr(start);
+  // PLplot numbers its clip paths from 0 in every file: figures inline in one page would share
+  // the ids (and clip with each other's paths). Each element gets this call's number.
+  const std::string prefix = "mneedle-figure-" + std::to_string(number) + "-";
+  for (std::size_t pos = 0; (pos = svg.find("text-clipping", pos)) != std::string::npos;
+       pos += prefix.size() + 13)
+    svg.insert(pos, prefix);
+  return svg;
 }
 
 }  // namespace mneedle::plot

@@ -156,7 +156,8 @@ std::vector<plot::Figure> optimize_figures(const json& r, const std::string& whe
   plot::Figure h;
   h.title = "the search: objective of every evaluation";
   h.x = {"evaluation", Dimension::Dimensionless, "", false};
-  h.y = {force_objective ? "peak force" : "puncture depth",
+  // Without a puncture the objective is a stand-in beyond the target depth (docs/cli.md).
+  h.y = {force_objective ? "objective: peak force" : "objective: puncture depth",
          force_objective ? Dimension::Force : Dimension::Length, "", false};
   plot::Series feasible{"feasible", {}, {}, plot::Mark::Dots};
   plot::Series infeasible{"infeasible", {}, {}, plot::Mark::Dots};
@@ -202,16 +203,12 @@ std::string table(const std::vector<std::string>& header,
   return t + "</tbody>\n</table>\n";
 }
 
-// The 3-D view's needle index of a name, or -1: a table row is clickable when it has one.
-int view_index(const std::vector<NeedleView>& views, const std::string& name) {
+// A table row is clickable when a needle of the 3-D view belongs to its entry of the result.
+std::string needle_row_attribute(const std::vector<NeedleView>& views, std::size_t entry) {
   for (std::size_t i = 0; i < views.size(); ++i)
-    if (views[i].name == name) return static_cast<int>(i);
-  return -1;
-}
-
-std::string needle_row_attribute(const std::vector<NeedleView>& views, const std::string& name) {
-  const int i = view_index(views, name);
-  return i < 0 ? "" : " data-needle=\"" + std::to_string(i) + "\" class=\"viewable\"";
+    if (views[i].entry >= 0 && static_cast<std::size_t>(views[i].entry) == entry)
+      return " data-needle=\"" + std::to_string(i) + "\" class=\"viewable\"";
+  return "";
 }
 
 std::string simulate_body(const json& r, const ReportInput& in) {
@@ -226,7 +223,7 @@ std::string simulate_body(const json& r, const ReportInput& in) {
                     quantity(n, "max_force_N", Dimension::Force),
                     p.is_object() ? esc(text_of(p.value("criterion", json("")))) : "no puncture",
                     yes_no(p, "at_first_contact")});
-    attributes.push_back(needle_row_attribute(in.needles, name));
+    attributes.push_back(needle_row_attribute(in.needles, rows.size() - 1));
   }
   std::string body = table({"needle", "puncture depth", "force at puncture", "force just after",
                             "largest force", "criterion", "at first contact"},
@@ -272,7 +269,7 @@ std::string screen_body(const json& r, const ReportInput& in) {
                       quantity(d, "capacity_N", Dimension::Force), plain_number(d, "margin"),
                       esc(text_of(d.value("governing", json("")))), notes});
     }
-    attributes.push_back(needle_row_attribute(in.needles, name));
+    attributes.push_back(needle_row_attribute(in.needles, rows.size() - 1));
   }
   std::string body =
       "<p>Ranked by puncture depth, then puncture force; designs that never puncture after them, "
@@ -304,7 +301,7 @@ std::string optimize_body(const json& r, const ReportInput& in) {
   }
   std::string body = "<p>" + esc(text_of(r.value("plugin", json("")))) + " searched by " +
                      esc(text_of(r.value("algorithm", json("")))) + " over " +
-                     plain_number(r, "evaluations") + " evaluations; " +
+                     std::to_string(r.value("evaluations", 0)) + " evaluations; " +
                      esc(text_of(r.value("stop_reason", json("")))) + ". " +
                      (r.value("feasible", false)
                           ? "The best design meets every constraint."
@@ -370,16 +367,19 @@ std::string provenance_body(const json& r, const json& made_by) {
 }
 
 // The needles for the viewer: millimetres, six significant digits (a micrometre of a 1 mm
-// needle is the fourth), the JSON kept inside its <script> element ("</" cannot appear).
+// needle is the fourth), the JSON kept inside its <script> element.
 std::string needles_json(const std::vector<NeedleView>& views) {
   std::string out = "[";
   char buf[40];
   for (std::size_t k = 0; k < views.size(); ++k) {
     const TriangleMesh& m = views[k].mesh;
-    json name = views[k].name;
-    std::string quoted = name.dump();
-    for (std::size_t pos = 0; (pos = quoted.find("</", pos)) != std::string::npos; pos += 3)
-      quoted.replace(pos, 2, "<\\/");
+    // No < or > at all inside the element: "</script" would end it, "<!--" changes how the
+    // browser looks for its end. JSON's \u escapes read back as the same characters.
+    std::string quoted;
+    for (char c : json(views[k].name).dump())
+      quoted += c == '<'   ? std::string("\\u003c")
+                : c == '>' ? std::string("\\u003e")
+                           : std::string(1, c);
     out += (k ? ",\n" : "\n") + std::string("{\"name\":") + quoted +
            ",\"triangles\":" + std::to_string(m.triangles.size()) + ",\"positions\":[";
     for (std::size_t i = 0; i < m.vertices.size(); ++i)

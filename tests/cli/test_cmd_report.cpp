@@ -105,11 +105,19 @@ TEST(ReportCommand, ResultThatIsNotJsonOrNotAResultIsOneLineNamingTheFile) {
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find((dir / "broken.json").string() + ": not JSON"), std::string::npos)
       << run.err;
+  std::ofstream(dir / "huge.json") << "{\"needles\": [1e999]}";  // beyond a double
+  run = run_mneedle("report '" + (dir / "huge.json").string() + "' -o '" +
+                    (dir / "r.html").string() + "'");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find((dir / "huge.json").string() + ": not JSON"), std::string::npos)
+      << run.err;
   std::ofstream(dir / "fit.json") << "{\"parameters\": {}}";
   run = run_mneedle("report '" + (dir / "fit.json").string() + "' -o '" +
                     (dir / "r.html").string() + "'");
   EXPECT_EQ(run.exit_code, 1);
-  EXPECT_NE(run.err.find(": not a result of simulate, screen or optimize"), std::string::npos)
+  EXPECT_NE(
+      run.err.find((dir / "fit.json").string() + ": not a result of simulate, screen or optimize"),
+      std::string::npos)
       << run.err;
   EXPECT_EQ(count(run.err, "\n"), 1u) << run.err;
   EXPECT_FALSE(fs::exists(dir / "r.html"));

@@ -59,6 +59,23 @@ Figure force_figure() {
   return f;
 }
 
+TEST(SvgElement, TwoFiguresInOnePageShareNoIdAndCarryNoXmlProlog) {
+  const std::string a = mneedle::plot::svg_element(force_figure());
+  const std::string b = mneedle::plot::svg_element(force_figure());
+  EXPECT_EQ(a.rfind("<svg", 0), 0u);
+  const auto ids = [](const std::string& svg) {
+    std::vector<std::string> found;
+    for (std::size_t pos = 0; (pos = svg.find(" id=\"", pos)) != std::string::npos; ++pos)
+      found.push_back(svg.substr(pos + 5, svg.find('"', pos + 5) - pos - 5));
+    return found;
+  };
+  ASSERT_FALSE(ids(a).empty());
+  for (const std::string& id : ids(a)) {
+    EXPECT_EQ(b.find("\"" + id + "\""), std::string::npos) << id;
+    EXPECT_NE(a.find("url(#" + id + ")"), std::string::npos) << id;  // still referenced
+  }
+}
+
 TEST(DisplayUnit, PicksTheUnitByMagnitude) {
   EXPECT_EQ(mneedle::plot::display_unit(Dimension::Length, 200e-6).name, "um");
   EXPECT_EQ(mneedle::plot::display_unit(Dimension::Length, 2e-3).name, "mm");

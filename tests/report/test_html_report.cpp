@@ -7,6 +7,8 @@
 #include <regex>
 #include <string>
 
+#include <unistd.h>
+
 #include "mneedle/base/error.h"
 
 namespace {
@@ -43,9 +45,10 @@ json screen_result() {
           {"provenance", {{"tool", "mneedle"}, {"version", "0.1.0"}}}};
 }
 
-NeedleView tetrahedron(const std::string& name) {
+NeedleView tetrahedron(const std::string& name, int entry = -1) {
   NeedleView v;
   v.name = name;
+  v.entry = entry;
   v.mesh.vertices = {{0, 0, 0}, {1e-4, 0, 1e-3}, {0, 1e-4, 1e-3}, {-1e-4, -1e-4, 1e-3}};
   v.mesh.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 1}, {1, 3, 2}};
   return v;
@@ -129,7 +132,8 @@ TEST(HtmlReport, NamesAreEscapedAndTheViewersJsonCannotCloseItsScript) {
   ReportInput in;
   in.result = screen_result();
   in.source = "r.json";
-  in.needles = {tetrahedron("cone <b>&"), tetrahedron("x</script><script>alert(1)")};
+  in.needles = {tetrahedron("cone <b>&"), tetrahedron("x</script><script>alert(1)"),
+                tetrahedron("<!--<script")};
   in.result["designs"][1] = in.result["designs"][0];  // two curves: a legend with the name
   in.result["designs"][1]["design"] = "cone <b>& 2";
   const std::string page = mneedle::report::html_report(in);
@@ -142,13 +146,21 @@ TEST(HtmlReport, NamesAreEscapedAndTheViewersJsonCannotCloseItsScript) {
   for (std::size_t pos = 0; (pos = page.find("</script>", pos)) != std::string::npos; ++pos)
     ++closes;
   EXPECT_EQ(closes, 2u);
+  // Inside the JSON element: no < or > at all, whatever the names hold.
+  const auto start = page.find("<script type=\"application/json\" id=\"mneedle-needles\">");
+  ASSERT_NE(start, std::string::npos);
+  const auto body =
+      start + std::string("<script type=\"application/json\" id=\"mneedle-needles\">").size();
+  const std::string inside = page.substr(body, page.find("</script>", body) - body);
+  EXPECT_EQ(inside.find_first_of("<>"), std::string::npos) << inside.substr(0, 200);
+  EXPECT_NE(inside.find("\\u003c!--\\u003cscript"), std::string::npos);
 }
 
 TEST(HtmlReport, NeedlesReachTheViewerInMillimetresAndRowsPointAtThem) {
   ReportInput in;
   in.result = screen_result();
   in.source = "r.json";
-  in.needles = {tetrahedron("cone <b>&")};
+  in.needles = {tetrahedron("cone <b>&", 0)};
   const std::string page = mneedle::report::html_report(in);
   EXPECT_NE(page.find("\"positions\":[0,0,0,0.1,0,1,0,0.1,1,-0.1,-0.1,1]"), std::string::npos);
   EXPECT_NE(page.find("\"indices\":[0,1,2,0,2,3,0,3,1,1,3,2]"), std::string::npos);
@@ -156,6 +168,24 @@ TEST(HtmlReport, NeedlesReachTheViewerInMillimetresAndRowsPointAtThem) {
   // The error row says why and is not clickable.
   EXPECT_NE(page.find("broken.stl: not a mesh"), std::string::npos);
   EXPECT_NE(page.find("<option value=\"0\">cone &lt;b&gt;&amp;</option>"), std::string::npos);
+}
+
+TEST(HtmlReport, RowsPointAtTheirOwnNeedleWhenTwoDesignsShareAName) {
+  ReportInput in;
+  in.result = screen_result();
+  in.result["designs"][1] = in.result["designs"][0];  // both "cone <b>&" (two files' stems)
+  in.source = "r.json";
+  in.needles = {tetrahedron("cone <b>&", 1)};  // only the second one was rebuilt
+  const std::string page = mneedle::report::html_report(in);
+  std::size_t clickable = 0;
+  for (std::size_t pos = 0; (pos = page.find("data-needle=", pos)) != std::string::npos; ++pos)
+    ++clickable;
+  EXPECT_EQ(clickable, 1u);
+  // The first row is not clickable; the second shows needle 0.
+  const auto first = page.find("<tr><td>1</td>");
+  const auto second = page.find("<tr data-needle=\"0\" class=\"viewable\"><td>2</td>");
+  EXPECT_NE(first, std::string::npos);
+  EXPECT_NE(second, std::string::npos);
 }
 
 TEST(HtmlReport, PageIsSelfContainedWithThePlotInlineAndNoAddressToFetch) {
@@ -188,7 +218,11 @@ TEST(WriteReport, UnwritableFileIsNamedAndLeavesNothing) {
   ReportInput in;
   in.result = screen_result();
   in.source = "r.json";
-  const auto file = std::filesystem::temp_directory_path() / "no_such_folder_mneedle" / "r.html";
+  // A file where the folder should be: cannot be written, even by root.
+  const auto blocker = std::filesystem::temp_directory_path() /
+                       ("mneedle_report_blocker_" + std::to_string(::getpid()));
+  std::ofstream(blocker) << "a file";
+  const auto file = blocker / "r.html";
   try {
     mneedle::report::write_report(file, in);
     FAIL() << "no error";
@@ -197,7 +231,9 @@ TEST(WriteReport, UnwritableFileIsNamedAndLeavesNothing) {
               std::string::npos)
         << e.what();
   }
-  EXPECT_FALSE(std::filesystem::exists(file.parent_path()));
+  EXPECT_FALSE(std::filesystem::exists(file.string() + ".tmp"));
+  EXPECT_EQ(std::filesystem::file_size(blocker), 6u);  // untouched
+  std::filesystem::remove(blocker);
 }
 
 }  // namespace

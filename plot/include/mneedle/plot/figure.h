@@ -61,7 +61,8 @@ struct Figure {
 void write_svg(const std::filesystem::path& file, const Figure& figure);
 
 /// The same figure as SVG text for embedding in a page: the <svg> element alone (no XML prolog
-/// or DOCTYPE), drawn through a private temporary file. Throws as write_svg.
+/// or DOCTYPE), drawn through a private temporary file; its ids (PLplot's clip paths) are unique to
+/// the call, so several figures can share a page. Throws as write_svg.
 std::string svg_element(const Figure& figure);
 
 /// The unit an axis of this dimension shows for values up to `largest_abs` (SI), and its size

@@ -26,6 +26,9 @@ ResultKind result_kind(const nlohmann::json& result, const std::string& where);
 struct NeedleView {
   std::string name;
   TriangleMesh mesh;
+  /// Its entry in the result: the index in a simulation's `needles` or a screen's `designs`
+  /// (names need not be unique); -1 when no table row shows it (an optimisation's best design).
+  int entry = -1;
 };
 
 struct ReportInput {
