@@ -130,11 +130,19 @@ void write_svg(const std::filesystem::path& file, const Figure& f) {
   const double pad = 0.05 * (y1 - y0);
   y1 += pad;
   if (y0 < 0.0 || f.y.logarithmic) y0 -= pad;
+  // A logarithmic x axis does not start at zero: room on both sides, so that the outermost
+  // points are not cut in half by the frame.
+  if (f.x.logarithmic) {
+    const double room = 0.03 * (x1 - x0);
+    x0 -= room;
+    x1 += room;
+  }
   // Headroom for the legend (top left, about 5.5 % of the height a line, 3 % of frame) so that
   // it sits above the data instead of on them.
   const auto labelled = static_cast<std::size_t>(std::count_if(
       f.series.begin(), f.series.end(), [](const Series& s) { return !s.label.empty(); }));
-  if (labelled > 1 && !f.y.logarithmic) {
+  // (On a logarithmic axis the same share of the height, in decades.)
+  if (labelled > 1) {
     const double covered =
         0.03 + 0.055 * static_cast<double>(std::min(labelled, kMaxLegendEntries));
     y1 = y0 + (y1 - y0) / (1.0 - covered);
