@@ -350,13 +350,20 @@ void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
   PreparedNeedle proxy = needles[0];
   if (!proxy.axisymmetric)
     proxy.axisymmetric = equivalent_axisymmetric_needle(proxy.mesh, 1.05 * plan.horizon_m);
+  // The proxy measures the truncation only, in the axisymmetric model's own (6-node) triangles:
+  // an element order asked of the 3-D model is not the proxy's to honour.
+  InsertionRunOptions proxy_options = options;
+  proxy_options.overrides.order.reset();
   auto reference_on = [&](double size_x, double size_y) {
     RunPlan probe = plan;
     probe.axisymmetric_radius_m = fe::equal_area_radius(std::sqrt(size_x * size_y));
     probe.threshold.reset();  // same depth steps, no early stop
     probe.vtu_directory.clear();
     probe.depth_m = reduced.needles[0].points.back().depth_m;
-    return run_axisymmetric(probe, proxy, areas[0], options, 0.0).needles[0].points.back().force_N;
+    return run_axisymmetric(probe, proxy, areas[0], proxy_options, 0.0)
+        .needles[0]
+        .points.back()
+        .force_N;
   };
   const double f_full = reference_on(plan.full_block_x_m, plan.full_block_y_m);
   const double f_cut = plan.pre == PreKind::Axisymmetric

@@ -413,6 +413,20 @@ TEST(ScenePlanner, DomainCutOfThe3dBlockIsMeasuredAndUndoneAboveTheTolerance) {
   EXPECT_LT(std::abs(fa - fb) / fb, 0.02) << fa << " vs " << fb;
 }
 
+TEST(ScenePlanner, DomainCutOfATet4BlockIsMeasuredByTheAxisymmetricProxyInItsOwnElements) {
+  // Linear tetrahedra asked of the 3-D model: the axisymmetric proxy that measures the cut has
+  // 6-node triangles only and must not be asked for order 1 (it threw, ending the run).
+  InsertionRunOptions tet4 = fast();
+  tet4.model = PreModel::Full3d;
+  tet4.overrides.order = 1;
+  const InsertionRun a = run_insertion(wide_block_scene(), {punch("punch", 115e-6)}, tet4);
+  const Reduction* cut = find_reduction(a, "domain_cut");
+  ASSERT_NE(cut, nullptr);
+  ASSERT_TRUE(cut->measured_effect.has_value());
+  EXPECT_LT(*cut->measured_effect, 0.05);  // the same truncation as with TET10 (above)
+  EXPECT_FALSE(a.needles[0].curve.empty());
+}
+
 TEST(ScenePlanner, HalfModelOfABevelMatchesTheFullModel) {
   PreparedNeedle bevel;
   bevel.name = "bevel";
