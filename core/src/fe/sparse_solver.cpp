@@ -1,6 +1,7 @@
 #include "mneedle/fe/sparse_solver.h"
 
 #include <Eigen/SparseCholesky>
+#include <mutex>
 
 #include "mneedle/base/error.h"
 
@@ -44,7 +45,15 @@ SparseSolver& SparseSolver::operator=(SparseSolver&&) noexcept = default;
 
 void SparseSolver::analyze(const Eigen::SparseMatrix<double>& matrix) {
   if (matrix.rows() != matrix.cols()) throw SolverError("sparse solver: matrix is not square");
-  impl_->cholesky.analyzePattern(matrix);
+  {
+    // CHOLMOD's ordering may call METIS, whose random numbers come from one generator per
+    // process (GKlib's, reseeded at each call): two threads ordering at once draw from each
+    // other's sequence, and the ordering, hence the round-off of every result, would depend on
+    // timing. One ordering at a time keeps screen --jobs N bit for bit equal to the serial run.
+    static std::mutex ordering;
+    std::lock_guard<std::mutex> lock(ordering);
+    impl_->cholesky.analyzePattern(matrix);
+  }
   impl_->indefinite_analyzed = false;
   impl_->rows = matrix.rows();
   impl_->nonzeros = matrix.nonZeros();
