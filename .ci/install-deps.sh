@@ -20,6 +20,7 @@ packages=(
   python3-meshio
   calculix-ccx
   chromium fonts-liberation libgl1-mesa-dri
+  libopenmpi-dev openmpi-bin
 )
 
 missing=()

@@ -33,3 +33,10 @@ else()
   set(MNEEDLE_HAVE_CHOLMOD OFF)
   message(STATUS "mneedle: CHOLMOD not found, using Eigen's sparse solvers")
 endif()
+
+# MPI for screening on a cluster (screen --mpi), only when asked for: the C bindings are all it
+# uses (optimize/src/screening_mpi.cpp).
+if(MNEEDLE_MPI)
+  find_package(MPI REQUIRED COMPONENTS C)
+  message(STATUS "mneedle: MPI ${MPI_C_VERSION} (${MPI_C_LIBRARIES})")
+endif()

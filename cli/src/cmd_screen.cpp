@@ -12,6 +12,7 @@
 #include "mneedle/base/units.h"
 #include "mneedle/needle/needle_frame.h"
 #include "mneedle/screening.h"
+#include "mneedle/screening_mpi.h"
 #include "report_needles.h"
 #include "run_provenance.h"
 
@@ -32,6 +33,7 @@ struct ScreenArgs {
   std::string report;
   bool json = false;
   bool resume = false;
+  bool mpi = false;
   std::vector<std::string> plugin_dirs;
 };
 
@@ -84,38 +86,82 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
   }
 }
 
-void run_screen(const ScreenArgs& args) {
-  const Scene scene = load_scene(args.scene);
-  record_scene(scene, args.scene);
-  const auto registry =
-      PluginRegistry::discover({args.plugin_dirs.begin(), args.plugin_dirs.end()});
-  const auto designs =
-      collect_designs({args.designs.begin(), args.designs.end()}, length_unit_scale(args.unit));
-  if (designs.empty()) throw InputError("screen: no mesh files or designs found in the inputs");
-
+// What every rank of an MPI run prepares alike from the command line; only the writer (rank 0,
+// or the one process) creates --out and records the run in it.
+struct ScreenSetup {
+  Scene scene;
+  PluginRegistry registry;
+  std::vector<DesignInput> designs;
   ScreeningOptions options;
+};
+
+ScreenSetup prepare_screen(const ScreenArgs& args, bool writer) {
+  ScreenSetup s{
+      load_scene(args.scene),
+      PluginRegistry::discover({args.plugin_dirs.begin(), args.plugin_dirs.end()}),
+      collect_designs({args.designs.begin(), args.designs.end()}, length_unit_scale(args.unit)),
+      {}};
+  if (writer) record_scene(s.scene, args.scene);
+  if (s.designs.empty()) throw InputError("screen: no mesh files or designs found in the inputs");
+  ScreeningOptions& options = s.options;
   options.jobs = args.jobs;
   if (!args.material.empty()) options.material = args.material;
-  if (!args.out.empty()) {
-    options.out = args.out;
-    create_output_folder(args.out, "--out");
-    append_provenance_line(args.out);
-  }
   options.resume = args.resume;
   options.fidelity = args.fidelity;
   options.model = args.model;
   options.axis = args.axis;
   options.repair = args.repair;
   parse_axis_choice(args.axis);  // a bad --axis is a usage error before any design runs
-  if (options.resume && !options.out) throw InputError("screen: --resume needs --out DIR");
+  if (options.resume && args.out.empty()) throw InputError("screen: --resume needs --out DIR");
+  if (!args.out.empty()) {
+    options.out = args.out;
+    if (writer) {
+      create_output_folder(args.out, "--out");
+      append_provenance_line(args.out);
+    }
+  }
+  return s;
+}
 
-  const auto rows = rank_rows(
-      screen_designs(designs, scene, args.scene, registry, options, [&](const ScreeningRow& row) {
-        if (!args.json) {
-          std::cerr << (row.resumed ? "resumed " : "done    ") << row.design
-                    << (row.frame_note.empty() ? "" : " (" + row.frame_note + ")") << "\n";
-        }
-      }));
+void run_screen(const ScreenArgs& args) {
+  if (const auto n = mpi_launch_size(); n && *n > 1 && !args.mpi) {
+    if (mpi_launch_rank() != 0) throw QuietExit{1};  // rank 0 says why, once
+    throw InputError("screen: started by an MPI launcher as " + std::to_string(*n) +
+                     " processes without --mpi: each would screen every design into the same "
+                     "files; add --mpi");
+  }
+  std::optional<MpiSession> session;
+  if (args.mpi) session.emplace(args.jobs);
+  const bool writer = !session || session->rank() == 0;
+  // Under MPI a rank whose setup fails must not leave the others waiting: every rank says
+  // whether it got through, rank 0 reports its own error, another rank only one rank 0 lacks.
+  std::optional<ScreenSetup> setup;
+  try {
+    setup.emplace(prepare_screen(args, writer));
+  } catch (const std::exception&) {
+    if (!session) throw;
+    const auto agreement = session->agree(false);
+    if (writer || agreement.rank0) throw;
+    throw QuietExit{1};  // rank 0 failed too and says so, once
+  }
+  if (session && !session->agree(true).all) {
+    if (writer) throw InputError("screen --mpi: another rank could not start (its line says why)");
+    throw QuietExit{1};
+  }
+  const Scene& scene = setup->scene;
+  const ScreeningOptions& options = setup->options;
+  const auto on_row = [&](const ScreeningRow& row) {
+    if (!args.json) {
+      std::cerr << (row.resumed ? "resumed " : "done    ") << row.design
+                << (row.frame_note.empty() ? "" : " (" + row.frame_note + ")") << "\n";
+    }
+  };
+  const auto rows =
+      rank_rows(session ? screen_designs_mpi(*session, setup->designs, scene, args.scene,
+                                             setup->registry, options, on_row)
+                        : screen_designs(setup->designs, scene, args.scene, setup->registry,
+                                         options, on_row));
+  if (!writer) return;  // rank 0 reports the run
   std::size_t failed = 0;
   for (const auto& r : rows) failed += r.ok ? 0 : 1;
   if (args.json || !args.report.empty()) {
@@ -184,6 +230,9 @@ void add_screen_command(CLI::App& app) {
   cmd->add_option("--out", args->out,
                   "Folder for results.csv and results.jsonl, written as designs finish");
   cmd->add_flag("--resume", args->resume, "Skip designs already in --out for the same inputs");
+  cmd->add_flag("--mpi", args->mpi,
+                "Share the designs among the processes of mpirun -n N (rank 0 writes; each "
+                "rank runs --jobs threads)");
   cmd->add_option("--plugin-dir", args->plugin_dirs, "Extra plugin folder (repeatable)");
   cmd->add_flag("--json", args->json, "Print one JSON object");
   cmd->add_option(

@@ -9,6 +9,12 @@ class App;
 
 namespace mneedle::cli {
 
+/// Thrown by a process whose error another one reports (a rank > 0 of an MPI run whose rank 0
+/// failed the same way): main() exits with `status` and prints nothing.
+struct QuietExit {
+  int status;
+};
+
 void add_scene_command(CLI::App& app);
 void add_plugins_command(CLI::App& app);
 void add_generate_command(CLI::App& app);

@@ -52,6 +52,8 @@ int main(int argc, char** argv) {
       if (!asks_help) throw;
     }
     app.parse(argc, argv);
+  } catch (const mneedle::cli::QuietExit& e) {
+    return e.status;
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --help, --version
   } catch (const CLI::ParseError& e) {

@@ -21,6 +21,7 @@
 #include "mneedle/base/files.h"
 #include "mneedle/blas_threads.h"
 #include "mneedle/design_source.h"
+#include "screening_batch.h"
 
 namespace mneedle {
 namespace fs = std::filesystem;
@@ -311,7 +312,7 @@ ScreeningRow row_from_json(const std::string& line) {
   const json j = json::parse(line);
   ScreeningRow row;
   row.design = j.at("design").get<std::string>();
-  row.hash = j.at("hash").get<std::string>();
+  row.hash = j.value("hash", "");  // an error row of a design that could not be read has none
   row.ok = j.at("ok").get<bool>();
   row.resumed = true;
   row.json = line;
@@ -324,6 +325,7 @@ ScreeningRow row_from_json(const std::string& line) {
     }
     row.margin = j.at("margin").is_null() ? INFINITY : j.at("margin").get<double>();
     row.passes = j.at("passes").get<bool>();
+    row.frame_note = j.value("frame_note", "");
   } else {
     row.error = j.value("error", "");
   }
@@ -421,30 +423,6 @@ std::string csv_preamble(const fs::path& out) {
   return text + csv_header() + "\n";
 }
 
-class ResultWriter {
- public:
-  explicit ResultWriter(const std::optional<fs::path>& out) {
-    if (!out) return;
-    create_output_folder(*out, "--out");
-    const bool fresh_csv = !fs::exists(*out / "results.csv");
-    jsonl_.open(*out / "results.jsonl", std::ios::app);
-    csv_.open(*out / "results.csv", std::ios::app);
-    if (!jsonl_ || !csv_) throw InputError(out->string() + ": cannot write results");
-    if (fresh_csv) csv_ << csv_preamble(*out) << std::flush;
-  }
-
-  void write(const ScreeningRow& row) {
-    if (!jsonl_.is_open()) return;
-    const std::string line = csv_line(json::parse(row.json));
-    // Flushed per row: a run killed half-way keeps every finished design.
-    jsonl_ << row.json << "\n" << std::flush;
-    csv_ << line << "\n" << std::flush;
-  }
-
- private:
-  std::ofstream jsonl_, csv_;
-};
-
 // results.jsonl is the record; results.csv its table. A run killed between writing a row's JSON
 // line and its CSV line would leave the CSV one design short for good (the design is resumed
 // from the JSON line and not written again), so --resume rewrites the CSV from the JSON lines,
@@ -503,51 +481,103 @@ std::vector<DesignInput> collect_designs(const std::vector<fs::path>& inputs,
   return out;
 }
 
+ScreeningRow screening_row_from_json(const std::string& line) {
+  ScreeningRow row = row_from_json(line);
+  row.resumed = false;
+  return row;
+}
+
+ScreeningBatch::ScreeningBatch(const std::vector<DesignInput>& designs, const Scene& scene,
+                               const fs::path& scene_file, const PluginRegistry& registry,
+                               const ScreeningOptions& options,
+                               std::function<void(const ScreeningRow&)> on_row, bool writes)
+    : designs_(designs),
+      scene_(scene),
+      registry_(registry),
+      options_(options),
+      on_row_(writes ? std::move(on_row) : nullptr),
+      scene_hash_(hex(fnv1a(read_bytes(scene_file)))),
+      material_(scene_material(scene, options)),
+      rows_(designs.size()) {
+  parse_fidelity(options.fidelity);  // bad names fail the run, not every row
+  parse_pre_model(options.model);
+  if (!writes || !options.out) return;
+  const fs::path& out = *options.out;
+  if (options.resume) done_ = finished_rows(out / "results.jsonl");
+  rebuild_csv(out);
+  create_output_folder(out, "--out");
+  const bool fresh_csv = !fs::exists(out / "results.csv");
+  jsonl_.open(out / "results.jsonl", std::ios::app);
+  csv_.open(out / "results.csv", std::ios::app);
+  if (!jsonl_ || !csv_) throw InputError(out.string() + ": cannot write results");
+  if (fresh_csv) csv_ << csv_preamble(out) << std::flush;
+}
+
+ScreeningBatch::~ScreeningBatch() = default;
+
+std::string ScreeningBatch::hash(std::size_t i) const {
+  return row_hash(designs_[i], scene_hash_,
+                  options_.fidelity + "|" + options_.model + "|axis=" + options_.axis +
+                      (options_.repair ? "|repair" : ""),
+                  material_);
+}
+
+std::optional<std::size_t> ScreeningBatch::claim() {
+  std::lock_guard<std::mutex> lock(claim_mutex_);
+  while (next_ < designs_.size()) {
+    const std::size_t i = next_++;
+    if (!done_.empty()) {
+      const auto previous = done_.find(hash(i));
+      if (previous != done_.end()) {
+        ScreeningRow row = previous->second;
+        record(i, std::move(row));
+        continue;
+      }
+    }
+    return i;
+  }
+  return std::nullopt;
+}
+
+ScreeningRow ScreeningBatch::evaluate(std::size_t i) const {
+  // Nothing may escape (a worker thread would terminate the process): whatever fails becomes
+  // this design's error row and the others go on.
+  try {
+    return evaluate_row(designs_[i], scene_, hash(i), material_, registry_, options_);
+  } catch (const std::exception& e) {
+    return error_row(designs_[i], e.what());
+  }
+}
+
+void ScreeningBatch::record(std::size_t i, ScreeningRow row) {
+  std::lock_guard<std::mutex> lock(record_mutex_);
+  try {
+    if (!row.resumed && jsonl_.is_open()) {
+      const std::string line = csv_line(json::parse(row.json));
+      // Flushed per row: a run killed half-way keeps every finished design.
+      jsonl_ << row.json << "\n" << std::flush;
+      csv_ << line << "\n" << std::flush;
+    }
+    if (on_row_) on_row_(row);
+  } catch (const std::exception& e) {
+    row = error_row(designs_[i], std::string("reporting the row failed: ") + e.what());
+  }
+  rows_[i] = std::move(row);
+}
+
+std::vector<ScreeningRow> ScreeningBatch::take_rows() {
+  std::lock_guard<std::mutex> lock(record_mutex_);
+  return std::move(rows_);
+}
+
 std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs,
                                          const Scene& scene, const fs::path& scene_file,
                                          const PluginRegistry& registry,
                                          const ScreeningOptions& options,
                                          const std::function<void(const ScreeningRow&)>& on_row) {
-  parse_fidelity(options.fidelity);  // bad names fail the run, not every row
-  parse_pre_model(options.model);
-  const std::string scene_hash = hex(fnv1a(read_bytes(scene_file)));
-  std::map<std::string, ScreeningRow> done;
-  if (options.resume && options.out) done = finished_rows(*options.out / "results.jsonl");
-  if (options.out) rebuild_csv(*options.out);
-  ResultWriter writer(options.out);
-
-  std::vector<ScreeningRow> rows(designs.size());
-  std::atomic<std::size_t> next{0};
-  std::mutex report;
-  const std::string material = scene_material(scene, options);
+  ScreeningBatch batch(designs, scene, scene_file, registry, options, on_row, true);
   auto worker = [&] {
-    for (std::size_t i = next++; i < designs.size(); i = next++) {
-      // Nothing may escape a worker thread (that would terminate the process): whatever fails
-      // becomes this design's error row and the others go on.
-      ScreeningRow row;
-      bool skip = false;
-      try {
-        const std::string hash =
-            row_hash(designs[i], scene_hash,
-                     options.fidelity + "|" + options.model + "|axis=" + options.axis +
-                         (options.repair ? "|repair" : ""),
-                     material);
-        const auto previous = done.find(hash);
-        skip = previous != done.end();
-        row = skip ? previous->second
-                   : evaluate_row(designs[i], scene, hash, material, registry, options);
-      } catch (const std::exception& e) {
-        row = error_row(designs[i], e.what());
-      }
-      std::lock_guard<std::mutex> lock(report);
-      try {
-        if (!skip) writer.write(row);
-        if (on_row) on_row(row);
-      } catch (const std::exception& e) {
-        row = error_row(designs[i], std::string("reporting the row failed: ") + e.what());
-      }
-      rows[i] = std::move(row);
-    }
+    while (const auto i = batch.claim()) batch.record(*i, batch.evaluate(*i));
   };
   const int jobs = std::max(1, std::min<int>(options.jobs, static_cast<int>(designs.size())));
   // Each job factorises with CHOLMOD; OpenBLAS would start a thread per core in every one of them.
@@ -557,7 +587,7 @@ std::vector<ScreeningRow> screen_designs(const std::vector<DesignInput>& designs
   for (int j = 1; j < jobs; ++j) pool.emplace_back(worker);
   worker();
   for (auto& t : pool) t.join();
-  return rows;
+  return batch.take_rows();
 }
 
 std::vector<ScreeningRow> rank_rows(std::vector<ScreeningRow> rows) {

@@ -22,13 +22,13 @@ inline std::string mneedle_binary() {
   return std::string(MNEEDLE_BINARY_ROOT) + "/cli/mneedle";
 }
 
-inline CommandRun run_mneedle(const std::string& arguments) {
+/// Runs a shell command line (its words quoted by the caller): exit status, stdout, stderr.
+inline CommandRun run_command(const std::string& command_line) {
   static int counter = 0;
   const std::filesystem::path err_file =
       std::filesystem::temp_directory_path() /
       ("mneedle_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + ".err");
-  const std::string command =
-      "'" + mneedle_binary() + "' " + arguments + " 2>'" + err_file.string() + "'";
+  const std::string command = command_line + " 2>'" + err_file.string() + "'";
   CommandRun run;
   FILE* pipe = ::popen(command.c_str(), "r");
   if (pipe == nullptr) return run;
@@ -43,6 +43,10 @@ inline CommandRun run_mneedle(const std::string& arguments) {
   run.err = text.str();
   std::filesystem::remove(err_file);
   return run;
+}
+
+inline CommandRun run_mneedle(const std::string& arguments) {
+  return run_command("'" + mneedle_binary() + "' " + arguments);
 }
 
 /// A whole output file as text ("" when it is missing).

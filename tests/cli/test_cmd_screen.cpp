@@ -285,11 +285,12 @@ TEST(StrengthCommand, UnknownMaterialAndMissingNeedleAreClearErrors) {
 
 namespace {
 
-// Starts mneedle with `arguments` (output discarded) and SIGKILLs it after `delay` unless it has
-// finished by then; true when it finished on its own.
+// Starts `program` (default mneedle) with `arguments` (output discarded) and sends it `signal`
+// after `delay` unless it has finished by then; true when it finished on its own.
 bool finished_before_kill(const std::vector<std::string>& arguments,
-                          std::chrono::microseconds delay) {
-  const std::string binary = mneedle::test::mneedle_binary();
+                          std::chrono::microseconds delay, int signal = SIGKILL,
+                          const std::string& program = mneedle::test::mneedle_binary()) {
+  const std::string binary = program;
   std::vector<char*> argv{const_cast<char*>(binary.c_str())};
   for (const std::string& a : arguments) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
@@ -307,7 +308,7 @@ bool finished_before_kill(const std::vector<std::string>& arguments,
     if (::waitpid(pid, &status, WNOHANG) == pid) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  ::kill(pid, SIGKILL);
+  ::kill(pid, signal);
   ::waitpid(pid, &status, 0);
   return false;
 }
@@ -405,5 +406,165 @@ TEST(ScreenCommand, KilledAndResumedAgainAndAgainListsEveryDesignOnceWithUninter
   for (const auto& [design, count] : csv_seen) EXPECT_EQ(count, 1) << design;
   fs::remove_all(dir);
 }
+
+#ifdef MNEEDLE_MPIEXEC
+// screen --mpi under the MPI launcher CMake found (docs/performance.md, "Screening on a cluster").
+// Two ranks on any machine (--oversubscribe); as root Open MPI wants the two variables below.
+std::vector<std::string> mpirun(int ranks, std::vector<std::string> arguments) {
+  ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+  ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+  std::vector<std::string> words{"-n", std::to_string(ranks), "--oversubscribe",
+                                 mneedle::test::mneedle_binary()};
+  words.insert(words.end(), arguments.begin(), arguments.end());
+  words.push_back("--mpi");
+  return words;
+}
+
+std::string shell_words(const std::vector<std::string>& words) {
+  std::string line = std::string("'") + MNEEDLE_MPIEXEC + "'";
+  for (const auto& w : words) line += " '" + w + "'";
+  return line;
+}
+
+// The rows of a --json screen by design, without what may differ between runs (timings) or
+// says how the row was reached (resumed).
+std::map<std::string, nlohmann::json> rows_by_design(const std::string& json_text) {
+  std::map<std::string, nlohmann::json> rows;
+  const auto result = nlohmann::json::parse(json_text);  // outlives the loop over its rows
+  for (auto row : result["designs"]) {
+    for (const char* key : {"seconds", "insertion_seconds", "resumed"}) row.erase(key);
+    rows[row["design"].get<std::string>()] = row;
+  }
+  return rows;
+}
+
+std::vector<std::string> ranked_names(const std::string& json_text) {
+  std::vector<std::string> names;
+  const auto result = nlohmann::json::parse(json_text);
+  for (const auto& row : result["designs"]) names.push_back(row["design"].get<std::string>());
+  return names;
+}
+
+TEST(ScreenCommand, TwoMpiRanksGiveTheSerialRowsBitForBitAndTheSameRanking) {
+  // FE designs (the three shipped bevels and cylinder as STL, two cones through the plugin) so
+  // that CHOLMOD, OpenBLAS and METIS all run. Serial --jobs 2 and the MPI ranks both evaluate
+  // each design on one OpenBLAS thread: the same arithmetic, so equal to the last bit.
+  const fs::path dir = fs::temp_directory_path() / ("mneedle_mpi_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "cones.toml")
+      << "[[designs]]\nname = \"cone_a\"\nplugin = \"cone\"\ndiameter = \"150 um\"\n\n"
+         "[[designs]]\nname = \"cone_b\"\nplugin = \"cone\"\ndiameter = \"200 um\"\n";
+  const std::vector<std::string> inputs{
+      "screen", kRoot + "/designs", (dir / "cones.toml").string(), "--scene", kSkin, "--json"};
+  std::string serial_args;
+  for (const auto& w : inputs) serial_args += " '" + w + "'";
+  const auto serial =
+      run_mneedle(serial_args + " --jobs 2 --out '" + (dir / "serial").string() + "'");
+  ASSERT_EQ(serial.exit_code, 0) << serial.err;
+
+  for (const std::string jobs : {"1", "2"}) {
+    auto words = mpirun(2, inputs);
+    for (const std::string w : {"--jobs", jobs.c_str(), "--out"}) words.push_back(w);
+    words.push_back((dir / ("mpi" + jobs)).string());
+    const auto mpi = mneedle::test::run_command(shell_words(words));
+    ASSERT_EQ(mpi.exit_code, 0) << mpi.err;
+    EXPECT_EQ(ranked_names(mpi.out), ranked_names(serial.out)) << "--jobs " << jobs;
+    const auto expected = rows_by_design(serial.out);
+    const auto got = rows_by_design(mpi.out);
+    ASSERT_EQ(got.size(), 6u);
+    for (const auto& [design, row] : expected) EXPECT_EQ(got.at(design), row) << design;
+    // One writer: every design once in the files rank 0 wrote.
+    EXPECT_EQ(jsonl_rows(dir / ("mpi" + jobs) / "results.jsonl").size(), 6u);
+  }
+  fs::remove_all(dir);
+}
+
+TEST(ScreenCommand, MpiJobTerminatedAgainAndAgainAndResumedListsEveryDesignOnceAsTheSerialRun) {
+  // SIGTERM to mpirun (what a batch scheduler sends) ends both ranks wherever they are; each
+  // time the job is resumed under MPI, as on one machine.
+  const fs::path dir =
+      fs::temp_directory_path() / ("mneedle_mpikill_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream list(dir / "designs.toml");
+  for (int i = 0; i < 32; ++i)
+    list << "[[designs]]\nname = \"cone_" << i << "\"\nplugin = \"cone\"\ndiameter = \""
+         << 150 + 5 * i << " um\"\n\n";
+  list.close();
+  const std::string scene = kRoot + "/designs/scenes/paper_a_silicone_blunt_bevel.toml";
+  const auto arguments = [&](const std::string& out) {
+    return std::vector<std::string>{
+        "screen",  (dir / "designs.toml").string(), "--scene", scene, "--out", (dir / out).string(),
+        "--resume"};
+  };
+  // The serial reference at one OpenBLAS thread per design, as every rank evaluates: --jobs 2.
+  auto serial_arguments = arguments("serial");
+  serial_arguments.insert(serial_arguments.end(), {"--jobs", "2"});
+  ASSERT_TRUE(finished_before_kill(serial_arguments, std::chrono::seconds(300)));
+  const auto start = std::chrono::steady_clock::now();
+  ASSERT_TRUE(finished_before_kill(mpirun(2, arguments("whole")), std::chrono::seconds(300),
+                                   SIGTERM, MNEEDLE_MPIEXEC));
+  const auto whole_run = std::chrono::duration_cast<std::chrono::microseconds>(
+      std::chrono::steady_clock::now() - start);
+  // As in the single-machine test above: restart the series with shorter delays when a job
+  // outlives its signal before three kills.
+  std::mt19937 random(2026);
+  int kills = 0;
+  for (long scale = 1; kills < 3 && scale <= 8; scale *= 2) {
+    fs::remove_all(dir / "killed");
+    std::uniform_int_distribution<long> delay_us(whole_run.count() / (10 * scale),
+                                                 whole_run.count() / (3 * scale));
+    kills = 0;
+    while (kills < 10 && !finished_before_kill(mpirun(2, arguments("killed")),
+                                               std::chrono::microseconds(delay_us(random)), SIGTERM,
+                                               MNEEDLE_MPIEXEC))
+      ++kills;
+  }
+  ASSERT_GE(kills, 3) << "too few kills to test anything, even with delays an eighth as long";
+  ASSERT_TRUE(finished_before_kill(mpirun(2, arguments("killed")), std::chrono::seconds(300),
+                                   SIGTERM, MNEEDLE_MPIEXEC));
+
+  std::map<std::string, nlohmann::json> serial;
+  for (const auto& row : jsonl_rows(dir / "serial" / "results.jsonl"))
+    serial[row["design"].get<std::string>()] = row;
+  ASSERT_EQ(serial.size(), 32u);
+  std::map<std::string, int> seen;
+  for (const auto& row : jsonl_rows(dir / "killed" / "results.jsonl")) {
+    const std::string design = row["design"].get<std::string>();
+    ++seen[design];
+    EXPECT_EQ(row, serial[design]) << design;
+  }
+  EXPECT_EQ(seen.size(), 32u);
+  for (const auto& [design, count] : seen) EXPECT_EQ(count, 1) << design;
+  std::ifstream csv(dir / "killed" / "results.csv");
+  std::map<std::string, int> csv_seen;
+  for (std::string line; std::getline(csv, line);)
+    if (line.rfind("\"cone_", 0) == 0) ++csv_seen[line.substr(0, line.find(','))];  // quoted
+  EXPECT_EQ(csv_seen.size(), 32u);
+  for (const auto& [design, count] : csv_seen) EXPECT_EQ(count, 1) << design;
+  fs::remove_all(dir);
+}
+
+TEST(ScreenCommand, UnderMpirunWithoutMpiFlagEveryRankRefusesAndOneLineSaysWhy) {
+  // Without --mpi every rank would screen every design into the same files.
+  auto words = mpirun(2, {"screen", kRoot + "/designs", "--scene", kSkin});
+  words.pop_back();  // no --mpi
+  const auto run = mneedle::test::run_command(shell_words(words));
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find("add --mpi"), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find("add --mpi"), run.err.rfind("add --mpi"))
+      << "one rank says it: " << run.err;
+}
+
+TEST(ScreenCommand, MpiJobWithAMissingInputSaysItOnceAndEveryRankStops) {
+  const auto run = mneedle::test::run_command(
+      shell_words(mpirun(2, {"screen", "/nonexistent/designs", "--scene", kSkin})));
+  EXPECT_NE(run.exit_code, 0);
+  const std::string line = "/nonexistent/designs: no such file or folder";
+  EXPECT_NE(run.err.find(line), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find(line), run.err.rfind(line)) << "said once: " << run.err;
+}
+#endif
 
 }  // namespace

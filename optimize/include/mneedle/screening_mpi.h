@@ -1,0 +1,63 @@
+#pragma once
+// Screening shared by the processes of an MPI job (`mpirun -n N mneedle screen … --mpi`;
+// docs/performance.md, "Screening on a cluster"). Rank 0 deals designs one at a time to whichever
+// thread of any rank asks next (a long design holds up only its own thread), and is the one
+// writer: every row is written by rank 0 the moment it arrives. No MPI type crosses this header.
+
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "mneedle/screening.h"
+
+namespace mneedle {
+
+/// True when this mneedle was built with MPI (CMake option MNEEDLE_MPI).
+bool mpi_built_in();
+
+/// The process count of an MPI launcher this process was started by (Open MPI's, MPICH's or
+/// Slurm's environment), or nothing: a command that was not asked for --mpi can refuse to run N
+/// copies of itself.
+std::optional<int> mpi_launch_size();
+
+/// This process's rank as the launcher's environment gives it (0 when there is none): before
+/// MPI is initialised, only rank 0 need say why a run cannot start.
+int mpi_launch_rank();
+
+/// MPI for the lifetime of the object: MPI_Init_thread (threads that each talk to rank 0 in turn,
+/// MPI_THREAD_SERIALIZED) and MPI_Finalize. InputError when mneedle was built without MPI or the
+/// library gives less thread support than `jobs` threads per rank need.
+class MpiSession {
+ public:
+  explicit MpiSession(int jobs);
+  ~MpiSession();
+  MpiSession(const MpiSession&) = delete;
+  MpiSession& operator=(const MpiSession&) = delete;
+
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+
+  /// Whether every rank, and whether rank 0, got through a step: called by every rank at the same
+  /// point with its own `ok`, so that a rank whose input failed does not leave the others waiting.
+  struct Agreement {
+    bool all = true;
+    bool rank0 = true;
+  };
+  Agreement agree(bool ok) const;
+
+ private:
+  int rank_ = 0;
+  int size_ = 1;
+};
+
+/// screen_designs over every rank of the session: the same rows, written to the same files as the
+/// serial run (rank 0 writes; --resume as on one machine). Rank 0 returns every row in input
+/// order; the other ranks return an empty vector. `on_row` is called on rank 0 only. Each rank
+/// evaluates with `options.jobs` threads (one OpenBLAS thread each when the job has more than one
+/// thread in all).
+std::vector<ScreeningRow> screen_designs_mpi(
+    const MpiSession& session, const std::vector<DesignInput>& designs, const Scene& scene,
+    const std::filesystem::path& scene_file, const PluginRegistry& registry,
+    const ScreeningOptions& options, const std::function<void(const ScreeningRow&)>& on_row = {});
+
+}  // namespace mneedle

@@ -1,0 +1,238 @@
+#include "mneedle/screening_mpi.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <initializer_list>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+
+#include "mneedle/base/error.h"
+#include "mneedle/blas_threads.h"
+#include "screening_batch.h"
+
+#if MNEEDLE_HAVE_MPI
+#include <mpi.h>
+#endif
+
+namespace mneedle {
+
+namespace {
+
+// The first of `names` set to a whole number in [minimum, 2^24).
+std::optional<int> launcher_number(std::initializer_list<const char*> names, long minimum) {
+  for (const char* name : names) {
+    const char* value = std::getenv(name);
+    if (value == nullptr) continue;
+    char* end = nullptr;
+    const long n = std::strtol(value, &end, 10);
+    if (end != value && *end == '\0' && n >= minimum && n < 1 << 24) return static_cast<int>(n);
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+// Open MPI's mpirun, then MPICH's hydra; both set these in every process they start.
+std::optional<int> mpi_launch_size() {
+  return launcher_number({"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"}, 1);
+}
+
+int mpi_launch_rank() {
+  return launcher_number({"OMPI_COMM_WORLD_RANK", "PMI_RANK"}, 0).value_or(0);
+}
+
+#if MNEEDLE_HAVE_MPI
+
+namespace {
+
+// The messages (docs/performance.md, "Screening on a cluster"): a thread of rank r > 0 sends
+// kRequest and waits for kIndex (a design's index, or -1: no more designs); when it has
+// evaluated the design it sends kRow, "index\n" followed by the row as results.jsonl holds it.
+constexpr int kRequest = 1;
+constexpr int kIndex = 2;
+constexpr int kRow = 3;
+
+ScreeningRow unreadable_row(const DesignInput& d, const std::string& why) {
+  ScreeningRow row;
+  row.design = d.name;
+  row.error = "the row sent by another rank is unreadable (" + why + ")";
+  row.json =
+      nlohmann::json{
+          {"design", d.name}, {"source", d.file.string()}, {"ok", false}, {"error", row.error}}
+          .dump();
+  return row;
+}
+
+// Rank 0: deals designs to its own threads and to every other rank's threads, and records every
+// row. Its main thread only talks MPI (polling, so that a row is written the moment it arrives);
+// `jobs` threads evaluate.
+std::vector<ScreeningRow> coordinate(const MpiSession& session, ScreeningBatch& batch, int jobs) {
+  std::vector<std::thread> pool;
+  for (int j = 0; j < jobs; ++j)
+    pool.emplace_back([&] {
+      while (const auto i = batch.claim()) batch.record(*i, batch.evaluate(*i));
+    });
+  // Every thread of every other rank asks until it is told -1; a row is owed for every index
+  // dealt. Both must be settled before rank 0 may stop listening.
+  const long remote_threads = static_cast<long>(session.size() - 1) * jobs;
+  long stopped = 0;
+  long owed = 0;
+  while (stopped < remote_threads || owed > 0) {
+    int arrived = 0;
+    MPI_Status status;
+    MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &arrived, &status);
+    if (!arrived) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      continue;
+    }
+    if (status.MPI_TAG == kRequest) {
+      int nothing = 0;
+      MPI_Recv(&nothing, 1, MPI_INT, status.MPI_SOURCE, kRequest, MPI_COMM_WORLD,
+               MPI_STATUS_IGNORE);
+      const auto i = batch.claim();
+      long long index = i ? static_cast<long long>(*i) : -1;
+      (i ? owed : stopped) += 1;
+      MPI_Send(&index, 1, MPI_LONG_LONG, status.MPI_SOURCE, kIndex, MPI_COMM_WORLD);
+    } else if (status.MPI_TAG == kRow) {
+      int bytes = 0;
+      MPI_Get_count(&status, MPI_CHAR, &bytes);
+      std::string message(static_cast<std::size_t>(bytes), '\0');
+      MPI_Recv(message.data(), bytes, MPI_CHAR, status.MPI_SOURCE, kRow, MPI_COMM_WORLD,
+               MPI_STATUS_IGNORE);
+      --owed;
+      // Our own ranks wrote it; a message that names no design of the batch would be a bug in
+      // this file, and is dropped rather than written anywhere.
+      const auto newline = message.find('\n');
+      std::size_t i = batch.size();
+      try {
+        i = std::stoul(message.substr(0, newline));
+      } catch (const std::exception&) {
+      }
+      if (newline == std::string::npos || i >= batch.size()) continue;
+      try {
+        batch.record(i, screening_row_from_json(message.substr(newline + 1)));
+      } catch (const std::exception& e) {
+        batch.record(i, unreadable_row(batch.design(i), e.what()));
+      }
+    }
+  }
+  for (auto& t : pool) t.join();
+  return batch.take_rows();
+}
+
+// Rank r > 0: `jobs` threads, each asking rank 0 for a design, evaluating it and sending the row
+// back. MPI calls are serialised by one mutex (MPI_THREAD_SERIALIZED); a thread holds it from
+// its request to the answer, so every answer reaches the thread that asked.
+void work(ScreeningBatch& batch, int jobs) {
+  std::mutex mpi;
+  auto worker = [&] {
+    for (;;) {
+      long long index = -1;
+      {
+        std::lock_guard<std::mutex> lock(mpi);
+        int nothing = 0;
+        MPI_Send(&nothing, 1, MPI_INT, 0, kRequest, MPI_COMM_WORLD);
+        MPI_Recv(&index, 1, MPI_LONG_LONG, 0, kIndex, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      }
+      if (index < 0) return;
+      const ScreeningRow row = batch.evaluate(static_cast<std::size_t>(index));
+      const std::string message = std::to_string(index) + "\n" + row.json;
+      std::lock_guard<std::mutex> lock(mpi);
+      MPI_Send(message.data(), static_cast<int>(message.size()), MPI_CHAR, 0, kRow, MPI_COMM_WORLD);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int j = 1; j < jobs; ++j) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+}
+
+}  // namespace
+
+bool mpi_built_in() {
+  return true;
+}
+
+MpiSession::MpiSession(int jobs) {
+  int provided = MPI_THREAD_SINGLE;
+  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+  if (provided < MPI_THREAD_SERIALIZED && jobs > 1) {
+    MPI_Finalize();
+    throw InputError("--mpi with --jobs " + std::to_string(jobs) +
+                     ": this MPI library cannot be called from several threads "
+                     "(MPI_THREAD_SERIALIZED); use --jobs 1 and one rank per core");
+  }
+}
+
+MpiSession::~MpiSession() {
+  MPI_Finalize();
+}
+
+MpiSession::Agreement MpiSession::agree(bool ok) const {
+  int mine[2] = {ok ? 1 : 0, ok || rank_ != 0 ? 1 : 0};
+  int all[2] = {0, 0};
+  MPI_Allreduce(mine, all, 2, MPI_INT, MPI_LAND, MPI_COMM_WORLD);
+  return {all[0] == 1, all[1] == 1};
+}
+
+std::vector<ScreeningRow> screen_designs_mpi(
+    const MpiSession& session, const std::vector<DesignInput>& designs, const Scene& scene,
+    const std::filesystem::path& scene_file, const PluginRegistry& registry,
+    const ScreeningOptions& options, const std::function<void(const ScreeningRow&)>& on_row) {
+  const int jobs = std::max(1, options.jobs);
+  // Several ranks on one machine, or several threads in one rank: one OpenBLAS thread each, as
+  // in the serial screen with --jobs > 1 (the same factorisations, so the same rows).
+  std::optional<BlasThreadLimit> blas;
+  if (jobs > 1 || session.size() > 1) blas.emplace(1);
+  const bool coordinator = session.rank() == 0;
+  // A rank whose batch cannot start (an unwritable --out) must not leave the others waiting.
+  std::optional<ScreeningBatch> batch;
+  std::string failure;
+  try {
+    batch.emplace(designs, scene, scene_file, registry, options, on_row, coordinator);
+  } catch (const std::exception& e) {
+    failure = e.what();
+  }
+  const auto agreement = session.agree(failure.empty());
+  if (!agreement.all) {
+    if (!failure.empty()) throw InputError(failure);
+    throw InputError("screen --mpi: another rank could not start its batch (its line says why)");
+  }
+  if (coordinator) return coordinate(session, *batch, jobs);
+  work(*batch, jobs);
+  return {};
+}
+
+#else  // built without MPI
+
+bool mpi_built_in() {
+  return false;
+}
+
+MpiSession::MpiSession(int) {
+  throw InputError(
+      "--mpi: this mneedle was built without MPI (configure with -DMNEEDLE_MPI=ON and "
+      "libopenmpi-dev installed; docs/performance.md, \"Screening on a cluster\")");
+}
+
+MpiSession::~MpiSession() = default;
+
+MpiSession::Agreement MpiSession::agree(bool ok) const {
+  return {ok, ok};
+}
+
+std::vector<ScreeningRow> screen_designs_mpi(const MpiSession&, const std::vector<DesignInput>&,
+                                             const Scene&, const std::filesystem::path&,
+                                             const PluginRegistry&, const ScreeningOptions&,
+                                             const std::function<void(const ScreeningRow&)>&) {
+  throw InputError("--mpi: this mneedle was built without MPI");
+}
+
+#endif
+
+}  // namespace mneedle
