@@ -125,13 +125,23 @@ ScreenSetup prepare_screen(const ScreenArgs& args, bool writer) {
 
 void run_screen(const ScreenArgs& args) {
   if (const auto n = mpi_launch_size(); n && *n > 1 && !args.mpi) {
-    if (mpi_launch_rank() != 0) throw QuietExit{1};  // rank 0 says why, once
+    if (mpi_launch_rank() != 0) throw QuietExit{0};  // rank 0 says why, once
     throw InputError("screen: started by an MPI launcher as " + std::to_string(*n) +
                      " processes without --mpi: each would screen every design into the same "
                      "files; add --mpi");
   }
+  // A rank > 0 exits quietly and with status 0 whenever rank 0 reports the reason: the job's one
+  // error line and its status are rank 0's (Open MPI ends a job at the first non-zero exit,
+  // which could cut rank 0 off before it has said why).
   std::optional<MpiSession> session;
-  if (args.mpi) session.emplace(args.jobs);
+  if (args.mpi) {
+    try {
+      session.emplace(args.jobs);
+    } catch (const InputError&) {
+      if (mpi_launch_rank() != 0) throw QuietExit{0};  // every rank fails alike here
+      throw;
+    }
+  }
   const bool writer = !session || session->rank() == 0;
   // Under MPI a rank whose setup fails must not leave the others waiting: every rank says
   // whether it got through, rank 0 reports its own error, another rank only one rank 0 lacks.
@@ -142,11 +152,11 @@ void run_screen(const ScreenArgs& args) {
     if (!session) throw;
     const auto agreement = session->agree(false);
     if (writer || agreement.rank0) throw;
-    throw QuietExit{1};  // rank 0 failed too and says so, once
+    throw QuietExit{0};  // rank 0 failed too and says so, once
   }
   if (session && !session->agree(true).all) {
     if (writer) throw InputError("screen --mpi: another rank could not start (its line says why)");
-    throw QuietExit{1};
+    throw QuietExit{0};
   }
   const Scene& scene = setup->scene;
   const ScreeningOptions& options = setup->options;
@@ -156,11 +166,18 @@ void run_screen(const ScreenArgs& args) {
                 << (row.frame_note.empty() ? "" : " (" + row.frame_note + ")") << "\n";
     }
   };
-  const auto rows =
-      rank_rows(session ? screen_designs_mpi(*session, setup->designs, scene, args.scene,
-                                             setup->registry, options, on_row)
-                        : screen_designs(setup->designs, scene, args.scene, setup->registry,
-                                         options, on_row));
+  std::vector<ScreeningRow> screened;
+  if (session) {
+    try {
+      screened = screen_designs_mpi(*session, setup->designs, scene, args.scene, setup->registry,
+                                    options, on_row);
+    } catch (const RankStopped&) {
+      throw QuietExit{0};
+    }
+  } else {
+    screened = screen_designs(setup->designs, scene, args.scene, setup->registry, options, on_row);
+  }
+  const auto rows = rank_rows(std::move(screened));
   if (!writer) return;  // rank 0 reports the run
   std::size_t failed = 0;
   for (const auto& r : rows) failed += r.ok ? 0 : 1;

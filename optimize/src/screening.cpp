@@ -325,10 +325,10 @@ ScreeningRow row_from_json(const std::string& line) {
     }
     row.margin = j.at("margin").is_null() ? INFINITY : j.at("margin").get<double>();
     row.passes = j.at("passes").get<bool>();
-    row.frame_note = j.value("frame_note", "");
   } else {
     row.error = j.value("error", "");
   }
+  row.frame_note = j.value("frame_note", "");  // a failed mesh file may have one too
   return row;
 }
 
@@ -481,6 +481,10 @@ std::vector<DesignInput> collect_designs(const std::vector<fs::path>& inputs,
   return out;
 }
 
+ScreeningRow screening_error_row(const DesignInput& d, const std::string& message) {
+  return error_row(d, message);
+}
+
 ScreeningRow screening_row_from_json(const std::string& line) {
   ScreeningRow row = row_from_json(line);
   row.resumed = false;
@@ -501,6 +505,13 @@ ScreeningBatch::ScreeningBatch(const std::vector<DesignInput>& designs, const Sc
       rows_(designs.size()) {
   parse_fidelity(options.fidelity);  // bad names fail the run, not every row
   parse_pre_model(options.model);
+  // Once, here: a mesh file's hash reads the whole file, which claim() must not do under its lock.
+  hashes_.reserve(designs.size());
+  for (std::size_t i = 0; i < designs.size(); ++i)
+    hashes_.push_back(row_hash(designs[i], scene_hash_,
+                               options.fidelity + "|" + options.model + "|axis=" + options.axis +
+                                   (options.repair ? "|repair" : ""),
+                               material_));
   if (!writes || !options.out) return;
   const fs::path& out = *options.out;
   if (options.resume) done_ = finished_rows(out / "results.jsonl");
@@ -515,11 +526,15 @@ ScreeningBatch::ScreeningBatch(const std::vector<DesignInput>& designs, const Sc
 
 ScreeningBatch::~ScreeningBatch() = default;
 
-std::string ScreeningBatch::hash(std::size_t i) const {
-  return row_hash(designs_[i], scene_hash_,
-                  options_.fidelity + "|" + options_.model + "|axis=" + options_.axis +
-                      (options_.repair ? "|repair" : ""),
-                  material_);
+std::string ScreeningBatch::fingerprint() const {
+  std::string all = std::to_string(designs_.size());
+  for (const auto& h : hashes_) all += "|" + h;
+  return hex(fnv1a(all));
+}
+
+bool ScreeningBatch::recorded(std::size_t i) {
+  std::lock_guard<std::mutex> lock(record_mutex_);
+  return !rows_[i].json.empty();
 }
 
 std::optional<std::size_t> ScreeningBatch::claim() {
@@ -527,7 +542,7 @@ std::optional<std::size_t> ScreeningBatch::claim() {
   while (next_ < designs_.size()) {
     const std::size_t i = next_++;
     if (!done_.empty()) {
-      const auto previous = done_.find(hash(i));
+      const auto previous = done_.find(hashes_[i]);
       if (previous != done_.end()) {
         ScreeningRow row = previous->second;
         record(i, std::move(row));
@@ -543,7 +558,7 @@ ScreeningRow ScreeningBatch::evaluate(std::size_t i) const {
   // Nothing may escape (a worker thread would terminate the process): whatever fails becomes
   // this design's error row and the others go on.
   try {
-    return evaluate_row(designs_[i], scene_, hash(i), material_, registry_, options_);
+    return evaluate_row(designs_[i], scene_, hashes_[i], material_, registry_, options_);
   } catch (const std::exception& e) {
     return error_row(designs_[i], e.what());
   }

@@ -42,12 +42,17 @@ class ScreeningBatch {
   /// Writes design i's finished row to the results and reports it. Thread-safe.
   void record(std::size_t i, ScreeningRow row);
 
+  /// Whether design i has its row.
+  bool recorded(std::size_t i);
+
+  /// A digest of the designs' and the scene's hashes: two processes with equal fingerprints
+  /// screen the same designs in the same order.
+  std::string fingerprint() const;
+
   /// Every row, in input order (a design never recorded has an empty row).
   std::vector<ScreeningRow> take_rows();
 
  private:
-  std::string hash(std::size_t i) const;
-
   const std::vector<DesignInput>& designs_;
   const Scene& scene_;
   const PluginRegistry& registry_;
@@ -55,12 +60,16 @@ class ScreeningBatch {
   std::function<void(const ScreeningRow&)> on_row_;
   std::string scene_hash_;
   std::string material_;
+  std::vector<std::string> hashes_;           // of each design's inputs (the resume key)
   std::map<std::string, ScreeningRow> done_;  // rows of earlier runs, by hash
   std::ofstream jsonl_, csv_;
   std::mutex claim_mutex_, record_mutex_;
   std::size_t next_ = 0;
   std::vector<ScreeningRow> rows_;
 };
+
+/// An error row for design `d` (what a design that fails to evaluate gets).
+ScreeningRow screening_error_row(const DesignInput& d, const std::string& message);
 
 /// A row as another rank sent it: what results.jsonl holds for it (`ScreeningRow::json`).
 ScreeningRow screening_row_from_json(const std::string& line);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <initializer_list>
 #include <mutex>
@@ -55,21 +56,27 @@ constexpr int kRequest = 1;
 constexpr int kIndex = 2;
 constexpr int kRow = 3;
 
-ScreeningRow unreadable_row(const DesignInput& d, const std::string& why) {
-  ScreeningRow row;
-  row.design = d.name;
-  row.error = "the row sent by another rank is unreadable (" + why + ")";
-  row.json =
-      nlohmann::json{
-          {"design", d.name}, {"source", d.file.string()}, {"ok", false}, {"error", row.error}}
-          .dump();
-  return row;
-}
+std::vector<ScreeningRow> coordinate_loop(const MpiSession& session, ScreeningBatch& batch,
+                                          int jobs);
 
 // Rank 0: deals designs to its own threads and to every other rank's threads, and records every
 // row. Its main thread only talks MPI (polling, so that a row is written the moment it arrives);
 // `jobs` threads evaluate.
 std::vector<ScreeningRow> coordinate(const MpiSession& session, ScreeningBatch& batch, int jobs) {
+  try {
+    return coordinate_loop(session, batch, jobs);
+  } catch (const std::exception& e) {
+    // Out of memory or the like in the loop itself: the other ranks wait on rank 0 and would
+    // wait for ever, so the job ends here (rows already written stay written).
+    std::fprintf(stderr, "mneedle: internal error: screen --mpi, rank 0: %s\n", e.what());
+    std::fflush(stderr);
+    MPI_Abort(MPI_COMM_WORLD, 4);
+    throw;
+  }
+}
+
+std::vector<ScreeningRow> coordinate_loop(const MpiSession& session, ScreeningBatch& batch,
+                                          int jobs) {
   std::vector<std::thread> pool;
   for (int j = 0; j < jobs; ++j)
     pool.emplace_back([&] {
@@ -115,11 +122,19 @@ std::vector<ScreeningRow> coordinate(const MpiSession& session, ScreeningBatch& 
       try {
         batch.record(i, screening_row_from_json(message.substr(newline + 1)));
       } catch (const std::exception& e) {
-        batch.record(i, unreadable_row(batch.design(i), e.what()));
+        batch.record(
+            i, screening_error_row(batch.design(i), std::string("the row sent by another rank is "
+                                                                "unreadable (") +
+                                                        e.what() + ")"));
       }
     }
   }
   for (auto& t : pool) t.join();
+  // Every design dealt had its row back (owed = 0); should one ever not, it gets an error row
+  // rather than an empty one.
+  for (std::size_t i = 0; i < batch.size(); ++i)
+    if (!batch.recorded(i))
+      batch.record(i, screening_error_row(batch.design(i), "no row came back for this design"));
   return batch.take_rows();
 }
 
@@ -138,7 +153,17 @@ void work(ScreeningBatch& batch, int jobs) {
         MPI_Recv(&index, 1, MPI_LONG_LONG, 0, kIndex, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
       }
       if (index < 0) return;
-      const ScreeningRow row = batch.evaluate(static_cast<std::size_t>(index));
+      // The fingerprints agreed, so rank 0 deals only indices of this batch; an index beyond it
+      // would be a bug, answered with an error row rather than a read past the designs.
+      ScreeningRow row;
+      if (static_cast<std::size_t>(index) < batch.size()) {
+        row = batch.evaluate(static_cast<std::size_t>(index));
+      } else {
+        row.json = nlohmann::json{{"design", "index " + std::to_string(index)},
+                                  {"ok", false},
+                                  {"error", "no such design on this rank"}}
+                       .dump();
+      }
       const std::string message = std::to_string(index) + "\n" + row.json;
       std::lock_guard<std::mutex> lock(mpi);
       MPI_Send(message.data(), static_cast<int>(message.size()), MPI_CHAR, 0, kRow, MPI_COMM_WORLD);
@@ -158,14 +183,17 @@ bool mpi_built_in() {
 
 MpiSession::MpiSession(int jobs) {
   int provided = MPI_THREAD_SINGLE;
-  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
+  const int needed = jobs > 1 ? MPI_THREAD_SERIALIZED : MPI_THREAD_FUNNELED;
+  MPI_Init_thread(nullptr, nullptr, needed, &provided);
   MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
   MPI_Comm_size(MPI_COMM_WORLD, &size_);
-  if (provided < MPI_THREAD_SERIALIZED && jobs > 1) {
+  if (provided < needed) {
     MPI_Finalize();
-    throw InputError("--mpi with --jobs " + std::to_string(jobs) +
-                     ": this MPI library cannot be called from several threads "
-                     "(MPI_THREAD_SERIALIZED); use --jobs 1 and one rank per core");
+    throw InputError(std::string("--mpi: this MPI library does not support ") +
+                     (jobs > 1 ? "MPI_THREAD_SERIALIZED (threads that call MPI in turn), which "
+                                 "--jobs > 1 needs; use --jobs 1"
+                               : "MPI_THREAD_FUNNELED (one thread calling MPI while others "
+                                 "evaluate)"));
   }
 }
 
@@ -190,18 +218,31 @@ std::vector<ScreeningRow> screen_designs_mpi(
   std::optional<BlasThreadLimit> blas;
   if (jobs > 1 || session.size() > 1) blas.emplace(1);
   const bool coordinator = session.rank() == 0;
-  // A rank whose batch cannot start (an unwritable --out) must not leave the others waiting.
+  // A rank whose batch cannot start (an unwritable --out), or that sees other designs than rank 0
+  // (another folder listing, a file changed in between), must not leave the others waiting.
   std::optional<ScreeningBatch> batch;
   std::string failure;
+  std::string fingerprint;
   try {
     batch.emplace(designs, scene, scene_file, registry, options, on_row, coordinator);
+    fingerprint = batch->fingerprint();
   } catch (const std::exception& e) {
     failure = e.what();
   }
+  // Collective: every rank takes part, whether its batch started or not.
+  fingerprint.resize(64, ' ');
+  std::string rank0 = fingerprint;
+  MPI_Bcast(rank0.data(), 64, MPI_CHAR, 0, MPI_COMM_WORLD);
+  if (failure.empty() && fingerprint != rank0)
+    failure = "screen --mpi: rank " + std::to_string(session.rank()) +
+              " sees other designs or another scene than rank 0 (every rank must read the same "
+              "files)";
   const auto agreement = session.agree(failure.empty());
   if (!agreement.all) {
-    if (!failure.empty()) throw InputError(failure);
-    throw InputError("screen --mpi: another rank could not start its batch (its line says why)");
+    if (!failure.empty() && (coordinator || agreement.rank0)) throw InputError(failure);
+    if (coordinator)
+      throw InputError("screen --mpi: another rank could not start (its line says why)");
+    throw RankStopped();
   }
   if (coordinator) return coordinate(session, *batch, jobs);
   work(*batch, jobs);

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -420,8 +421,9 @@ std::vector<std::string> mpirun(int ranks, std::vector<std::string> arguments) {
   return words;
 }
 
+// A hang in the ranks' protocol must fail the test, not hold up the suite: coreutils' timeout.
 std::string shell_words(const std::vector<std::string>& words) {
-  std::string line = std::string("'") + MNEEDLE_MPIEXEC + "'";
+  std::string line = std::string("timeout 300 '") + MNEEDLE_MPIEXEC + "'";
   for (const auto& w : words) line += " '" + w + "'";
   return line;
 }
@@ -443,6 +445,19 @@ std::vector<std::string> ranked_names(const std::string& json_text) {
   const auto result = nlohmann::json::parse(json_text);
   for (const auto& row : result["designs"]) names.push_back(row["design"].get<std::string>());
   return names;
+}
+
+// Whether any process still has `text` on its command line (/proc): a rank that outlived its
+// mpirun would be a second writer in the folder the next run resumes.
+bool process_mentions(const std::string& text) {
+  for (const auto& entry : fs::directory_iterator("/proc")) {
+    const std::string pid = entry.path().filename().string();
+    if (pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream in(entry.path() / "cmdline", std::ios::binary);
+    std::string cmdline((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (cmdline.find(text) != std::string::npos) return true;
+  }
+  return false;
 }
 
 TEST(ScreenCommand, TwoMpiRanksGiveTheSerialRowsBitForBitAndTheSameRanking) {
@@ -518,8 +533,15 @@ TEST(ScreenCommand, MpiJobTerminatedAgainAndAgainAndResumedListsEveryDesignOnceA
     kills = 0;
     while (kills < 10 && !finished_before_kill(mpirun(2, arguments("killed")),
                                                std::chrono::microseconds(delay_us(random)), SIGTERM,
-                                               MNEEDLE_MPIEXEC))
+                                               MNEEDLE_MPIEXEC)) {
       ++kills;
+      // mpirun ends its ranks before it exits; give them a moment, then insist.
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (process_mentions((dir / "killed").string()) &&
+             std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      ASSERT_FALSE(process_mentions((dir / "killed").string())) << "a rank outlived mpirun";
+    }
   }
   ASSERT_GE(kills, 3) << "too few kills to test anything, even with delays an eighth as long";
   ASSERT_TRUE(finished_before_kill(mpirun(2, arguments("killed")), std::chrono::seconds(300),

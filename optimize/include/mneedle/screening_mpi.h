@@ -4,6 +4,7 @@
 // thread of any rank asks next (a long design holds up only its own thread), and is the one
 // writer: every row is written by rank 0 the moment it arrives. No MPI type crosses this header.
 
+#include <exception>
 #include <functional>
 #include <optional>
 #include <vector>
@@ -15,8 +16,8 @@ namespace mneedle {
 /// True when this mneedle was built with MPI (CMake option MNEEDLE_MPI).
 bool mpi_built_in();
 
-/// The process count of an MPI launcher this process was started by (Open MPI's, MPICH's or
-/// Slurm's environment), or nothing: a command that was not asked for --mpi can refuse to run N
+/// The process count of an MPI launcher this process was started by (Open MPI's or MPICH's
+/// environment), or nothing: a command that was not asked for --mpi can refuse to run N
 /// copies of itself.
 std::optional<int> mpi_launch_size();
 
@@ -24,9 +25,18 @@ std::optional<int> mpi_launch_size();
 /// MPI is initialised, only rank 0 need say why a run cannot start.
 int mpi_launch_rank();
 
-/// MPI for the lifetime of the object: MPI_Init_thread (threads that each talk to rank 0 in turn,
-/// MPI_THREAD_SERIALIZED) and MPI_Finalize. InputError when mneedle was built without MPI or the
-/// library gives less thread support than `jobs` threads per rank need.
+/// Thrown on a rank > 0 when the run stops for a reason rank 0 reports (rank 0 could not start,
+/// or another rank could not): the rank should exit quietly and with status 0, so that the job's
+/// status and its one error line are rank 0's.
+class RankStopped : public std::exception {
+ public:
+  const char* what() const noexcept override { return "stopped: rank 0 reports why"; }
+};
+
+/// MPI for the lifetime of the object: MPI_Init_thread and MPI_Finalize. Rank 0 talks MPI from
+/// one thread while others evaluate (MPI_THREAD_FUNNELED); with `jobs` > 1 the evaluating threads
+/// of the other ranks talk in turn (MPI_THREAD_SERIALIZED). InputError when mneedle was built
+/// without MPI or the library gives less thread support than that.
 class MpiSession {
  public:
   explicit MpiSession(int jobs);
@@ -51,10 +61,11 @@ class MpiSession {
 };
 
 /// screen_designs over every rank of the session: the same rows, written to the same files as the
-/// serial run (rank 0 writes; --resume as on one machine). Rank 0 returns every row in input
-/// order; the other ranks return an empty vector. `on_row` is called on rank 0 only. Each rank
-/// evaluates with `options.jobs` threads (one OpenBLAS thread each when the job has more than one
-/// thread in all).
+/// serial run (rank 0 writes; --resume as on one machine). Every rank must pass the same designs
+/// and scene (checked: a rank that sees other files stops the run with an InputError). Rank 0
+/// returns every row in input order; the other ranks return an empty vector. `on_row` is called on
+/// rank 0 only. Each rank evaluates with `options.jobs` threads (one OpenBLAS thread each when the
+/// job has more than one thread in all).
 std::vector<ScreeningRow> screen_designs_mpi(
     const MpiSession& session, const std::vector<DesignInput>& designs, const Scene& scene,
     const std::filesystem::path& scene_file, const PluginRegistry& registry,
