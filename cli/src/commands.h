@@ -32,5 +32,6 @@ void add_calibrate_command(CLI::App& app);
 void add_energy_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 void add_report_command(CLI::App& app);
+void add_uncertainty_command(CLI::App& app);
 
 }  // namespace mneedle::cli

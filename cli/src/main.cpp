@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   mneedle::cli::add_energy_command(app);
   mneedle::cli::add_export_command(app);
   mneedle::cli::add_report_command(app);
+  mneedle::cli::add_uncertainty_command(app);
   // Exit statuses (docs/cli.md, "Exit status"): 0 success, 1 bad input, 2 bad command line,
   // 3 a solver that could not deliver, 4 an internal error (a bug: please report it).
   try {

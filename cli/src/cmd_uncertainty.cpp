@@ -1,0 +1,222 @@
+// mneedle uncertainty: the spread of puncture depth, forces and margin when scene values vary
+// (docs/cli.md, "mneedle uncertainty").
+#include <CLI/CLI.hpp>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "json_output.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
+#include "mneedle/uncertainty.h"
+#include "run_provenance.h"
+
+namespace mneedle::cli {
+namespace {
+
+struct UncertaintyArgs {
+  std::string scene;
+  std::vector<std::string> vary;
+  int samples = 200;
+  std::uint64_t seed = 1;
+  std::string method = "mc";
+  int jobs = 1;
+  std::string fidelity = "fast";
+  std::string model = "auto";
+  std::string material;
+  bool no_sensitivity = false;
+  bool json = false;
+  std::vector<std::string> plugin_dirs;
+};
+
+nlohmann::json optional_number(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+nlohmann::json sample_json(const UncertaintySample& s, const std::vector<VariedValue>& inputs) {
+  nlohmann::json values = nlohmann::json::object();
+  for (std::size_t k = 0; k < s.values.size() && k < inputs.size(); ++k)
+    values[inputs[k].path] = s.values[k];
+  nlohmann::json j = {{"values_si", values}, {"ok", s.ok}};
+  if (!s.ok) {
+    j["error"] = s.error;
+    return j;
+  }
+  j["puncture_depth_m"] = optional_number(s.puncture_depth_m);
+  j["puncture_force_N"] = s.puncture_depth_m ? nlohmann::json(s.puncture_force_n) : nullptr;
+  j["puncture_at_first_contact"] = s.puncture_at_first_contact;
+  j["puncture_objective_m"] = s.puncture_objective_m;
+  j["peak_force_N"] = s.peak_force_n;
+  j["margin"] = std::isfinite(s.margin) ? nlohmann::json(s.margin) : nullptr;
+  j["passes"] = s.passes;
+  return j;
+}
+
+nlohmann::json percentiles_json(const Percentiles& p) {
+  if (p.count == 0) return {{"count", 0}, {"p5", nullptr}, {"p50", nullptr}, {"p95", nullptr}};
+  return {{"count", p.count}, {"p5", p.p5}, {"p50", p.p50}, {"p95", p.p95}};
+}
+
+std::string kind_name(DistributionKind k) {
+  switch (k) {
+    case DistributionKind::Normal:
+      return "normal";
+    case DistributionKind::LogNormal:
+      return "lognormal";
+    case DistributionKind::Uniform:
+      return "uniform";
+  }
+  return "";
+}
+
+void print_row(const char* what, const Percentiles& p, Dimension d) {
+  if (p.count == 0) {
+    std::printf("  %-22s (no sample has it)\n", what);
+    return;
+  }
+  std::printf("  %-22s %-12s %-12s %-12s (%zu samples)\n", what, format_quantity(p.p5, d).c_str(),
+              format_quantity(p.p50, d).c_str(), format_quantity(p.p95, d).c_str(), p.count);
+}
+
+void run_uncertainty_command(const UncertaintyArgs& args) {
+  std::vector<VariedValue> inputs;
+  for (const auto& spec : args.vary) inputs.push_back(parse_varied_value(spec));
+  if (args.method != "mc" && args.method != "lhs")
+    throw InputError("uncertainty: --method '" + args.method + "' (mc or lhs)");
+  record_input("scene", args.scene);
+  const auto registry =
+      PluginRegistry::discover({args.plugin_dirs.begin(), args.plugin_dirs.end()});
+  UncertaintyOptions options;
+  options.samples = args.samples;
+  options.seed = args.seed;
+  options.latin_hypercube = args.method == "lhs";
+  options.jobs = args.jobs;
+  options.fidelity = args.fidelity;
+  options.model = args.model;
+  if (!args.material.empty()) options.material = args.material;
+  options.sensitivity = !args.no_sensitivity;
+  const bool terminal = !args.json && ::isatty(STDERR_FILENO) == 1;
+  const UncertaintyResult r =
+      run_uncertainty(args.scene, inputs, registry, options, [&](int done, int total) {
+        if (terminal && (done == total || done % 10 == 0))
+          std::cerr << "\runcertainty: " << done << " of " << total << " runs" << std::flush;
+      });
+  if (terminal) std::cerr << "\n";
+
+  nlohmann::json out = {{"scene", args.scene},       {"samples", args.samples},
+                        {"seed", args.seed},         {"method", args.method},
+                        {"fidelity", args.fidelity}, {"model", args.model}};
+  out["inputs"] = nlohmann::json::array();
+  for (const auto& v : r.inputs)
+    out["inputs"].push_back({{"path", v.path},
+                             {"text", v.text},
+                             {"distribution", kind_name(v.distribution.kind)},
+                             {"a_si", v.distribution.a},
+                             {"b_si", v.distribution.b},
+                             {"unit", std::string(si_unit(v.distribution.dimension))},
+                             {"p5_si", distribution_quantile(v.distribution, 0.05)},
+                             {"p95_si", distribution_quantile(v.distribution, 0.95)}});
+  out["nominal"] = sample_json(r.nominal, {});
+  out["summary"] = {{"puncture_depth_m", percentiles_json(r.puncture_depth_m)},
+                    {"puncture_force_N", percentiles_json(r.puncture_force_n)},
+                    {"peak_force_N", percentiles_json(r.peak_force_n)},
+                    {"margin", percentiles_json(r.margin)},
+                    {"punctured_fraction", r.punctured_fraction},
+                    {"first_contact_fraction", r.first_contact_fraction},
+                    {"pass_probability", r.pass_probability},
+                    {"failed_samples", r.failed}};
+  out["sensitivity"] = nlohmann::json::array();
+  for (const auto& s : r.sensitivity)
+    out["sensitivity"].push_back({{"path", s.path},
+                                  {"low", sample_json(s.low, {})},
+                                  {"high", sample_json(s.high, {})},
+                                  {"depth_effect_m", s.depth_effect_m},
+                                  {"peak_effect_N", s.peak_effect_n}});
+  out["rows"] = nlohmann::json::array();
+  for (const auto& s : r.samples) out["rows"].push_back(sample_json(s, r.inputs));
+  if (args.json) {
+    print_checked_json(std::cout, out, "uncertainty");
+  } else {
+    require_finite_json(out, "uncertainty");
+    std::printf("Scene %s: %d samples (%s, seed %llu), %s fidelity, model %s\n", args.scene.c_str(),
+                args.samples, args.method == "lhs" ? "Latin hypercube" : "Monte Carlo",
+                static_cast<unsigned long long>(args.seed), args.fidelity.c_str(),
+                args.model.c_str());
+    for (const auto& v : r.inputs)
+      std::printf(
+          "  vary %-30s 5 %%: %-12s 95 %%: %s\n", v.text.c_str(),
+          format_quantity(distribution_quantile(v.distribution, 0.05), v.distribution.dimension)
+              .c_str(),
+          format_quantity(distribution_quantile(v.distribution, 0.95), v.distribution.dimension)
+              .c_str());
+    std::printf("\n  %-22s %-12s %-12s %-12s\n", "", "5 %", "median", "95 %");
+    print_row("puncture depth", r.puncture_depth_m, Dimension::Length);
+    print_row("force at puncture", r.puncture_force_n, Dimension::Force);
+    print_row("peak force", r.peak_force_n, Dimension::Force);
+    print_row("margin", r.margin, Dimension::Dimensionless);
+    std::printf(
+        "\n  punctured before the target depth: %.1f %% of samples (first-contact "
+        "crossings not counted)\n  passes: %.1f %%\n",
+        100.0 * r.punctured_fraction, 100.0 * r.pass_probability);
+    if (r.first_contact_fraction > 0.0)
+      std::printf(
+          "  fired at the first depth step (depth unresolved, not in the spread): %.1f %%\n",
+          100.0 * r.first_contact_fraction);
+    if (r.failed > 0)
+      std::printf("  %zu samples could not be evaluated (see --json rows)\n", r.failed);
+    if (!r.sensitivity.empty()) {
+      std::printf("\n  one at a time (5 %% -> 95 %% of each value, the others as written):\n");
+      for (const auto& s : r.sensitivity)
+        std::printf("  %-30s puncture depth moves %-12s peak force %s\n", s.path.c_str(),
+                    format_quantity(s.depth_effect_m, Dimension::Length).c_str(),
+                    format_quantity(s.peak_effect_n, Dimension::Force).c_str());
+    }
+  }
+}
+
+}  // namespace
+
+void add_uncertainty_command(CLI::App& app) {
+  auto args = std::make_shared<UncertaintyArgs>();
+  auto* cmd = app.add_subcommand(
+      "uncertainty", "Spread of puncture depth, forces and margin when scene values vary");
+  cmd->footer(
+      "Example:\n"
+      "  mneedle uncertainty designs/scenes/human_skin.toml --vary 'dermis.E=lognormal(80kPa,30%)' "
+      "--vary 'stratum_corneum.thickness=uniform(10um,30um)' --samples 200 --seed 1");
+  cmd->add_option("scene", args->scene, "Scene file (TOML); its first needle is evaluated")
+      ->required();
+  cmd->add_option("--vary", args->vary,
+                  "PATH=normal(MEAN,SD|SD%) | lognormal(MEDIAN,CV%) | uniform(LOW,HIGH), "
+                  "e.g. dermis.E=lognormal(80kPa,30%) (repeatable)")
+      ->required();
+  cmd->add_option("--samples", args->samples, "Number of samples")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option("--seed", args->seed, "Seed of the draws (same seed, same samples)")
+      ->capture_default_str();
+  cmd->add_option("--method", args->method, "mc (Monte Carlo) or lhs (Latin hypercube)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"mc", "lhs"}));
+  cmd->add_option("--jobs", args->jobs, "Samples evaluated at once (one OpenBLAS thread each)")
+      ->check(CLI::Range(1, 1000));
+  cmd->add_option("--fidelity", args->fidelity, "fast, standard or fine")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"fast", "standard", "fine"}));
+  cmd->add_option("--model", args->model, "auto, analytic, axisymmetric or 3d (as screen)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "analytic", "axisymmetric", "3d"}));
+  cmd->add_option("--material", args->material, "Needle material (default: the scene's)");
+  cmd->add_flag("--no-sensitivity", args->no_sensitivity,
+                "Skip the one-at-a-time runs (two per --vary)");
+  cmd->add_option("--plugin-dir", args->plugin_dirs, "Extra plugin folder (repeatable)");
+  cmd->add_flag("--json", args->json, "Print one JSON object (every sample in rows)");
+  cmd->callback([args] { run_uncertainty_command(*args); });
+}
+
+}  // namespace mneedle::cli

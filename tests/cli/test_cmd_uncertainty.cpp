@@ -1,0 +1,77 @@
+// `mneedle uncertainty` end to end: the JSON a notebook reads, the table, and bad --vary values.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "run_mneedle.h"
+
+namespace {
+
+using mneedle::test::run_mneedle;
+const std::string kRoot = MNEEDLE_SOURCE_ROOT;
+const std::string kSilicone = kRoot + "/designs/scenes/paper_a_silicone_blunt_bevel.toml";
+
+TEST(UncertaintyCommand, JsonGivesInputsSummarySensitivityAndEverySample) {
+  const auto run = run_mneedle("uncertainty '" + kSilicone +
+                               "' --vary 'silicone.E=lognormal(0.2MPa,20%)' "
+                               "--vary 'fracture.critical_pressure=uniform(0.5MPa,0.8MPa)' "
+                               "--samples 8 --seed 3 --model analytic --jobs 2 --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["samples"], 8);
+  EXPECT_EQ(j["seed"], 3);
+  ASSERT_EQ(j["inputs"].size(), 2u);
+  EXPECT_EQ(j["inputs"][0]["path"], "silicone.E");
+  EXPECT_EQ(j["inputs"][0]["unit"], "Pa");
+  EXPECT_DOUBLE_EQ(j["inputs"][1]["p5_si"].get<double>(), 0.515e6);
+  ASSERT_EQ(j["rows"].size(), 8u);
+  for (const auto& row : j["rows"]) {
+    EXPECT_TRUE(row["ok"].get<bool>()) << row.dump();
+    EXPECT_TRUE(row["values_si"].contains("silicone.E"));
+  }
+  for (const char* key : {"puncture_depth_m", "puncture_force_N", "peak_force_N", "margin"}) {
+    const auto& p = j["summary"][key];
+    ASSERT_TRUE(p.contains("count")) << key;
+    if (p["count"].get<int>() == 0) continue;  // e.g. no resolved puncture: nulls
+    EXPECT_LE(p["p5"].get<double>(), p["p50"].get<double>()) << key;
+    EXPECT_LE(p["p50"].get<double>(), p["p95"].get<double>()) << key;
+  }
+  EXPECT_EQ(j["summary"]["peak_force_N"]["count"], 8);
+  const double pass = j["summary"]["pass_probability"].get<double>();
+  EXPECT_GE(pass, 0.0);
+  EXPECT_LE(pass, 1.0);
+  ASSERT_EQ(j["sensitivity"].size(), 2u);
+  EXPECT_GE(j["sensitivity"][0]["depth_effect_m"].get<double>(),
+            j["sensitivity"][1]["depth_effect_m"].get<double>());
+  EXPECT_TRUE(j.contains("provenance"));
+  // The same seed again: the same rows.
+  const auto again = run_mneedle("uncertainty '" + kSilicone +
+                                 "' --vary 'silicone.E=lognormal(0.2MPa,20%)' "
+                                 "--vary 'fracture.critical_pressure=uniform(0.5MPa,0.8MPa)' "
+                                 "--samples 8 --seed 3 --model analytic --json");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(nlohmann::json::parse(again.out)["rows"], j["rows"]);
+}
+
+TEST(UncertaintyCommand, TableGivesPercentilesProbabilityAndRanking) {
+  const auto run = run_mneedle("uncertainty '" + kSilicone +
+                               "' --vary 'fracture.critical_pressure=uniform(0.5MPa,0.8MPa)' "
+                               "--samples 5 --model analytic");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  for (const char* text : {"puncture depth", "median", "95 %", "passes:", "one at a time",
+                           "fracture.critical_pressure"})
+    EXPECT_NE(run.out.find(text), std::string::npos) << text << "\n" << run.out;
+}
+
+TEST(UncertaintyCommand, BadVaryIsOneLineNamingItAndExitOne) {
+  for (const std::string vary : {"silicone.E=uniform(2MPa,1MPa)", "silicone.E=beta(1,2)",
+                                 "silicone.Young=uniform(1MPa,2MPa)", "silicone.E=uniform(1,2)"}) {
+    const auto run = run_mneedle("uncertainty '" + kSilicone + "' --vary '" + vary +
+                                 "' --samples 3 --model analytic");
+    EXPECT_EQ(run.exit_code, 1) << vary << ": " << run.err;
+    EXPECT_NE(run.err.find("silicone."), std::string::npos) << run.err;
+    EXPECT_EQ(run.err.find('\n'), run.err.size() - 1) << "one line: " << run.err;
+  }
+}
+
+}  // namespace
