@@ -38,10 +38,11 @@ nlohmann::json optional_number(const std::optional<double>& v) {
   return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
 }
 
-nlohmann::json sample_json(const UncertaintySample& s, const std::vector<VariedValue>& inputs) {
+// `paths` name s.values in order (a sample: every input; a sensitivity run: its one input).
+nlohmann::json sample_json(const UncertaintySample& s, const std::vector<std::string>& paths) {
   nlohmann::json values = nlohmann::json::object();
-  for (std::size_t k = 0; k < s.values.size() && k < inputs.size(); ++k)
-    values[inputs[k].path] = s.values[k];
+  for (std::size_t k = 0; k < s.values.size() && k < paths.size(); ++k)
+    values[paths[k]] = s.values[k];
   nlohmann::json j = {{"values_si", values}, {"ok", s.ok}};
   if (!s.ok) {
     j["error"] = s.error;
@@ -133,12 +134,15 @@ void run_uncertainty_command(const UncertaintyArgs& args) {
   out["sensitivity"] = nlohmann::json::array();
   for (const auto& s : r.sensitivity)
     out["sensitivity"].push_back({{"path", s.path},
-                                  {"low", sample_json(s.low, {})},
-                                  {"high", sample_json(s.high, {})},
-                                  {"depth_effect_m", s.depth_effect_m},
-                                  {"peak_effect_N", s.peak_effect_n}});
+                                  {"low", sample_json(s.low, {s.path})},
+                                  {"high", sample_json(s.high, {s.path})},
+                                  {"depth_effect_m", optional_number(s.depth_effect_m)},
+                                  {"depths_resolved", s.both_resolved},
+                                  {"peak_effect_N", optional_number(s.peak_effect_n)}});
+  std::vector<std::string> paths;
+  for (const auto& v : r.inputs) paths.push_back(v.path);
   out["rows"] = nlohmann::json::array();
-  for (const auto& s : r.samples) out["rows"].push_back(sample_json(s, r.inputs));
+  for (const auto& s : r.samples) out["rows"].push_back(sample_json(s, paths));
   if (args.json) {
     print_checked_json(std::cout, out, "uncertainty");
   } else {
@@ -167,14 +171,32 @@ void run_uncertainty_command(const UncertaintyArgs& args) {
       std::printf(
           "  fired at the first depth step (depth unresolved, not in the spread): %.1f %%\n",
           100.0 * r.first_contact_fraction);
+    if (r.margin.count < r.peak_force_n.count)
+      std::printf("  (%zu samples without force have an infinite margin: not in its spread)\n",
+                  r.peak_force_n.count - r.margin.count);
     if (r.failed > 0)
       std::printf("  %zu samples could not be evaluated (see --json rows)\n", r.failed);
     if (!r.sensitivity.empty()) {
       std::printf("\n  one at a time (5 %% -> 95 %% of each value, the others as written):\n");
+      for (const auto& s : r.sensitivity) {
+        if (!s.depth_effect_m) {
+          const std::string& why = s.low.ok ? s.high.error : s.low.error;
+          std::printf("  %-30s n/a: the %s run failed (%s)\n", s.path.c_str(),
+                      s.low.ok ? "95 %" : "5 %", why.c_str());
+          continue;
+        }
+        std::printf("  %-30s %s %-12s peak force %s\n", s.path.c_str(),
+                    s.both_resolved ? "puncture depth moves" : "puncture objective moves*",
+                    format_quantity(*s.depth_effect_m, Dimension::Length).c_str(),
+                    format_quantity(*s.peak_effect_n, Dimension::Force).c_str());
+      }
+      bool starred = false;
       for (const auto& s : r.sensitivity)
-        std::printf("  %-30s puncture depth moves %-12s peak force %s\n", s.path.c_str(),
-                    format_quantity(s.depth_effect_m, Dimension::Length).c_str(),
-                    format_quantity(s.peak_effect_n, Dimension::Force).c_str());
+        starred = starred || (s.depth_effect_m && !s.both_resolved);
+      if (starred)
+        std::printf(
+            "  * an end that fires at the first step or does not puncture: the objective "
+            "(docs/model.md, \"Optimisation\"), not a puncture depth\n");
     }
   }
 }
@@ -187,14 +209,16 @@ void add_uncertainty_command(CLI::App& app) {
       "uncertainty", "Spread of puncture depth, forces and margin when scene values vary");
   cmd->footer(
       "Example:\n"
-      "  mneedle uncertainty designs/scenes/human_skin.toml --vary 'dermis.E=lognormal(80kPa,30%)' "
-      "--vary 'stratum_corneum.thickness=uniform(10um,30um)' --samples 200 --seed 1");
+      "  mneedle uncertainty designs/scenes/paper_a_silicone_blunt_bevel.toml "
+      "--vary 'silicone.E=lognormal(0.2MPa,20%)' "
+      "--vary 'fracture.critical_pressure=uniform(0.5MPa,0.8MPa)' --samples 200 --seed 1");
   cmd->add_option("scene", args->scene, "Scene file (TOML); its first needle is evaluated")
       ->required();
   cmd->add_option("--vary", args->vary,
                   "PATH=normal(MEAN,SD|SD%) | lognormal(MEDIAN,CV%) | uniform(LOW,HIGH), "
                   "e.g. dermis.E=lognormal(80kPa,30%) (repeatable)")
-      ->required();
+      ->required()
+      ->allow_extra_args(false);
   cmd->add_option("--samples", args->samples, "Number of samples")
       ->capture_default_str()
       ->check(CLI::Range(1, 100000));
@@ -214,7 +238,8 @@ void add_uncertainty_command(CLI::App& app) {
   cmd->add_option("--material", args->material, "Needle material (default: the scene's)");
   cmd->add_flag("--no-sensitivity", args->no_sensitivity,
                 "Skip the one-at-a-time runs (two per --vary)");
-  cmd->add_option("--plugin-dir", args->plugin_dirs, "Extra plugin folder (repeatable)");
+  cmd->add_option("--plugin-dir", args->plugin_dirs, "Extra plugin folder (repeatable)")
+      ->allow_extra_args(false);
   cmd->add_flag("--json", args->json, "Print one JSON object (every sample in rows)");
   cmd->callback([args] { run_uncertainty_command(*args); });
 }

@@ -45,7 +45,8 @@ std::optional<double> percentage(const std::string& text) {
 
 // A 64-bit draw as a double in (0, 1): never 0 or 1, where inverse CDFs are infinite.
 double open_unit(std::uint64_t bits) {
-  return (static_cast<double>(bits >> 11) + 0.5) * 0x1.0p-53;
+  // 52 bits plus a half: exact in a double, so never rounds up to 1.
+  return (static_cast<double>(bits >> 12) + 0.5) * 0x1.0p-52;
 }
 
 toml::node* find_in(toml::table& table, const std::string& dotted) {
@@ -74,7 +75,7 @@ toml::node* locate(toml::table& root, const std::string& path) {
       if (t == nullptr || t->get("name") == nullptr ||
           t->get("name")->value_or(std::string()) != head)
         continue;
-      if (toml::node* n = t->get(key)) return n;
+      if (toml::node* n = find_in(*t, key)) return n;  // a key, or fracture.KEY of its own
       if (auto* material = t->get("material"); material && material->as_table())
         if (toml::node* n = material->as_table()->get(key)) return n;
       return nullptr;
@@ -138,41 +139,47 @@ VariedValue parse_varied_value(const std::string& spec) {
     bad_spec(spec, "a distribution takes two values");
   const std::string first = std::string(trim(inner.substr(0, comma)));
   const std::string second = std::string(trim(inner.substr(comma + 1)));
-  Quantity a{};
+  if (kind != "normal" && kind != "lognormal" && kind != "uniform")
+    bad_spec(spec, "unknown distribution '" + kind + "' (normal, lognormal, uniform)");
+  const auto relative = percentage(second);
+  if (kind == "lognormal" && !relative)
+    bad_spec(spec, "lognormal(MEDIAN,CV%) takes its spread as a percentage");
+  if (kind == "uniform" && relative)
+    bad_spec(spec, "uniform(LOW,HIGH) takes two values with units");
+  // The dimension is that of whichever value has a unit ("0" has none and fits any).
+  Quantity a{}, b_given{};
   try {
     a = parse_quantity(first);
+    if (!relative) b_given = parse_quantity(second);
   } catch (const InputError& e) {
     bad_spec(spec, e.what());
   }
-  v.distribution.dimension = a.dimension;
-  v.distribution.a = a.value_si;
-  // The second value: a percentage (of the first), or a quantity of the first's dimension.
-  const auto relative = percentage(second);
+  const Dimension dimension =
+      a.dimension != Dimension::Dimensionless || relative ? a.dimension : b_given.dimension;
+  v.distribution.dimension = dimension;
   double b = 0.0;
-  if (!relative) {
-    try {
-      b = quantity_in(parse_quantity(second), a.dimension, v.path);
-    } catch (const InputError& e) {
-      bad_spec(spec, e.what());
-    }
+  try {
+    v.distribution.a = quantity_in(a, dimension, v.path);
+    if (!relative) b = quantity_in(b_given, dimension, v.path);
+  } catch (const InputError& e) {
+    bad_spec(spec, e.what());
   }
   if (kind == "normal") {
     v.distribution.kind = DistributionKind::Normal;
-    v.distribution.b = relative ? *relative * std::abs(a.value_si) : b;
-    if (!(v.distribution.b > 0.0)) bad_spec(spec, "the standard deviation must be > 0");
+    v.distribution.b = relative ? *relative * std::abs(v.distribution.a) : b;
+    if (!(v.distribution.b > 0.0))
+      bad_spec(spec, relative ? "the standard deviation must be > 0 (a percentage of a zero mean "
+                                "is 0: give it with units)"
+                              : "the standard deviation must be > 0");
   } else if (kind == "lognormal") {
     v.distribution.kind = DistributionKind::LogNormal;
-    if (!relative) bad_spec(spec, "lognormal(MEDIAN,CV%) takes its spread as a percentage");
-    if (!(a.value_si > 0.0)) bad_spec(spec, "a lognormal median must be > 0");
+    if (!(v.distribution.a > 0.0)) bad_spec(spec, "a lognormal median must be > 0");
     if (!(*relative > 0.0)) bad_spec(spec, "the coefficient of variation must be > 0");
     v.distribution.b = std::sqrt(std::log1p(*relative * *relative));
   } else if (kind == "uniform") {
     v.distribution.kind = DistributionKind::Uniform;
-    if (relative) bad_spec(spec, "uniform(LOW,HIGH) takes two values with units");
     v.distribution.b = b;
-    if (!(b > a.value_si)) bad_spec(spec, "uniform needs LOW < HIGH");
-  } else {
-    bad_spec(spec, "unknown distribution '" + kind + "' (normal, lognormal, uniform)");
+    if (!(b > v.distribution.a)) bad_spec(spec, "uniform needs LOW < HIGH");
   }
   return v;
 }
@@ -185,6 +192,7 @@ std::string scene_with_values(const std::string& toml_text, const std::string& s
   } catch (const toml::parse_error& e) {
     throw InputError(source + ": " + std::string(e.description()));
   }
+  std::vector<const toml::node*> seen;
   for (const auto& [varied, value] : values) {
     toml::node* node = locate(root, varied.path);
     const std::string where = source + ": --vary " + varied.path;
@@ -193,25 +201,31 @@ std::string scene_with_values(const std::string& toml_text, const std::string& s
                        ": no such value in the scene (a layer name and one of its keys or its "
                        "material's, fracture.KEY, needle.KEY or a dotted path; write the value "
                        "into the scene first)");
+    if (std::find(seen.begin(), seen.end(), node) != seen.end())
+      throw InputError(where + ": the same value is varied twice (another --vary names it)");
+    seen.push_back(node);
     const Dimension d = varied.distribution.dimension;
     if (auto* text = node->as_string()) {
-      const Quantity written = parse_quantity(text->get());
+      Quantity written{};
+      try {
+        written = parse_quantity(text->get());
+      } catch (const InputError&) {
+        throw InputError(where + ": the scene's value \"" + text->get() +
+                         "\" is not a number or a quantity");
+      }
       if (!dimensions_compatible(d, written.dimension))
         throw InputError(where + ": the scene's value \"" + text->get() + "\" is a " +
                          std::string(dimension_name(written.dimension)) +
                          ", the distribution's a " + std::string(dimension_name(d)));
-      *text =
-          exact_text(value, written.dimension == Dimension::Dimensionless ? d : written.dimension);
+      *text = exact_text(value, written.dimension);
     } else if (node->is_number()) {
       if (d != Dimension::Dimensionless)
         throw InputError(where + ": the scene's value is a plain number, the distribution's a " +
                          std::string(dimension_name(d)));
-      if (auto* f = node->as_floating_point()) {
-        *f = value;
-      } else {
-        // an integer in the scene takes a real value: replace the node
+      auto* f = node->as_floating_point();
+      if (f == nullptr)  // an integer cannot hold a drawn real value
         throw InputError(where + ": the scene's value is an integer; write it as a real number");
-      }
+      *f = value;
     } else {
       throw InputError(where + ": not a number or a quantity");
     }
@@ -253,60 +267,78 @@ UncertaintyResult run_uncertainty(const std::filesystem::path& scene_file,
   const PreModel model = parse_pre_model(options.model);
   const std::string text = read_input_file(scene_file);
   const std::string source = scene_file.string();
+  // A scene with drawn values is the file re-serialised (keys sorted, comments gone): its
+  // messages must not point at lines of the file.
+  const std::string drawn_source = source + " (with drawn values)";
 
   UncertaintyResult result;
   result.inputs = inputs;
-  // Every value is checked against the scene once, before any run: a misspelt path fails here.
+  using Edit = std::vector<std::pair<VariedValue, double>>;
+  // Every value is checked against the scene once, before any run: a misspelt path, a wrong unit
+  // or the same value twice fails here.
   {
-    std::vector<std::pair<VariedValue, double>> medians;
+    Edit medians;
     for (const auto& v : inputs)
       medians.emplace_back(v, distribution_quantile(v.distribution, 0.5));
-    parse_scene(scene_with_values(text, source, medians), source);
+    parse_scene(scene_with_values(text, source, medians), drawn_source);
   }
 
-  // Evaluates the scene with the values `set` (none: as written); never throws.
-  using Edit = std::vector<std::pair<VariedValue, double>>;
-  const auto evaluate = [&](const Edit& set) {
+  // Evaluates the scene with `set` (none: as written); throws what the evaluation throws.
+  const auto evaluate_or_throw = [&](const Edit& set) {
     UncertaintySample s;
-    for (const auto& [v, value] : set) s.values.push_back(value);
-    try {
-      const Scene scene =
-          parse_scene(set.empty() ? text : scene_with_values(text, source, set), source);
-      if (scene.needles.empty()) throw InputError(source + ": the scene has no needle to evaluate");
-      const NeedleSource needle = needle_from_scene(registry, scene.needles.front());
-      EvaluationOptions o;
-      o.fidelity = fidelity;
-      o.model = model;
-      o.axisymmetric = axisymmetric_profile(registry, needle, source);
-      o.mirror_symmetric_y0 = o.axisymmetric.has_value() || mirror_symmetric_y0(needle.mesh);
-      const DesignEvaluation e =
-          evaluate_design(needle.mesh, scene, sample_material(scene, options), o);
-      s.ok = true;
-      if (e.puncture) {
-        s.puncture_depth_m = e.puncture->depth_m;
-        s.puncture_force_n = e.puncture->force_N;
-        s.puncture_at_first_contact = e.puncture->at_first_contact;
-      }
-      s.puncture_objective_m = e.puncture_objective_m;
-      s.peak_force_n = e.peak_force_n;
-      s.margin = e.margin;
-      s.passes = e.passes;
-    } catch (const std::exception& e) {
-      s.ok = false;
-      s.error = e.what();
+    for (const auto& entry : set) s.values.push_back(entry.second);
+    const Scene scene = set.empty()
+                            ? parse_scene(text, source)
+                            : parse_scene(scene_with_values(text, source, set), drawn_source);
+    if (scene.needles.empty()) throw InputError(source + ": the scene has no needle to evaluate");
+    const NeedleSource needle = needle_from_scene(registry, scene.needles.front());
+    EvaluationOptions o;
+    o.fidelity = fidelity;
+    o.model = model;
+    o.axisymmetric = axisymmetric_profile(registry, needle, source);
+    o.mirror_symmetric_y0 = o.axisymmetric.has_value() || mirror_symmetric_y0(needle.mesh);
+    const DesignEvaluation e =
+        evaluate_design(needle.mesh, scene, sample_material(scene, options), o);
+    s.ok = true;
+    if (e.puncture) {
+      s.puncture_depth_m = e.puncture->depth_m;
+      s.puncture_force_n = e.puncture->force_N;
+      s.puncture_at_first_contact = e.puncture->at_first_contact;
     }
+    s.puncture_objective_m = e.puncture_objective_m;
+    s.peak_force_n = e.peak_force_n;
+    s.margin = e.margin;  // +inf without force: the safest case, not an error
+    s.passes = e.passes;
+    // As in screen: no NaN or Inf may reach a percentile or the output.
+    for (const double v : {s.puncture_depth_m.value_or(0.0), s.puncture_force_n,
+                           s.puncture_objective_m, s.peak_force_n})
+      if (!std::isfinite(v)) throw SolverError("non-finite result (not used)");
+    if (std::isnan(s.margin)) throw SolverError("non-finite margin (not used)");
     return s;
   };
+  const auto evaluate = [&](const Edit& set) {
+    try {
+      return evaluate_or_throw(set);
+    } catch (const std::exception& e) {
+      UncertaintySample s;
+      for (const auto& entry : set) s.values.push_back(entry.second);
+      s.error = e.what();
+      return s;
+    }
+  };
+  // The scene as written first, alone: if it cannot run, nothing else is worth running, and its
+  // error keeps its kind (input or solver).
+  result.nominal = evaluate_or_throw({});
 
-  // The draws, in a fixed order and before any run: sample i, value k takes the i-th draw of
-  // value k (Monte Carlo), or a point of stratum perm_k[i] (Latin hypercube).
+  // The draws, in a fixed order and before any run: sample i, value k takes the (i K + k)-th draw
+  // (Monte Carlo), or a point of stratum perm_k(i) (Latin hypercube). Plain numbers only: the
+  // scene edit of a sample is built when it runs.
   const auto n = static_cast<std::size_t>(options.samples);
+  const std::size_t K = inputs.size();
   std::mt19937_64 random(options.seed);
-  std::vector<Edit> runs(1 + n);  // runs[0]: the scene as written
-  for (std::size_t i = 0; i < n; ++i)
-    for (const auto& v : inputs) runs[1 + i].emplace_back(v, 0.0);
+  std::vector<double> draws(n * K);
   if (options.latin_hypercube) {
-    for (std::size_t k = 0; k < inputs.size(); ++k) {
+    for (std::size_t k = 0; k < K; ++k) {
       std::vector<std::size_t> stratum(n);
       for (std::size_t i = 0; i < n; ++i) stratum[i] = i;
       for (std::size_t i = n; i > 1; --i) {  // Fisher-Yates, spelt out: std::shuffle may differ
@@ -317,35 +349,43 @@ UncertaintyResult run_uncertainty(const std::filesystem::path& scene_file,
       for (std::size_t i = 0; i < n; ++i) {
         const double u =
             (static_cast<double>(stratum[i]) + open_unit(random())) / static_cast<double>(n);
-        runs[1 + i][k].second = distribution_quantile(inputs[k].distribution, u);
+        draws[i * K + k] = distribution_quantile(inputs[k].distribution, u);
       }
     }
   } else {
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t k = 0; k < inputs.size(); ++k)
-        runs[1 + i][k].second = distribution_quantile(inputs[k].distribution, open_unit(random()));
+    for (std::size_t i = 0; i < n * K; ++i)
+      draws[i] = distribution_quantile(inputs[i % K].distribution, open_unit(random()));
   }
-  // One at a time: each value at its 5 % and 95 % quantiles, every other as the scene has it.
-  if (options.sensitivity)
-    for (const auto& v : inputs)
-      for (const double q : {0.05, 0.95})
-        runs.push_back({{v, distribution_quantile(v.distribution, q)}});
+  // Runs 0 … n−1: the samples; then, one at a time, each value at its 5 % and 95 % quantiles with
+  // every other value as the scene has it.
+  const std::size_t runs = n + (options.sensitivity ? 2 * K : 0);
+  const auto edit_of = [&](std::size_t r) {
+    Edit set;
+    if (r < n) {
+      for (std::size_t k = 0; k < K; ++k) set.emplace_back(inputs[k], draws[r * K + k]);
+    } else {
+      const std::size_t k = (r - n) / 2;
+      const double q = (r - n) % 2 == 0 ? 0.05 : 0.95;
+      set.emplace_back(inputs[k], distribution_quantile(inputs[k].distribution, q));
+    }
+    return set;
+  };
 
-  std::vector<UncertaintySample> done(runs.size());
+  std::vector<UncertaintySample> done(runs);
   std::atomic<std::size_t> next{0};
   std::mutex report;
   int finished = 0;
   const auto worker = [&] {
-    for (std::size_t j = next++; j < runs.size(); j = next++) {
-      done[j] = evaluate(runs[j]);
+    for (std::size_t r = next++; r < runs; r = next++) {
+      done[r] = evaluate(edit_of(r));
       std::lock_guard<std::mutex> lock(report);
       ++finished;
-      if (on_sample) on_sample(finished, static_cast<int>(runs.size()));
+      if (on_sample) on_sample(finished, static_cast<int>(runs));
     }
   };
-  const int jobs = std::max(1, std::min<int>(options.jobs, static_cast<int>(runs.size())));
-  // As in screen: one OpenBLAS thread per job, so that jobs share the cores (and the samples'
-  // arithmetic does not depend on how many run at once).
+  const int jobs = std::max(1, std::min<int>(options.jobs, static_cast<int>(runs)));
+  // As in screen: one OpenBLAS thread per job, so that jobs share the cores (and each run's
+  // arithmetic does not depend on how many run beside it).
   std::optional<BlasThreadLimit> blas;
   if (jobs > 1) blas.emplace(1);
   std::vector<std::thread> pool;
@@ -353,21 +393,19 @@ UncertaintyResult run_uncertainty(const std::filesystem::path& scene_file,
   worker();
   for (auto& t : pool) t.join();
 
-  result.nominal = done[0];
-  if (!result.nominal.ok)
-    throw InputError("uncertainty: the scene as written cannot be evaluated: " +
-                     result.nominal.error);
-  result.samples.assign(done.begin() + 1, done.begin() + 1 + static_cast<std::ptrdiff_t>(n));
+  result.samples.assign(done.begin(), done.begin() + static_cast<std::ptrdiff_t>(n));
   std::vector<double> depth, force, peak, margin;
   std::size_t ran = 0, punctured = 0, passed = 0, first_contact = 0;
+  const UncertaintySample* first_failure = nullptr;
   for (const auto& s : result.samples) {
     if (!s.ok) {
       ++result.failed;
+      if (first_failure == nullptr) first_failure = &s;
       continue;
     }
     ++ran;
     peak.push_back(s.peak_force_n);
-    if (std::isfinite(s.margin)) margin.push_back(s.margin);
+    if (std::isfinite(s.margin)) margin.push_back(s.margin);  // +inf (no force) left out
     passed += s.passes ? 1 : 0;
     first_contact += s.puncture_at_first_contact ? 1 : 0;
     // A depth that is only the first step's says nothing of the tissue: not in the spread.
@@ -377,31 +415,45 @@ UncertaintyResult run_uncertainty(const std::filesystem::path& scene_file,
       force.push_back(s.puncture_force_n);
     }
   }
+  if (ran == 0)
+    throw InputError("uncertainty: none of the " + std::to_string(n) +
+                     " samples could be evaluated; the first: " + first_failure->error);
   result.puncture_depth_m = percentiles(depth);
   result.puncture_force_n = percentiles(force);
   result.peak_force_n = percentiles(peak);
   result.margin = percentiles(margin);
-  result.punctured_fraction = ran ? static_cast<double>(punctured) / static_cast<double>(ran) : 0.0;
-  result.first_contact_fraction =
-      ran ? static_cast<double>(first_contact) / static_cast<double>(ran) : 0.0;
-  result.pass_probability = ran ? static_cast<double>(passed) / static_cast<double>(ran) : 0.0;
+  const auto share = [&](std::size_t count) {
+    return static_cast<double>(count) / static_cast<double>(ran);
+  };
+  result.punctured_fraction = share(punctured);
+  result.first_contact_fraction = share(first_contact);
+  result.pass_probability = share(passed);
   if (options.sensitivity) {
-    for (std::size_t k = 0; k < inputs.size(); ++k) {
+    for (std::size_t k = 0; k < K; ++k) {
       Sensitivity s;
       s.path = inputs[k].path;
-      s.low = done[1 + n + 2 * k];
-      s.high = done[1 + n + 2 * k + 1];
+      s.low = done[n + 2 * k];
+      s.high = done[n + 2 * k + 1];
       if (s.low.ok && s.high.ok) {
         s.depth_effect_m = std::abs(s.high.puncture_objective_m - s.low.puncture_objective_m);
         s.peak_effect_n = std::abs(s.high.peak_force_n - s.low.peak_force_n);
+        const auto resolved = [](const UncertaintySample& x) {
+          return x.puncture_depth_m.has_value() && !x.puncture_at_first_contact;
+        };
+        s.both_resolved = resolved(s.low) && resolved(s.high);
       }
       result.sensitivity.push_back(std::move(s));
     }
+    // Measured effects first (largest depth effect, then force); an input whose 5 % or 95 % run
+    // failed has none and comes last.
     std::stable_sort(result.sensitivity.begin(), result.sensitivity.end(),
                      [](const Sensitivity& a, const Sensitivity& b) {
-                       if (a.depth_effect_m != b.depth_effect_m)
-                         return a.depth_effect_m > b.depth_effect_m;
-                       return a.peak_effect_n > b.peak_effect_n;
+                       if (a.depth_effect_m.has_value() != b.depth_effect_m.has_value())
+                         return a.depth_effect_m.has_value();
+                       if (!a.depth_effect_m) return false;
+                       if (*a.depth_effect_m != *b.depth_effect_m)
+                         return *a.depth_effect_m > *b.depth_effect_m;
+                       return *a.peak_effect_n > *b.peak_effect_n;
                      });
   }
   return result;

@@ -99,11 +99,12 @@ TEST(SceneWithValues, SetsLayerMaterialFractureNeedleAndDottedPathValues) {
                                   {v("needle.diameter=uniform(1um,2um)"), 250e-6},
                                   {v("requirements.target_depth=uniform(1um,2um)"), 4e-4}});
   const mneedle::Scene scene = mneedle::parse_scene(edited, file.string());
-  EXPECT_DOUBLE_EQ(layer_E(scene, 2), 123456.789);  // exactly: written with 17 digits
+  EXPECT_EQ(layer_E(scene, 2), 123456.789);  // exactly: written with 17 significant digits
   EXPECT_DOUBLE_EQ(scene.tissue.layers[0].thickness, 17.5e-6);
   EXPECT_DOUBLE_EQ(scene.tissue.fracture->critical_pressure, 2.5e6);
   EXPECT_DOUBLE_EQ(*scene.requirements.target_depth, 4e-4);
-  EXPECT_NE(edited.find("250"), std::string::npos);
+  const auto& geometry = std::get<mneedle::PluginGeometry>(scene.needles[0].geometry);
+  EXPECT_EQ(geometry.parameters.at("diameter").value_si, 250e-6);
   // and nothing else moved
   const mneedle::Scene original = mneedle::parse_scene(text, file.string());
   EXPECT_DOUBLE_EQ(layer_E(scene, 1), layer_E(original, 1));
@@ -116,7 +117,8 @@ TEST(SceneWithValues, UnknownPathOrWrongDimensionIsAnErrorNamingThePath) {
       {"dermis.Young=uniform(1kPa,2kPa)", "no such value"},
       {"hypodermis.E=uniform(1kPa,2kPa)", "no such value"},
       {"dermis.E=uniform(1um,2um)", "pressure"},
-      {"dermis.nu=uniform(1kPa,2kPa)", "plain number"}};
+      {"dermis.nu=uniform(1kPa,2kPa)", "plain number"},
+      {"dermis.model=uniform(1kPa,2kPa)", "not a number or a quantity"}};
   for (const auto& [spec, expected] : cases) {
     try {
       mneedle::scene_with_values(text, file.string(), {{mneedle::parse_varied_value(spec), 1.0}});
@@ -127,6 +129,18 @@ TEST(SceneWithValues, UnknownPathOrWrongDimensionIsAnErrorNamingThePath) {
       EXPECT_NE(what.find(mneedle::parse_varied_value(spec).path), std::string::npos) << what;
       EXPECT_NE(what.find(expected), std::string::npos) << what;
     }
+  }
+}
+
+TEST(SceneWithValues, TheSameValueVariedTwiceIsAnError) {
+  const fs::path file = kRoot + "/designs/scenes/human_skin.toml";
+  const auto a = mneedle::parse_varied_value("fracture.toughness=uniform(1J/m^2,2J/m^2)");
+  const auto b = mneedle::parse_varied_value("tissue.fracture.toughness=uniform(1J/m^2,2J/m^2)");
+  try {
+    mneedle::scene_with_values(file_text(file), file.string(), {{a, 1.5}, {b, 1.5}});
+    FAIL() << "expected an InputError";
+  } catch (const mneedle::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("varied twice"), std::string::npos) << e.what();
   }
 }
 
@@ -194,7 +208,50 @@ TEST_F(Uncertainty, PunctureDepthLinearInAnInputHasThePercentilesOfThatInput) {
   EXPECT_DOUBLE_EQ(r.punctured_fraction, 1.0);
   // One at a time: the depth moves by c (q95 - q5) = c 0.27 MPa.
   ASSERT_EQ(r.sensitivity.size(), 1u);
-  EXPECT_NEAR(r.sensitivity[0].depth_effect_m / (c * 0.27e6), 1.0, 1e-6);
+  ASSERT_TRUE(r.sensitivity[0].depth_effect_m.has_value());
+  EXPECT_TRUE(r.sensitivity[0].both_resolved);
+  EXPECT_NEAR(*r.sensitivity[0].depth_effect_m / (c * 0.27e6), 1.0, 1e-6);
+}
+
+TEST_F(Uncertainty, LatinHypercubePutsOneSampleInEveryStratumOfEveryInputIndependently) {
+  // Two inputs: each must fill its N strata once, and their strata must not be paired in the
+  // same order (an identity shuffle would correlate the inputs perfectly).
+  const auto pc = mneedle::parse_varied_value("fracture.critical_pressure=uniform(0.5MPa,0.8MPa)");
+  const auto e = mneedle::parse_varied_value("silicone.E=uniform(0.15MPa,0.25MPa)");
+  options_.samples = 16;
+  options_.latin_hypercube = true;
+  options_.sensitivity = false;
+  const auto r = mneedle::run_uncertainty(scene_, {pc, e}, registry_, options_);
+  std::vector<int> first(16, 0), second(16, 0);
+  std::vector<std::size_t> stratum_a, stratum_b;
+  for (const auto& s : r.samples) {
+    const auto a = static_cast<std::size_t>((s.values[0] - 0.5e6) / 0.3e6 * 16);
+    const auto b = static_cast<std::size_t>((s.values[1] - 0.15e6) / 0.1e6 * 16);
+    ASSERT_LT(a, 16u);
+    ASSERT_LT(b, 16u);
+    ++first[a];
+    ++second[b];
+    stratum_a.push_back(a);
+    stratum_b.push_back(b);
+  }
+  for (int i = 0; i < 16; ++i) {
+    EXPECT_EQ(first[i], 1) << i;
+    EXPECT_EQ(second[i], 1) << i;
+  }
+  EXPECT_NE(stratum_a, stratum_b);
+}
+
+TEST_F(Uncertainty, ASceneThatCannotRunAsWrittenFailsBeforeAnySample) {
+  // A target depth beyond the needle's length: evaluate_design refuses it (an InputError).
+  const fs::path deep = dir_ / "deep.toml";
+  std::ofstream(deep) << mneedle::scene_with_values(
+      file_text(scene_), scene_.string(),
+      {{mneedle::parse_varied_value("requirements.target_depth=uniform(1um,2um)"), 5e-3}});
+  const auto pc = mneedle::parse_varied_value("fracture.critical_pressure=uniform(0.5MPa,0.8MPa)");
+  int runs = 0;
+  EXPECT_THROW(mneedle::run_uncertainty(deep, {pc}, registry_, options_, [&](int, int) { ++runs; }),
+               mneedle::InputError);
+  EXPECT_EQ(runs, 0);
 }
 
 TEST_F(Uncertainty, SameSeedGivesTheSameSamplesBitForBitWhateverTheJobs) {
@@ -221,7 +278,6 @@ TEST_F(Uncertainty, ASampleThatCannotRunIsAnErrorRowAndTheOthersGoOn) {
   // A normal wide enough to draw negative critical pressures, which the scene refuses.
   const auto pc = mneedle::parse_varied_value("fracture.critical_pressure=normal(0.663MPa,100%)");
   options_.samples = 20;
-  options_.sensitivity = false;
   const auto r = mneedle::run_uncertainty(scene_, {pc}, registry_, options_);
   EXPECT_GT(r.failed, 0u);
   EXPECT_LT(r.failed, 20u);
@@ -237,6 +293,10 @@ TEST_F(Uncertainty, ASampleThatCannotRunIsAnErrorRowAndTheOthersGoOn) {
   }
   EXPECT_EQ(ran + r.failed, 20u);
   EXPECT_EQ(r.peak_force_n.count, ran);  // the spread is over the samples that ran
+  // Its 5 % quantile is negative: that end fails, so there is no effect to rank.
+  ASSERT_EQ(r.sensitivity.size(), 1u);
+  EXPECT_FALSE(r.sensitivity[0].low.ok);
+  EXPECT_FALSE(r.sensitivity[0].depth_effect_m.has_value());
 }
 
 TEST_F(Uncertainty, MisspeltPathFailsBeforeAnyRun) {

@@ -2,8 +2,9 @@
 // Uncertainty from tissue variability (docs/cli.md, "mneedle uncertainty"; docs/model.md,
 // "Uncertainty"): scene values drawn from distributions, every sample evaluated as `screen`
 // evaluates a design (the scene's first needle), and the spread of puncture depth, forces and
-// margin with a one-at-a-time sensitivity ranking. Seeded runs are reproducible bit for bit, with
-// any number of jobs, at one OpenBLAS thread per sample (what --jobs > 1 gives each job).
+// margin with a one-at-a-time sensitivity ranking. Seeded runs are reproducible bit for bit at the
+// same number of OpenBLAS threads per run: any --jobs > 1 (one each), or --jobs 1 with
+// OPENBLAS_NUM_THREADS=1.
 
 #include <cstdint>
 #include <filesystem>
@@ -90,8 +91,13 @@ Percentiles percentiles(std::vector<double> values);
 struct Sensitivity {
   std::string path;
   UncertaintySample low, high;
-  double depth_effect_m = 0.0;  ///< |puncture objective at 95 % − at 5 %|
-  double peak_effect_n = 0.0;   ///< |peak force at 95 % − at 5 %|
+  /// |puncture objective at 95 % − at 5 %|: a puncture depth difference when both ends are
+  /// resolved punctures (both_resolved), else a difference of the objective (a first-step depth,
+  /// or beyond the target depth a measure of how near the criterion came). Empty when either end
+  /// could not be evaluated.
+  std::optional<double> depth_effect_m;
+  std::optional<double> peak_effect_n;  ///< |peak force at 95 % − at 5 %|
+  bool both_resolved = false;
 };
 
 struct UncertaintyResult {
@@ -106,10 +112,11 @@ struct UncertaintyResult {
   std::vector<Sensitivity> sensitivity;  ///< largest depth effect first, then peak force
 };
 
-/// Runs the scene at its own values, at every sample (drawn in a fixed order from a 64-bit
+/// Runs the scene at its own values first (if that fails, its exception: InputError or
+/// SolverError), then every sample (drawn in a fixed order from a 64-bit
 /// Mersenne Twister seeded with options.seed, so the draws do not depend on jobs), and one at a
 /// time at each input's 5 % and 95 % quantiles. A sample that fails is an error row, the others go
-/// on; the nominal run failing is an InputError or SolverError. `on_sample` (optional) is called
+/// on; every sample failing is an InputError quoting the first. `on_sample` (optional) is called
 /// for each finished evaluation, serialised: (done, total).
 UncertaintyResult run_uncertainty(const std::filesystem::path& scene_file,
                                   const std::vector<VariedValue>& inputs,
