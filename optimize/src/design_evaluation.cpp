@@ -169,6 +169,13 @@ std::string to_string(PreModel model) {
   return "auto";
 }
 
+std::string design_material(const Scene& scene, const std::optional<std::string>& chosen) {
+  if (chosen) return *chosen;
+  for (const auto& n : scene.needles)
+    if (n.material) return *n.material;
+  return "silicon";
+}
+
 DesignEvaluation evaluate_design(const TriangleMesh& mesh, const Scene& scene,
                                  const std::string& needle_material,
                                  const EvaluationOptions& options) {

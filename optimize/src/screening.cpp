@@ -176,13 +176,6 @@ json optional_number(const std::optional<double>& v) {
   return v ? json(*v) : json(nullptr);
 }
 
-std::string scene_material(const Scene& scene, const ScreeningOptions& o) {
-  if (o.material) return *o.material;
-  for (const auto& n : scene.needles)
-    if (n.material) return *n.material;
-  return "silicon";
-}
-
 json evaluation_json(const DesignEvaluation& e) {
   const auto& g = e.geometry;
   const auto& s = e.strength;
@@ -501,7 +494,7 @@ ScreeningBatch::ScreeningBatch(const std::vector<DesignInput>& designs, const Sc
       options_(options),
       on_row_(writes ? std::move(on_row) : nullptr),
       scene_hash_(hex(fnv1a(read_bytes(scene_file)))),
-      material_(scene_material(scene, options)),
+      material_(design_material(scene, options.material)),
       rows_(designs.size()) {
   parse_fidelity(options.fidelity);  // bad names fail the run, not every row
   parse_pre_model(options.model);

@@ -98,13 +98,6 @@ std::string exact_text(double value_si, Dimension d) {
   return unit.empty() ? std::string(text) : std::string(text) + " " + unit;
 }
 
-std::string sample_material(const Scene& scene, const UncertaintyOptions& o) {
-  if (o.material) return *o.material;
-  for (const auto& n : scene.needles)
-    if (n.material) return *n.material;
-  return "silicon";
-}
-
 }  // namespace
 
 double distribution_quantile(const Distribution& d, double p) {
@@ -298,7 +291,7 @@ UncertaintyResult run_uncertainty(const std::filesystem::path& scene_file,
     o.axisymmetric = axisymmetric_profile(registry, needle, source);
     o.mirror_symmetric_y0 = o.axisymmetric.has_value() || mirror_symmetric_y0(needle.mesh);
     const DesignEvaluation e =
-        evaluate_design(needle.mesh, scene, sample_material(scene, options), o);
+        evaluate_design(needle.mesh, scene, design_material(scene, options.material), o);
     s.ok = true;
     if (e.puncture) {
       s.puncture_depth_m = e.puncture->depth_m;

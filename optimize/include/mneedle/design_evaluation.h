@@ -90,6 +90,10 @@ DesignEvaluation evaluate_design(const TriangleMesh& mesh, const Scene& scene,
                                  const std::string& needle_material,
                                  const EvaluationOptions& options = {});
 
+/// The needle material a design is evaluated in: `chosen` (--material) if given, else the first
+/// of the scene's needles that names one, else silicon.
+std::string design_material(const Scene& scene, const std::optional<std::string>& chosen);
+
 /// The scene's needle materials as NeedleMaterial values (fracture mode assumed for user ones).
 std::vector<NeedleMaterial> scene_needle_materials(const Scene& scene);
 
