@@ -13,6 +13,7 @@
 #include "mneedle/needle/needle_frame.h"
 #include "mneedle/screening.h"
 #include "mneedle/screening_mpi.h"
+#include "mneedle/uncertainty.h"
 #include "report_needles.h"
 #include "run_provenance.h"
 
@@ -34,6 +35,10 @@ struct ScreenArgs {
   bool json = false;
   bool resume = false;
   bool mpi = false;
+  int uncertainty = 0;
+  std::vector<std::string> vary;
+  std::uint64_t seed = 1;
+  std::string method = "mc";
   std::vector<std::string> plugin_dirs;
 };
 
@@ -56,6 +61,13 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
       "criterion already fires at the first depth step: not resolved, ranked after the "
       "resolved ones (docs/model.md, \"Criteria\").\n\n",
       std::string(to_string(scene.model.criterion)).c_str());
+  bool sampled = false;
+  for (const auto& row : ranked) sampled = sampled || row.pass_probability.has_value();
+  if (sampled)
+    std::printf(
+        "With --uncertainty: ranked by the probability of passing over the sampled scenes "
+        "(the same draws for every design), then by the median puncture depth; the columns are "
+        "the nominal run's.\n\n");
   std::printf("%-4s %-24s %-6s %-11s %-11s %-11s %-11s %-9s %-8s %s\n", "rank", "design", "status",
               "puncture at", "force", "peak force", "capacity", "governing", "margin", "model");
   int rank = 0;
@@ -83,6 +95,17 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
                 cell(row.peak_force_n, Dimension::Force).c_str(),
                 cell(j["capacity_N"].get<double>(), Dimension::Force).c_str(),
                 j["governing"].get<std::string>().c_str(), margin.c_str(), models.c_str());
+    if (row.pass_probability) {
+      const auto& u = j["uncertainty"];
+      const auto& d = u["puncture_depth_m"];
+      std::printf("     P(pass) %.1f %% of %d samples; puncture depth 5/50/95 %%: %s\n",
+                  100.0 * *row.pass_probability, u["samples"].get<int>(),
+                  d["p50"].is_null() ? "no resolved puncture"
+                                     : (cell(d["p5"].get<double>(), Dimension::Length) + " / " +
+                                        cell(d["p50"].get<double>(), Dimension::Length) + " / " +
+                                        cell(d["p95"].get<double>(), Dimension::Length))
+                                           .c_str());
+    }
   }
 }
 
@@ -112,6 +135,22 @@ ScreenSetup prepare_screen(const ScreenArgs& args, bool writer) {
   options.axis = args.axis;
   options.repair = args.repair;
   parse_axis_choice(args.axis);  // a bad --axis is a usage error before any design runs
+  if (args.uncertainty > 0 && args.vary.empty())
+    throw InputError("screen: --uncertainty N needs the values to vary (--vary PATH=DIST)");
+  if (args.uncertainty == 0 && !args.vary.empty())
+    throw InputError("screen: --vary needs --uncertainty N (the number of samples)");
+  if (args.uncertainty > 0) {
+    for (const auto& spec : args.vary) options.vary.push_back(parse_varied_value(spec));
+    options.uncertainty.samples = args.uncertainty;
+    options.uncertainty.seed = args.seed;
+    options.uncertainty.latin_hypercube = args.method == "lhs";
+    // Every path checked against the scene once, before any design runs.
+    std::vector<std::pair<VariedValue, double>> medians;
+    for (const auto& v : options.vary)
+      medians.emplace_back(v, distribution_quantile(v.distribution, 0.5));
+    parse_scene(scene_with_values(read_input_file(args.scene), args.scene, medians),
+                args.scene + " (with drawn values)");
+  }
   if (options.resume && args.out.empty()) throw InputError("screen: --resume needs --out DIR");
   if (!args.out.empty()) {
     options.out = args.out;
@@ -182,11 +221,15 @@ void run_screen(const ScreenArgs& args) {
   std::size_t failed = 0;
   for (const auto& r : rows) failed += r.ok ? 0 : 1;
   if (args.json || !args.report.empty()) {
-    nlohmann::json out = {{"scene", args.scene},
-                          {"fidelity", options.fidelity},
-                          {"model", options.model},
-                          {"ranking", {"puncture_depth_m", "puncture_force_N"}},
-                          {"designs", nlohmann::json::array()}};
+    nlohmann::json out = {
+        {"scene", args.scene},
+        {"fidelity", options.fidelity},
+        {"model", options.model},
+        {"ranking", args.uncertainty > 0 ? nlohmann::json{"uncertainty.pass_probability",
+                                                          "uncertainty.puncture_depth_m.p50",
+                                                          "puncture_depth_m", "puncture_force_N"}
+                                         : nlohmann::json{"puncture_depth_m", "puncture_force_N"}},
+        {"designs", nlohmann::json::array()}};
     for (const auto& r : rows) {
       auto j = nlohmann::json::parse(r.json);
       j["resumed"] = r.resumed;
@@ -247,6 +290,19 @@ void add_screen_command(CLI::App& app) {
   cmd->add_option("--out", args->out,
                   "Folder for results.csv and results.jsonl, written as designs finish");
   cmd->add_flag("--resume", args->resume, "Skip designs already in --out for the same inputs");
+  cmd->add_option("--uncertainty", args->uncertainty,
+                  "Also run every design in N scenes with the --vary values drawn (the same "
+                  "draws for every design) and rank by the probability of passing")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option("--vary", args->vary,
+                  "With --uncertainty: PATH=normal(MEAN,SD)|lognormal(MEDIAN,CV%)|"
+                  "uniform(LOW,HIGH), as mneedle uncertainty (repeatable)")
+      ->allow_extra_args(false);
+  cmd->add_option("--seed", args->seed, "With --uncertainty: seed of the draws")
+      ->capture_default_str();
+  cmd->add_option("--method", args->method, "With --uncertainty: mc or lhs")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"mc", "lhs"}));
   cmd->add_flag("--mpi", args->mpi,
                 "Share the designs among the processes of mpirun -n N (rank 0 writes; each "
                 "rank runs --jobs threads)");

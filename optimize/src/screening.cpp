@@ -238,7 +238,43 @@ std::string row_hash(const DesignInput& d, const std::string& scene_hash,
       fnv1a(fingerprint + "|" + scene_hash + "|" + fidelity + "|" + material + "|" + kRowVersion));
 }
 
-ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::string& hash,
+json percentiles_json(const Percentiles& p) {
+  if (p.count == 0) return {{"count", 0}, {"p5", nullptr}, {"p50", nullptr}, {"p95", nullptr}};
+  return {{"count", p.count}, {"p5", p.p5}, {"p50", p.p50}, {"p95", p.p95}};
+}
+
+// screen --uncertainty: the design in every sampled scene (run_uncertainty's draws, the same for
+// every design), summarised for its row.
+json design_uncertainty(const ScreenedNeedle& needle, const std::string& scene_text,
+                        const std::string& scene_source, const std::string& material,
+                        const ScreeningOptions& o) {
+  UncertaintyOptions u = o.uncertainty;
+  u.jobs = 1;  // the designs share the jobs
+  u.sensitivity = false;
+  u.fidelity = o.fidelity;
+  u.model = o.model;
+  const SceneEvaluator evaluate = [&](const Scene& sampled) {
+    return evaluate_design(needle.mesh, sampled, material, needle.options);
+  };
+  const UncertaintyResult r = run_uncertainty(scene_text, scene_source, o.vary, u, evaluate);
+  json inputs = json::array();
+  for (const auto& v : o.vary) inputs.push_back(v.text);
+  return {{"samples", u.samples},
+          {"seed", u.seed},
+          {"method", u.latin_hypercube ? "lhs" : "mc"},
+          {"vary", inputs},
+          {"pass_probability", r.pass_probability},
+          {"punctured_fraction", r.punctured_fraction},
+          {"first_contact_fraction", r.first_contact_fraction},
+          {"failed_samples", r.failed},
+          {"puncture_depth_m", percentiles_json(r.puncture_depth_m)},
+          {"puncture_force_N", percentiles_json(r.puncture_force_n)},
+          {"peak_force_N", percentiles_json(r.peak_force_n)},
+          {"margin", percentiles_json(r.margin)}};
+}
+
+ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::string& scene_text,
+                          const std::string& scene_source, const std::string& hash,
                           const std::string& material, const PluginRegistry& registry,
                           const ScreeningOptions& o) {
   ScreeningRow row;
@@ -277,6 +313,14 @@ ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::s
     if (const auto key = non_finite_key(evaluation))
       throw SolverError("non-finite value of " + *key + " (not written)");
     j.update(evaluation);
+    if (!o.vary.empty()) {
+      j["uncertainty"] = design_uncertainty(needle, scene_text, scene_source, material, o);
+      row.pass_probability = j["uncertainty"]["pass_probability"].get<double>();
+      const auto& depth = j["uncertainty"]["puncture_depth_m"];
+      if (!depth["p50"].is_null()) row.median_puncture_depth_m = depth["p50"].get<double>();
+      if (const auto key = non_finite_key(j["uncertainty"]))
+        throw SolverError("non-finite value of uncertainty." + *key + " (not written)");
+    }
   } catch (const std::exception& e) {
     row.ok = false;
     row.error = e.what();
@@ -318,6 +362,12 @@ ScreeningRow row_from_json(const std::string& line) {
     }
     row.margin = j.at("margin").is_null() ? INFINITY : j.at("margin").get<double>();
     row.passes = j.at("passes").get<bool>();
+    if (j.contains("uncertainty")) {
+      const auto& u = j.at("uncertainty");
+      row.pass_probability = u.at("pass_probability").get<double>();
+      if (!u.at("puncture_depth_m").at("p50").is_null())
+        row.median_puncture_depth_m = u.at("puncture_depth_m").at("p50").get<double>();
+    }
   } else {
     row.error = j.value("error", "");
   }
@@ -493,7 +543,9 @@ ScreeningBatch::ScreeningBatch(const std::vector<DesignInput>& designs, const Sc
       registry_(registry),
       options_(options),
       on_row_(writes ? std::move(on_row) : nullptr),
-      scene_hash_(hex(fnv1a(read_bytes(scene_file)))),
+      scene_text_(read_bytes(scene_file)),
+      scene_source_(scene_file.string()),
+      scene_hash_(hex(fnv1a(scene_text_))),
       material_(design_material(scene, options.material)),
       rows_(designs.size()) {
   parse_fidelity(options.fidelity);  // bad names fail the run, not every row
@@ -503,7 +555,7 @@ ScreeningBatch::ScreeningBatch(const std::vector<DesignInput>& designs, const Sc
   for (std::size_t i = 0; i < designs.size(); ++i)
     hashes_.push_back(row_hash(designs[i], scene_hash_,
                                options.fidelity + "|" + options.model + "|axis=" + options.axis +
-                                   (options.repair ? "|repair" : ""),
+                                   (options.repair ? "|repair" : "") + uncertainty_key(options),
                                material_));
   if (!writes || !options.out) return;
   const fs::path& out = *options.out;
@@ -518,6 +570,15 @@ ScreeningBatch::ScreeningBatch(const std::vector<DesignInput>& designs, const Sc
 }
 
 ScreeningBatch::~ScreeningBatch() = default;
+
+std::string ScreeningBatch::uncertainty_key(const ScreeningOptions& o) {
+  if (o.vary.empty()) return "";
+  std::string key = "|uncertainty=" + std::to_string(o.uncertainty.samples) + "," +
+                    std::to_string(o.uncertainty.seed) + "," +
+                    (o.uncertainty.latin_hypercube ? "lhs" : "mc");
+  for (const auto& v : o.vary) key += "," + v.text;
+  return key;
+}
 
 std::string ScreeningBatch::fingerprint() const {
   std::string all = std::to_string(designs_.size());
@@ -551,7 +612,8 @@ ScreeningRow ScreeningBatch::evaluate(std::size_t i) const {
   // Nothing may escape (a worker thread would terminate the process): whatever fails becomes
   // this design's error row and the others go on.
   try {
-    return evaluate_row(designs_[i], scene_, hashes_[i], material_, registry_, options_);
+    return evaluate_row(designs_[i], scene_, scene_text_, scene_source_, hashes_[i], material_,
+                        registry_, options_);
   } catch (const std::exception& e) {
     return error_row(designs_[i], e.what());
   }
@@ -602,6 +664,15 @@ std::vector<ScreeningRow> rank_rows(std::vector<ScreeningRow> rows) {
   std::stable_sort(rows.begin(), rows.end(), [](const ScreeningRow& a, const ScreeningRow& b) {
     if (a.ok != b.ok) return a.ok;
     if (!a.ok) return false;
+    // --uncertainty: the probability of passing first, then the median puncture depth
+    if (a.pass_probability && b.pass_probability) {
+      if (*a.pass_probability != *b.pass_probability)
+        return *a.pass_probability > *b.pass_probability;
+      if (a.median_puncture_depth_m.has_value() != b.median_puncture_depth_m.has_value())
+        return a.median_puncture_depth_m.has_value();
+      if (a.median_puncture_depth_m && *a.median_puncture_depth_m != *b.median_puncture_depth_m)
+        return *a.median_puncture_depth_m < *b.median_puncture_depth_m;
+    }
     if (a.puncture_depth_m.has_value() != b.puncture_depth_m.has_value())
       return a.puncture_depth_m.has_value();
     // A depth that is only the first step's says nothing about the tip: after resolved ones.

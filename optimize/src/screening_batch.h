@@ -32,6 +32,9 @@ class ScreeningBatch {
   std::size_t size() const { return designs_.size(); }
   const DesignInput& design(std::size_t i) const { return designs_[i]; }
 
+  /// What --uncertainty adds to the resume hash ("" without it).
+  static std::string uncertainty_key(const ScreeningOptions& o);
+
   /// The next design to evaluate (input order), or nothing once every design is dealt. A design
   /// an earlier run finished is recorded on the way and never dealt. Thread-safe.
   std::optional<std::size_t> claim();
@@ -58,6 +61,8 @@ class ScreeningBatch {
   const PluginRegistry& registry_;
   const ScreeningOptions& options_;
   std::function<void(const ScreeningRow&)> on_row_;
+  std::string scene_text_;
+  std::string scene_source_;
   std::string scene_hash_;
   std::string material_;
   std::vector<std::string> hashes_;           // of each design's inputs (the resume key)

@@ -249,6 +249,28 @@ UncertaintyResult run_uncertainty(const std::filesystem::path& scene_file,
                                   const std::vector<VariedValue>& inputs,
                                   const PluginRegistry& registry, const UncertaintyOptions& options,
                                   const std::function<void(int, int)>& on_sample) {
+  const fe::Fidelity fidelity = parse_fidelity(options.fidelity);
+  const PreModel model = parse_pre_model(options.model);
+  const std::string source = scene_file.string();
+  // The scene's own first needle, built again in each sampled scene (a varied needle.KEY moves it).
+  const SceneEvaluator evaluate = [&](const Scene& scene) {
+    if (scene.needles.empty()) throw InputError(source + ": the scene has no needle to evaluate");
+    const NeedleSource needle = needle_from_scene(registry, scene.needles.front());
+    EvaluationOptions o;
+    o.fidelity = fidelity;
+    o.model = model;
+    o.axisymmetric = axisymmetric_profile(registry, needle, source);
+    o.mirror_symmetric_y0 = o.axisymmetric.has_value() || mirror_symmetric_y0(needle.mesh);
+    return evaluate_design(needle.mesh, scene, design_material(scene, options.material), o);
+  };
+  return run_uncertainty(read_input_file(scene_file), source, inputs, options, evaluate, on_sample);
+}
+
+UncertaintyResult run_uncertainty(const std::string& text, const std::string& source,
+                                  const std::vector<VariedValue>& inputs,
+                                  const UncertaintyOptions& options,
+                                  const SceneEvaluator& evaluate_scene,
+                                  const std::function<void(int, int)>& on_sample) {
   if (inputs.empty()) throw InputError("uncertainty: nothing to vary (give --vary PATH=DIST)");
   if (inputs.size() > kMaxInputs)
     throw InputError("uncertainty: " + std::to_string(inputs.size()) + " --vary values (at most " +
@@ -256,10 +278,6 @@ UncertaintyResult run_uncertainty(const std::filesystem::path& scene_file,
   if (options.samples < 1 || options.samples > kMaxSamples)
     throw InputError("uncertainty: --samples " + std::to_string(options.samples) + " (from 1 to " +
                      std::to_string(kMaxSamples) + ")");
-  const fe::Fidelity fidelity = parse_fidelity(options.fidelity);
-  const PreModel model = parse_pre_model(options.model);
-  const std::string text = read_input_file(scene_file);
-  const std::string source = scene_file.string();
   // A scene with drawn values is the file re-serialised (keys sorted, comments gone): its
   // messages must not point at lines of the file.
   const std::string drawn_source = source + " (with drawn values)";
@@ -283,15 +301,7 @@ UncertaintyResult run_uncertainty(const std::filesystem::path& scene_file,
     const Scene scene = set.empty()
                             ? parse_scene(text, source)
                             : parse_scene(scene_with_values(text, source, set), drawn_source);
-    if (scene.needles.empty()) throw InputError(source + ": the scene has no needle to evaluate");
-    const NeedleSource needle = needle_from_scene(registry, scene.needles.front());
-    EvaluationOptions o;
-    o.fidelity = fidelity;
-    o.model = model;
-    o.axisymmetric = axisymmetric_profile(registry, needle, source);
-    o.mirror_symmetric_y0 = o.axisymmetric.has_value() || mirror_symmetric_y0(needle.mesh);
-    const DesignEvaluation e =
-        evaluate_design(needle.mesh, scene, design_material(scene, options.material), o);
+    const DesignEvaluation e = evaluate_scene(scene);
     s.ok = true;
     if (e.puncture) {
       s.puncture_depth_m = e.puncture->depth_m;

@@ -13,6 +13,7 @@
 #include "mneedle/design_evaluation.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
+#include "mneedle/uncertainty.h"
 
 namespace mneedle {
 
@@ -40,6 +41,12 @@ struct ScreeningOptions {
   std::string model = "auto";     // auto | analytic | axisymmetric | 3d
   std::string axis = "auto";      // mesh files: auto | x | y | z | a,b,c (parse_axis_choice)
   bool repair = false;            // mesh files: repair_mesh before validation
+  /// screen --uncertainty (docs/cli.md): with `vary` given, every design is also run in
+  /// uncertainty.samples scenes with those values drawn — the same draws for every design, so
+  /// that designs differ by their geometry, not by their luck — and ranked by its probability of
+  /// passing. uncertainty.jobs is ignored (the designs share the jobs).
+  std::vector<VariedValue> vary;
+  UncertaintyOptions uncertainty;
 };
 
 /// A two-stage curve as screening rows and optimize's summary write it: [{depth_m, force_N,
@@ -62,6 +69,8 @@ struct ScreeningRow {
   double margin = 0.0;
   bool passes = false;
   std::string frame_note;  // mesh files: how the axis, tip and a holder were found (or empty)
+  std::optional<double> pass_probability;  // screen --uncertainty: share of samples that pass
+  std::optional<double> median_puncture_depth_m;  // screen --uncertainty: of resolved punctures
 };
 
 /// Screens `designs` on `scene` (its file is `scene_file`, for the hash). Every design gets a row,
@@ -73,9 +82,10 @@ std::vector<ScreeningRow> screen_designs(
     const std::filesystem::path& scene_file, const PluginRegistry& registry,
     const ScreeningOptions& options, const std::function<void(const ScreeningRow&)>& on_row = {});
 
-/// Sorted for the table: successful rows first; designs that puncture by puncture depth, then
-/// puncture force; designs that never puncture after them (by peak force); error rows last in
-/// input order. Pass/fail does not reorder: it is a column.
+/// Sorted for the table: successful rows first; with --uncertainty by probability of passing
+/// (highest first), then median puncture depth; else (and between equal probabilities) designs
+/// that puncture by puncture depth, then puncture force; designs that never puncture after them
+/// (by peak force); error rows last in input order. Pass/fail does not reorder: it is a column.
 std::vector<ScreeningRow> rank_rows(std::vector<ScreeningRow> rows);
 
 }  // namespace mneedle

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "mneedle/base/units.h"
+#include "mneedle/design_evaluation.h"
 #include "mneedle/plugin_host.h"
 
 namespace mneedle {
@@ -121,6 +122,17 @@ struct UncertaintyResult {
 UncertaintyResult run_uncertainty(const std::filesystem::path& scene_file,
                                   const std::vector<VariedValue>& inputs,
                                   const PluginRegistry& registry, const UncertaintyOptions& options,
+                                  const std::function<void(int, int)>& on_sample = {});
+
+/// Evaluates one needle in one scene (the scene with a sample's values, or as written).
+using SceneEvaluator = std::function<DesignEvaluation(const Scene&)>;
+
+/// The same for any needle: `scene_text` is the scene (named `source` in messages) and
+/// `evaluate` runs the needle in it; screen --uncertainty passes each design's needle. Must be
+/// safe to call from several threads at once when options.jobs > 1.
+UncertaintyResult run_uncertainty(const std::string& scene_text, const std::string& source,
+                                  const std::vector<VariedValue>& inputs,
+                                  const UncertaintyOptions& options, const SceneEvaluator& evaluate,
                                   const std::function<void(int, int)>& on_sample = {});
 
 }  // namespace mneedle
