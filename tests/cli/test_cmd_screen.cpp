@@ -408,6 +408,22 @@ TEST(ScreenCommand, KilledAndResumedAgainAndAgainListsEveryDesignOnceWithUninter
   fs::remove_all(dir);
 }
 
+TEST(ScreenCommand, UncertaintyAndVaryNeedEachOtherAndABadPathFailsBeforeAnyDesign) {
+  const std::string designs = "'" + kRoot + "/designs' --scene '" + kSkin + "' --model analytic";
+  const auto no_vary = run_mneedle("screen " + designs + " --uncertainty 5");
+  EXPECT_EQ(no_vary.exit_code, 1);
+  EXPECT_NE(no_vary.err.find("--vary"), std::string::npos) << no_vary.err;
+  const auto no_samples =
+      run_mneedle("screen " + designs + " --vary 'dermis.E=uniform(1kPa,2kPa)'");
+  EXPECT_EQ(no_samples.exit_code, 1);
+  EXPECT_NE(no_samples.err.find("--uncertainty"), std::string::npos) << no_samples.err;
+  const auto bad = run_mneedle("screen " + designs +
+                               " --uncertainty 5 --vary 'dermis.Young=uniform(1kPa,2kPa)'");
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("dermis.Young"), std::string::npos) << bad.err;
+  EXPECT_EQ(bad.err.find("done"), std::string::npos) << "no design ran: " << bad.err;
+}
+
 #ifdef MNEEDLE_MPIEXEC
 // screen --mpi under the MPI launcher CMake found (docs/performance.md, "Screening on a cluster").
 // Two ranks on any machine (--oversubscribe); as root Open MPI wants the two variables below.

@@ -118,6 +118,41 @@ TEST_F(Screening, TwoJobsGiveTheRowsOfOneJobBitForBitAtOneBlasThreadEach) {
     EXPECT_EQ(without_timing(one[i].json), without_timing(two[i].json)) << one[i].design;
 }
 
+TEST_F(Screening, UncertaintyRanksByTheProbabilityOfPassingAndIsPartOfTheResumeHash) {
+  mneedle::ScreeningOptions options = analytic();
+  options.out = dir_ / "out";
+  options.vary = {mneedle::parse_varied_value("fracture.critical_pressure=uniform(0.5MPa,6MPa)")};
+  options.uncertainty.samples = 6;
+  options.uncertainty.seed = 3;
+  const auto designs = mneedle::collect_designs({dir_ / "in", dir_ / "list.toml"}, 1e-3);
+  const auto rows = mneedle::screen_designs(designs, scene_, scene_file_, registry_, options);
+  std::size_t sampled = 0;
+  for (const auto& r : rows) {
+    if (!r.ok) continue;
+    ASSERT_TRUE(r.pass_probability.has_value()) << r.design;
+    const auto j = nlohmann::json::parse(r.json);
+    EXPECT_EQ(j["uncertainty"]["samples"], 6);
+    EXPECT_EQ(j["uncertainty"]["pass_probability"].get<double>(), *r.pass_probability);
+    EXPECT_EQ(j["uncertainty"]["peak_force_N"]["count"].get<int>() +
+                  j["uncertainty"]["failed_samples"].get<int>(),
+              6);
+    ++sampled;
+  }
+  EXPECT_EQ(sampled, 4u);  // every design but the open box
+  const auto ranked = mneedle::rank_rows(rows);
+  for (std::size_t i = 1; i < ranked.size(); ++i)
+    if (ranked[i].ok) {
+      EXPECT_GE(*ranked[i - 1].pass_probability, *ranked[i].pass_probability) << i;
+    }
+  // The same settings resume; another seed is another run.
+  options.resume = true;
+  for (const auto& r : mneedle::screen_designs(designs, scene_, scene_file_, registry_, options))
+    EXPECT_TRUE(r.resumed || !r.ok) << r.design;
+  options.uncertainty.seed = 4;
+  for (const auto& r : mneedle::screen_designs(designs, scene_, scene_file_, registry_, options))
+    EXPECT_FALSE(r.resumed) << r.design;
+}
+
 TEST_F(Screening, ResumeRedoesOnlyWhatAKilledRunHadNotFinished) {
   mneedle::ScreeningOptions options = analytic();
   options.out = dir_ / "out";
