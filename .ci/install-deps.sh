@@ -21,6 +21,7 @@ packages=(
   calculix-ccx
   chromium fonts-liberation libgl1-mesa-dri
   libopenmpi-dev openmpi-bin
+  pybind11-dev pybind11-json-dev python3-dev python3-numpy python3-pytest python3-matplotlib
 )
 
 missing=()

@@ -13,7 +13,7 @@
 
 #include "commands.h"
 #include "json_output.h"
-#include "loads_json.h"
+#include "mneedle/api/loads_json.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
 #include "mneedle/design_source.h"

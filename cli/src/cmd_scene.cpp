@@ -12,7 +12,7 @@
 
 #include "commands.h"
 #include "json_output.h"
-#include "loads_json.h"
+#include "mneedle/api/loads_json.h"
 #include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
 #include "mneedle/insertion/insertion_run.h"

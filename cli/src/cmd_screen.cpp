@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "mneedle/api/screening_report.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/files.h"
 #include "mneedle/base/units.h"
@@ -221,23 +222,10 @@ void run_screen(const ScreenArgs& args) {
   std::size_t failed = 0;
   for (const auto& r : rows) failed += r.ok ? 0 : 1;
   if (args.json || !args.report.empty()) {
-    nlohmann::json out = {
-        {"scene", args.scene},
-        {"fidelity", options.fidelity},
-        {"model", options.model},
-        {"ranking", args.uncertainty > 0 ? nlohmann::json{"uncertainty.pass_probability",
-                                                          "uncertainty.puncture_depth_m.p50",
-                                                          "puncture_depth_m", "puncture_force_N"}
-                                         : nlohmann::json{"puncture_depth_m", "puncture_force_N"}},
-        {"designs", nlohmann::json::array()}};
-    for (const auto& r : rows) {
-      auto j = nlohmann::json::parse(r.json);
-      j["resumed"] = r.resumed;
-      out["designs"].push_back(j);
-    }
+    const nlohmann::json out = screening_json(rows, args.scene, options);
     // The report first: a design that failed still leaves every finished row in it.
     if (!args.report.empty()) write_report_folder(args.report, out, args.plugin_dirs);
-    if (args.json) print_checked_json(std::cout, out, "screen");
+    if (args.json) std::cout << with_provenance(out).dump(2) << "\n";
   }
   if (!args.json) {
     std::string material = args.material;

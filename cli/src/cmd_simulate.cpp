@@ -15,7 +15,7 @@
 
 #include "commands.h"
 #include "json_output.h"
-#include "loads_json.h"
+#include "mneedle/api/simulation.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
@@ -36,39 +36,19 @@ namespace {
 
 struct SimulateOptions {
   std::filesystem::path scene;
-  std::string fidelity;
-  std::string contact;
-  std::string criterion;
-  std::string model = "auto";
-  std::string axis;  // overrides the scene's STL needles' axis when given
+  SimulateSettings settings;
   std::string vtu;
   bool json = false;
-  bool no_reductions = false;
   bool csv = false;
   bool quiet = false;  // no progress line
   std::string plot;    // SVG of force against depth
   std::string report;  // folder for result.json and report.html
   std::vector<std::string> plugin_dirs;
-  std::size_t max_needles = 16;
 };
 
 InsertionRunOptions run_options(const Scene& scene, const SimulateOptions& o) {
-  InsertionRunOptions r = scene_run_options(scene);
-  if (o.fidelity == "fast") r.fidelity = fe::Fidelity::Fast;
-  if (o.fidelity == "standard") r.fidelity = fe::Fidelity::Standard;
-  if (o.fidelity == "fine") r.fidelity = fe::Fidelity::Fine;
-  if (o.contact == "sticking") r.contact = Contact::Sticking;
-  if (o.contact == "frictionless") r.contact = Contact::Frictionless;
-  if (o.criterion == "pressure") r.criterion = PunctureCriterion::Pressure;
-  if (o.criterion == "energy") r.criterion = PunctureCriterion::Energy;
-  if (o.criterion == "stress") r.criterion = PunctureCriterion::Stress;
-  r.model = o.model == "analytic"       ? PreModel::Analytic
-            : o.model == "axisymmetric" ? PreModel::Axisymmetric
-            : o.model == "3d"           ? PreModel::Full3d
-                                        : PreModel::Auto;
+  InsertionRunOptions r = simulate_run_options(scene, o.settings);
   r.vtu_directory = o.vtu;
-  r.max_fe_needles = o.max_needles;
-  r.allow_reductions = !o.no_reductions;
   if (r.vtu_directory.empty() && scene.model.wants(Output::Fields)) {
     // The scene asks for fields: write them beside the working directory, named after it.
     r.vtu_directory = o.scene.stem().string() + "_fields";
@@ -76,93 +56,6 @@ InsertionRunOptions run_options(const Scene& scene, const SimulateOptions& o) {
               << "/\n";
   }
   return r;
-}
-
-nlohmann::json point_json(const RunPoint& p, std::optional<PunctureCriterion> criterion) {
-  nlohmann::json j = {
-      {"depth_m", p.depth_m}, {"force_N", p.force_N}, {"stage", std::string(to_string(p.stage))}};
-  if (p.stage == Stage::Pre) {
-    j["lateral_force_N"] = {p.lateral_force_N[0], p.lateral_force_N[1]};
-    j["contact_area_m2"] = p.contact_area_m2;
-    j["contact_pressure_Pa"] = p.contact_pressure_Pa;
-    j["section_area_m2"] = p.section_area_m2;
-    j["section_pressure_Pa"] = p.section_pressure_Pa;
-    j["strain_energy_J"] = p.strain_energy_J;
-    if (criterion == PunctureCriterion::Stress) j["tip_stress_Pa"] = p.tip_stress_Pa;
-    if (criterion == PunctureCriterion::Energy)
-      j["energy_release_rate_J_per_m2"] = p.energy_release_rate_J_per_m2;
-  } else {
-    j["alpha_N"] = p.alpha_N;
-    j["beta_N"] = p.beta_N;
-    j["friction_N"] = p.friction_N;
-  }
-  return j;
-}
-
-nlohmann::json curve_json(const std::vector<RunPoint>& curve,
-                          std::optional<PunctureCriterion> criterion) {
-  nlohmann::json c = nlohmann::json::array();
-  for (const RunPoint& p : curve) c.push_back(point_json(p, criterion));
-  return c;
-}
-
-nlohmann::json energy_check_json(const std::optional<EnergyCheck>& check) {
-  if (!check) return nullptr;
-  return {{"depth_m", check->depth_m},
-          {"work_J", check->work_J},
-          {"strain_energy_J", check->strain_energy_J},
-          {"relative_difference", check->relative_difference},
-          {"tolerance", kEnergyCheckTolerance},
-          {"passes", check->passes}};
-}
-
-nlohmann::json to_json(const InsertionRun& run, const Scene& scene) {
-  nlohmann::json needles = nlohmann::json::array();
-  for (const NeedleRun& n : run.needles) {
-    nlohmann::json puncture = nullptr;
-    if (n.puncture)
-      puncture = {{"depth_m", n.puncture->depth_m},
-                  {"force_N", n.puncture->force_N},
-                  {"criterion", to_string(n.puncture->criterion)},
-                  {"post_force_N", n.puncture->post_force_N},
-                  {"at_first_contact", n.puncture->at_first_contact}};
-    needles.push_back({{"name", n.name},
-                       {"curve", curve_json(n.curve, run.criterion)},
-                       {"puncture", puncture},
-                       {"max_force_N", n.max_force_N}});
-  }
-  nlohmann::json mesh = {{"nodes", run.nodes},
-                         {"elements", run.elements},
-                         {"order", run.order},
-                         {"axisymmetric", run.axisymmetric}};
-  if (run.min_dihedral_deg > 0.0) {
-    mesh["min_dihedral_deg"] = run.min_dihedral_deg;
-    mesh["max_aspect_ratio"] = run.max_aspect_ratio;
-  }
-  nlohmann::json reductions = nlohmann::json::array();
-  for (const Reduction& r : run.reductions) {
-    nlohmann::json j = {{"name", r.name}, {"detail", r.detail}};
-    j["measured_effect"] = r.measured_effect ? nlohmann::json(*r.measured_effect) : nullptr;
-    reductions.push_back(j);
-  }
-  nlohmann::json criterion = nullptr;
-  if (run.criterion) {
-    criterion = {{"name", to_string(*run.criterion)}, {"threshold", *run.threshold}};
-    if (*run.criterion == PunctureCriterion::Energy) criterion["crack_depth_m"] = run.crack_depth_m;
-  }
-  return {{"needles", needles},
-          {"mesh", mesh},
-          {"total_curve", curve_json(run.total_curve, std::nullopt)},
-          {"models_run", run.models_run},
-          {"reductions", reductions},
-          {"fidelity", fe::to_string(run.fidelity)},
-          {"criterion", criterion},
-          {"loads", resolved_loads_json(scene)},
-          {"pre_puncture_horizon_m", run.horizon_m},
-          {"pre_puncture_step_m", run.first_step_m},
-          {"energy_check", energy_check_json(run.energy_check)},
-          {"peak_memory_bytes", run.peak_memory_bytes},
-          {"seconds", run.seconds}};
 }
 
 void print_csv(const InsertionRun& run) {
@@ -265,17 +158,13 @@ plot::Figure simulate_figure(const InsertionRun& run, const std::string& title) 
 
 void run(const SimulateOptions& o) {
   Scene scene = load_scene(o.scene);
-  if (!o.axis.empty()) {
-    parse_axis_choice(o.axis);
-    for (NeedleSpec& n : scene.needles) {
-      if (auto* stl = std::get_if<StlGeometry>(&n.geometry)) stl->axis = o.axis;
-    }
-  }
+  apply_simulate_settings(scene, o.settings);
   const PluginRegistry registry =
       PluginRegistry::discover({o.plugin_dirs.begin(), o.plugin_dirs.end()});
   // Checked before any needle is built: the finite element limit below would otherwise come
   // only after every mesh of a 10 000-needle scene was made.
-  const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene, o.max_needles);
+  const std::vector<PreparedNeedle> needles =
+      prepare_needles(registry, scene, o.settings.max_needles);
   record_scene(scene, o.scene);
   record_plugin_meshes(scene, needles);
   for (const PreparedNeedle& n : needles) {
@@ -292,12 +181,7 @@ void run(const SimulateOptions& o) {
   const InsertionRun result = run_insertion(scene, needles, options);
   progress.finish();
   // Every format prints the numbers of this tree: check them once, before anything is printed.
-  nlohmann::json tree = to_json(result, scene);
-  // What lets a report rebuild and check each needle: its mesh's hash and the axis override.
-  for (std::size_t i = 0; i < needles.size() && i < tree["needles"].size(); ++i)
-    tree["needles"][i]["mesh_sha256"] = mesh_sha256(needles[i].mesh);
-  if (!o.axis.empty()) tree["axis"] = o.axis;
-  require_finite_json(tree, o.scene.string());
+  const nlohmann::json tree = simulation_json(result, scene, needles, o.settings);
   if (result.energy_check && !result.energy_check->passes)
     std::cerr << "mneedle: warning: " << o.scene.string() << ": the tissue stores "
               << std::setprecision(3) << 100.0 * (1.0 + result.energy_check->relative_difference)
@@ -326,16 +210,17 @@ void add_simulate_command(CLI::App& app) {
       "Two-stage insertion: pre-puncture FE until the puncture criterion fires, then "
       "the post-puncture distributed loads");
   cmd->add_option("scene", options->scene, "scene file (TOML)")->required();
-  cmd->add_option("--fidelity", options->fidelity, "mesh fidelity (default: the scene's)")
+  cmd->add_option("--fidelity", options->settings.fidelity, "mesh fidelity (default: the scene's)")
       ->check(CLI::IsMember({"fast", "standard", "fine"}));
-  cmd->add_option("--contact", options->contact, "needle contact (default: the scene's)")
+  cmd->add_option("--contact", options->settings.contact, "needle contact (default: the scene's)")
       ->check(CLI::IsMember({"sticking", "frictionless"}));
-  cmd->add_option("--criterion", options->criterion, "puncture criterion (default: the scene's)")
+  cmd->add_option("--criterion", options->settings.criterion,
+                  "puncture criterion (default: the scene's)")
       ->check(CLI::IsMember({"pressure", "energy", "stress"}));
-  cmd->add_option("--axis", options->axis,
+  cmd->add_option("--axis", options->settings.axis,
                   "Axis of the scene's STL needles (overrides their axis key): auto, x, y, z or "
                   "a tip direction a,b,c");
-  cmd->add_option("--model", options->model,
+  cmd->add_option("--model", options->settings.model,
                   "pre-puncture model: auto (the planner decides), analytic, axisymmetric or 3d")
       ->check(CLI::IsMember({"auto", "analytic", "axisymmetric", "3d"}))
       ->capture_default_str();
@@ -346,11 +231,11 @@ void add_simulate_command(CLI::App& app) {
       "  mneedle simulate designs/scenes/human_skin.toml --criterion stress --json\n"
       "  mneedle simulate tests/assets/scenes/axisymmetric_punch.toml --csv");
   cmd->add_option("--plugin-dir", options->plugin_dirs, "Extra plugin folder (repeatable)");
-  cmd->add_option("--max-needles", options->max_needles,
+  cmd->add_option("--max-needles", options->settings.max_needles,
                   "Most needles the scene may hold (each finite element model holds them all)")
       ->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
-  cmd->add_flag("--no-reductions", options->no_reductions,
+  cmd->add_flag("--no-reductions", options->settings.no_reductions,
                 "solve the whole scene: no half model, layer merge or domain cut (to check them)");
   auto* json = cmd->add_flag("--json", options->json, "print the run as JSON");
   cmd->add_flag("--csv", options->csv, "print the curves as CSV")->excludes(json);

@@ -8,12 +8,11 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "mneedle/api/strength_report.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
 #include "mneedle/needle/needle_frame.h"
-#include "mneedle/strength/needle_strength.h"
-#include "mneedle/strength/section_table.h"
 #include "run_provenance.h"
 
 namespace mneedle::cli {
@@ -33,26 +32,6 @@ struct StrengthArgs {
   bool json = false;
 };
 
-// The plugin's analytic hook when it has one (exact, cheap); the sliced mesh otherwise.
-SectionTable section_table(const PluginRegistry& registry, const NeedleSource& needle) {
-  const int samples = 200;
-  if (!needle.plugin || !registry.shape(*needle.plugin).has_section_properties)
-    return SectionTable::from_mesh(needle.mesh, samples);
-  const double length = bounding_box(needle.mesh).max[2];
-  std::vector<double> heights;
-  std::vector<SectionProperties> sections;
-  for (int i = 0; i <= samples; ++i) {
-    const double h = length * i / samples;
-    const auto s = registry.section_properties(*needle.plugin, needle.params, h);
-    // The hook gives no fibre distance: 2√(I/A) is exact for a solid circle, an upper bound
-    // for a tube (conservative for the bending check).
-    const double fibre = s->area_m2 > 0 ? 2.0 * std::sqrt(s->i_min_m4 / s->area_m2) : 0.0;
-    heights.push_back(h);
-    sections.push_back({s->area_m2, s->i_min_m4, fibre});
-  }
-  return SectionTable(std::move(heights), std::move(sections));
-}
-
 void run_strength(const StrengthArgs& args) {
   if (args.file.empty() == args.plugin.empty())
     throw InputError("strength: give either a mesh FILE or --plugin NAME");
@@ -69,51 +48,31 @@ void run_strength(const StrengthArgs& args) {
     record_mesh(needle.name, needle.mesh);
   else
     record_input("needle", args.file);
-  const NeedleMaterial material = find_needle_material(args.material);
-  const SectionTable table = section_table(registry, needle);
-
-  StrengthOptions options;
-  options.length_m = table.length_m();
-  options.end = parse_end_condition(args.end);
-  options.lateral_ratio = args.lateral_ratio;
-  options.load_height_m =
-      args.depth.empty() ? table.tip_length_m() : parse_quantity(args.depth, Dimension::Length);
-  const StrengthReport r = needle_strength(table.profile(), material, options);
-
-  nlohmann::json out = {{"needle", needle.name},
-                        {"material", material.name},
-                        {"E_Pa", material.youngs_modulus_pa},
-                        {"strength_Pa", material.strength_pa},
-                        {"failure_mode", failure_mode_name(material.failure)},
-                        {"end", end_condition_name(options.end)},
-                        {"effective_length_factor", effective_length_factor(options.end)},
-                        {"length_m", options.length_m},
-                        {"load_height_m", options.load_height_m},
-                        {"I_min_m4", r.i_min_m4},
-                        {"A_min_m2", r.a_min_m2},
-                        {"elastic_buckling_N", r.elastic_buckling_n},
-                        {"johnson", r.johnson},
-                        {"buckling_N", r.buckling_n},
-                        {"strength_N", r.strength_n},
-                        {"critical_height_m", r.critical_height_m},
-                        {"capacity_N", r.capacity_n},
-                        {"governing", r.governing}};
-  // Text and JSON print the same numbers: check them once, before either.
-  require_finite_json(out, "strength");
+  StrengthSettings settings;
+  settings.material = args.material;
+  settings.end = args.end;
+  settings.depth = args.depth;
+  settings.lateral_ratio = args.lateral_ratio;
+  // Text and JSON print the same numbers, checked once by strength_report.
+  const nlohmann::json out = strength_report(registry, needle, settings);
   if (args.json) {
     std::cout << with_provenance(out).dump(2) << "\n";
     return;
   }
-  std::cout << needle.name << " in " << material.name << " (" << end_condition_name(options.end)
-            << ", loaded from " << format_quantity(options.load_height_m, Dimension::Length)
-            << " above the tip)\n"
-            << "  buckling:  " << format_quantity(r.buckling_n, Dimension::Force)
-            << (r.johnson ? "  (Johnson, inelastic)" : "  (Euler, elastic)") << "\n"
-            << "  strength:  " << format_quantity(r.strength_n, Dimension::Force) << "  ("
-            << failure_mode_name(material.failure) << " at "
-            << format_quantity(r.critical_height_m, Dimension::Length) << " above the tip)\n"
-            << "  capacity:  " << format_quantity(r.capacity_n, Dimension::Force)
-            << "  governed by " << r.governing << "\n";
+  const auto q = [&](const char* key, Dimension d) {
+    return format_quantity(out[key].get<double>(), d);
+  };
+  std::cout << needle.name << " in " << out["material"].get<std::string>() << " ("
+            << out["end"].get<std::string>() << ", loaded from "
+            << q("load_height_m", Dimension::Length) << " above the tip)\n"
+            << "  buckling:  " << q("buckling_N", Dimension::Force)
+            << (out["johnson"].get<bool>() ? "  (Johnson, inelastic)" : "  (Euler, elastic)")
+            << "\n"
+            << "  strength:  " << q("strength_N", Dimension::Force) << "  ("
+            << out["failure_mode"].get<std::string>() << " at "
+            << q("critical_height_m", Dimension::Length) << " above the tip)\n"
+            << "  capacity:  " << q("capacity_N", Dimension::Force) << "  governed by "
+            << out["governing"].get<std::string>() << "\n";
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "mneedle/api/fit_report.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
 #include "mneedle/measurement/anova.h"
@@ -32,16 +33,7 @@
 namespace mneedle::cli {
 namespace {
 
-struct CurveArgs {
-  std::string depth_col;
-  std::string force_col;
-  std::string depth_unit;
-  std::string force_unit;
-  std::string speed;  // empty = from the time column
-  std::string angle = "90deg";
-};
-
-void add_curve_options(CLI::App* cmd, CurveArgs& a) {
+void add_curve_options(CLI::App* cmd, CurveSettings& a) {
   cmd->add_option("--depth-col", a.depth_col,
                   "Depth/travel column (default: depth*, travel*, ...)");
   cmd->add_option("--force-col", a.force_col, "Force column (default: force*, fz*, ...)");
@@ -54,105 +46,15 @@ void add_curve_options(CLI::App* cmd, CurveArgs& a) {
       ->capture_default_str();
 }
 
-struct LoadedCurve {
-  LoadingBranch branch;
-  FitCurve curve;
-};
-
-LoadedCurve load_curve(const std::string& file, const CurveArgs& a) {
-  const CurveColumns columns{a.depth_col, a.force_col, "", a.depth_unit, a.force_unit};
-  LoadedCurve out;
-  out.branch = extract_loading_branch(read_force_curve_csv(file, columns));
-  record_input("curve", file);
-  out.curve.name = std::filesystem::path(file).filename().string();
-  out.curve.depth_m = out.branch.curve.depth_m;
-  out.curve.force_N = out.branch.curve.force_N;
-  out.curve.conditions.speed_m_per_s =
-      a.speed.empty() ? loading_speed(out.branch) : parse_quantity(a.speed, Dimension::Speed);
-  out.curve.conditions.angle_rad = parse_quantity(a.angle, Dimension::Angle);
-  return out;
-}
-
-Dimension parameter_dimension(const std::string& name) {
-  const auto base =
-      name.substr(0, name.rfind("_L") == std::string::npos ? name.size() : name.rfind("_L"));
-  const auto ends = [&](std::string_view s) {
-    return base.size() >= s.size() && base.compare(base.size() - s.size(), s.size(), s) == 0;
-  };
-  if (ends("_per_m") || ends("_per_m2") || ends("_Ns")) return Dimension::Dimensionless;
-  if (ends("_N")) return Dimension::Force;
-  if (ends("_m")) return Dimension::Length;
-  if (ends("_s")) return Dimension::Time;
-  return Dimension::Dimensionless;
-}
-
-std::pair<std::string, double> parse_fix(const std::string& text) {
-  const auto eq = text.find('=');
-  if (eq == std::string::npos || eq == 0) {
-    throw InputError("--fix '" + text + "': expected NAME=VALUE, e.g. mu=0.2");
-  }
-  const std::string name = text.substr(0, eq);
-  return {name, parse_quantity(text.substr(eq + 1), parameter_dimension(name))};
-}
-
-nlohmann::json finite_or_null(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
-}
-
 // ---------------------------------------------------------------- fit
 struct FitArgs {
   std::vector<std::string> files;
   std::string model = "triforce";
-  CurveArgs curve;
-  std::vector<std::string> fix;
-  std::vector<std::string> free;
-  std::vector<std::string> layer_starts;
-  std::size_t detect_layers = 0;
-  int starts = 8;
+  FitSettings settings;
   bool json = false;
   std::string out_dir;
   std::string plot;  // SVG: each curve measured (dots) and fitted (line)
 };
-
-nlohmann::json fit_json(const TriforceFit& fit, const std::vector<LoadedCurve>& curves) {
-  nlohmann::json params = nlohmann::json::object(), errors = nlohmann::json::object();
-  nlohmann::json fixed = nlohmann::json::array();
-  for (const auto& p : fit.parameters) {
-    params[p.name] = p.value;
-    if (p.fitted) {
-      errors[p.name] = finite_or_null(p.standard_error);
-    } else {
-      fixed.push_back(p.name);
-    }
-  }
-  nlohmann::json list = nlohmann::json::array();
-  for (std::size_t i = 0; i < curves.size(); ++i) {
-    const auto& c = fit.curves[i];
-    const auto& loaded = curves[i];
-    list.push_back({{"file", c.name},
-                    {"rmse_N", c.metrics.rmse_N},
-                    {"r2", c.metrics.r2},
-                    {"max_error_N", c.metrics.max_error_N},
-                    {"samples", c.metrics.samples},
-                    {"offset_m", c.offset_m},
-                    {"offset_stderr_m", finite_or_null(c.offset_standard_error_m)},
-                    {"contact_travel_m", loaded.branch.contact_travel_m},
-                    {"speed_m_per_s", loaded.curve.conditions.speed_m_per_s},
-                    {"angle_rad", loaded.curve.conditions.angle_rad},
-                    {"peak_force_N",
-                     *std::max_element(loaded.curve.force_N.begin(), loaded.curve.force_N.end())},
-                    {"loading_branch", loaded.branch.summary}});
-  }
-  return {{"model", "triforce"},
-          {"params", params},
-          {"stderr", errors},
-          {"fixed", fixed},
-          {"curves", list},
-          {"residual_sd_N", fit.residual_sd_N},
-          {"samples_fitted", fit.samples},
-          {"converged", fit.converged},
-          {"starts", fit.starts}};
-}
 
 void print_fit(const TriforceFit& fit, const std::vector<LoadedCurve>& curves) {
   for (const auto& c : curves) std::cout << c.branch.summary << "\n";
@@ -202,40 +104,16 @@ void write_fit_files(const std::string& dir, const nlohmann::json& report, const
 void run_fit(const FitArgs& args) {
   if (args.model != "triforce")
     throw InputError("fit: unknown --model '" + args.model + "' (known: triforce)");
-  std::vector<LoadedCurve> curves;
-  std::vector<FitCurve> data;
-  for (const auto& f : args.files) {
-    curves.push_back(load_curve(f, args.curve));
-    data.push_back(curves.back().curve);
+  for (const auto& f : args.files) record_input("curve", f);
+  const FitOutcome outcome = fit_recordings(args.files, args.settings);
+  const TriforceFit& fit = outcome.fit;
+  const std::vector<LoadedCurve>& curves = outcome.curves;
+  const nlohmann::json& report = outcome.report;
+  if (args.settings.detect_layers > 1 && !args.json) {
+    std::cout << "layers start at (mm):";
+    for (double start : outcome.initial_layer_starts_m) std::cout << " " << start * 1e3;
+    std::cout << "\n";
   }
-  TriforceFitOptions options;
-  options.starts = args.starts;
-  for (const auto& s : args.layer_starts) {
-    TriforceLayer layer = options.initial.layers.back();
-    layer.start_m = parse_quantity(s, Dimension::Length);
-    options.initial.layers.push_back(layer);
-  }
-  if (args.detect_layers > 1) {
-    // Boundaries from the slope changes of the first curve (paper B's layer reading).
-    const auto& first = curves.front().curve;
-    for (double start : detect_layer_boundaries(first.depth_m, first.force_N, args.detect_layers)) {
-      TriforceLayer layer = options.initial.layers.back();
-      layer.start_m = start;
-      options.initial.layers.push_back(layer);
-    }
-    std::sort(options.initial.layers.begin(), options.initial.layers.end(),
-              [](const auto& a, const auto& b) { return a.start_m < b.start_m; });
-    if (!args.json) {
-      std::cout << "layers start at (mm):";
-      for (const auto& l : options.initial.layers) std::cout << " " << l.start_m * 1e3;
-      std::cout << "\n";
-    }
-  }
-  for (const auto& text : args.fix) options.fixed.insert(parse_fix(text));
-  options.free = args.free;
-  const auto fit = fit_triforce(data, options);
-  const auto report = fit_json(fit, curves);
-  require_finite_json(report, "fit");
   if (!args.out_dir.empty()) write_fit_files(args.out_dir, report, fit, curves);
   if (!args.plot.empty()) {
     plot::Figure f;
@@ -271,7 +149,7 @@ struct PredictArgs {
   double frequency_Hz = 1000.0;
   std::size_t max_samples = 20'000'000;
   std::string compare;
-  CurveArgs curve;
+  CurveSettings curve;
   bool csv = false;
   bool json = false;
   std::string plot;  // SVG: the predicted force against depth (and --compare's curve)
@@ -345,10 +223,11 @@ void run_predict(const PredictArgs& args) {
   }
   std::optional<LoadedCurve> measured;
   if (!args.compare.empty()) {
-    CurveArgs c = args.curve;
+    CurveSettings c = args.curve;
     c.speed = args.speed;
     c.angle = args.angle;
-    measured = load_curve(args.compare, c);
+    record_input("curve", args.compare);
+    measured = load_fit_curve(args.compare, c);
   }
   if (!args.depth.empty()) {
     protocol.max_depth_m = parse_quantity(args.depth, Dimension::Length);
@@ -527,15 +406,16 @@ void add_fit_command(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--model", args->model, "Force model")->capture_default_str();
-  add_curve_options(cmd, args->curve);
-  cmd->add_option("--fix", args->fix, "Hold a parameter, NAME=VALUE (e.g. beta=0, eta_Ns=0.5)");
-  cmd->add_option("--free", args->free,
+  add_curve_options(cmd, args->settings.curve);
+  cmd->add_option("--fix", args->settings.fix,
+                  "Hold a parameter, NAME=VALUE (e.g. beta=0, eta_Ns=0.5)");
+  cmd->add_option("--free", args->settings.free,
                   "Fit exactly these parameters (default: the material ones)");
-  cmd->add_option("--layer-start", args->layer_starts,
+  cmd->add_option("--layer-start", args->settings.layer_starts,
                   "Add a layer starting at this travel (e.g. 8mm)");
-  cmd->add_option("--detect-layers", args->detect_layers,
+  cmd->add_option("--detect-layers", args->settings.detect_layers,
                   "Up to N layers, boundaries from slope changes of the first curve");
-  cmd->add_option("--starts", args->starts, "Number of Levenberg-Marquardt starts")
+  cmd->add_option("--starts", args->settings.starts, "Number of Levenberg-Marquardt starts")
       ->capture_default_str();
   cmd->add_flag("--json", args->json, "Print the fit as JSON");
   cmd->add_option("--plot", args->plot, "Write each curve measured and fitted as SVG");

@@ -1,5 +1,5 @@
-// The output gate: every NaN/Inf in a JSON tree, a CSV row or a single number is refused with a
-// SolverError that names where it is; finite trees pass unchanged.
+// Printing a command's JSON: a finite tree is printed with the run's provenance; a tree with a
+// NaN or Inf prints nothing (the gate itself: tests/api/test_finite_json.cpp).
 #include "json_output.h"
 
 #include <gtest/gtest.h>
@@ -14,23 +14,12 @@ namespace mneedle::cli {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
-std::string message_of(const auto& call) {
-  try {
-    call();
-  } catch (const SolverError& e) {
-    return e.what();
-  }
-  return "no SolverError";
-}
-
-TEST(JsonOutput, FiniteTreePassesAndPrints) {
+TEST(JsonOutput, FiniteTreePrintsWithProvenance) {
   const nlohmann::json tree = {{"needles", {{{"name", "a"}, {"force_N", 1.5e-3}, {"n", 3}}}},
                                {"ok", true},
                                {"missing", nullptr},
                                {"max_double", std::numeric_limits<double>::max()}};
-  EXPECT_NO_THROW(require_finite_json(tree, "force"));
   std::ostringstream out;
   print_checked_json(out, tree, "force");
   nlohmann::json printed = nlohmann::json::parse(out.str());
@@ -41,46 +30,10 @@ TEST(JsonOutput, FiniteTreePassesAndPrints) {
   EXPECT_EQ(printed, tree);
 }
 
-TEST(JsonOutput, NaNDeepInAnArrayIsNamedByItsPath) {
-  nlohmann::json tree = {{"needles", nlohmann::json::array()}};
-  tree["needles"].push_back({{"name", "a"}, {"curve", {{{"depth_m", 0.0}, {"force_N", 0.0}}}}});
-  tree["needles"].push_back(
-      {{"name", "b"}, {"curve", {{{"depth_m", 0.0}, {"force_N", 1.0}}, {{"force_N", kNaN}}}}});
-  const std::string m = message_of([&] { require_finite_json(tree, "mneedle force"); });
-  EXPECT_EQ(m, "mneedle force: non-finite value NaN at needles[1].curve[1].force_N");
-}
-
-TEST(JsonOutput, InfinityIsRefusedWithItsSign) {
-  nlohmann::ordered_json tree = {{"a", {{"b", -kInf}}}};
-  EXPECT_EQ(message_of([&] { require_finite_json(tree, "scene"); }),
-            "scene: non-finite value -Inf at a.b");
-  tree = {{"x", {1.0, kInf}}};
-  EXPECT_EQ(message_of([&] { require_finite_json(tree, "scene"); }),
-            "scene: non-finite value +Inf at x[1]");
-}
-
-TEST(JsonOutput, TopLevelNumberIsNamed) {
-  EXPECT_EQ(message_of([] { require_finite_json(nlohmann::json(kNaN), "c"); }),
-            "c: non-finite value NaN at the top level");
-}
-
 TEST(JsonOutput, PrintWritesNothingWhenTheTreeIsNotFinite) {
   std::ostringstream out;
   EXPECT_THROW(print_checked_json(out, nlohmann::json{{"v", kNaN}}, "c"), SolverError);
   EXPECT_TRUE(out.str().empty());
-}
-
-TEST(JsonOutput, SingleNumbersAndCsvRows) {
-  EXPECT_EQ(require_finite(2.5, "force_N", "c"), 2.5);
-  EXPECT_EQ(message_of([] { require_finite(kNaN, "force_N", "strength"); }),
-            "strength: non-finite value NaN at force_N");
-  EXPECT_NO_THROW(require_finite_row({1.0, 2.0}, {"depth_m", "force_N"}, "row 1", "c"));
-  EXPECT_EQ(message_of([] {
-              require_finite_row({1.0, kInf}, {"depth_m", "force_N"}, "needle a, row 4", "csv");
-            }),
-            "csv: non-finite value +Inf at needle a, row 4, force_N");
-  EXPECT_EQ(message_of([] { require_finite_row({kNaN}, {}, "row 2", "csv"); }),
-            "csv: non-finite value NaN at row 2, column 1");
 }
 
 }  // namespace

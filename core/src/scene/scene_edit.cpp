@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "mneedle/base/error.h"
+#include "mneedle/base/files.h"
 
 namespace mneedle {
 namespace {
@@ -88,6 +89,21 @@ std::string edited_scene_text(const std::filesystem::path& scene_file,
   for (const std::string& line : edits.header_comment) text << "# " << line << "\n";
   text << root << "\n";
   return text.str();
+}
+
+std::string scene_values_json(const std::filesystem::path& scene_file) {
+  const std::string text = read_input_file(scene_file);
+  toml::table root;
+  try {
+    root = toml::parse(text, scene_file.string());
+  } catch (const toml::parse_error& e) {
+    throw InputError(scene_file.string() + ":" + std::to_string(e.source().begin.line) + ": " +
+                     std::string(e.description()));
+  }
+  make_stl_paths_absolute(root, scene_file.parent_path());
+  std::ostringstream json;
+  json << toml::json_formatter{root};
+  return json.str();
 }
 
 }  // namespace mneedle

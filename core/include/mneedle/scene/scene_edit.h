@@ -28,4 +28,10 @@ std::string edited_scene_text(const std::filesystem::path& scene_file,
                               const SceneConstantEdits& edits,
                               const std::filesystem::path& out_file);
 
+/// The scene file's values as JSON text (toml++'s JSON form: tables as objects, quantities as
+/// their strings), STL paths made absolute so that the values stand anywhere — what Python's
+/// read_scene returns as a dict (docs/python.md). InputError "<file>: <problem>" for a file
+/// that is missing or not TOML; the scene's keys are checked when it is run, not here.
+std::string scene_values_json(const std::filesystem::path& scene_file);
+
 }  // namespace mneedle

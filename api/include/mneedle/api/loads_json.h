@@ -8,7 +8,7 @@
 
 #include "mneedle/scene/scene.h"
 
-namespace mneedle::cli {
+namespace mneedle {
 
 /// {"mode": ..., "beta_length_m": l or null (= each needle's R_ref), "layers": [{"name",
 /// "pressure_scale_Pa", "wall_pressure_cap_Pa" (null: none), "source"}]}.
@@ -17,4 +17,4 @@ nlohmann::json resolved_loads_json(const Scene& scene);
 /// One line per layer: "  q stratum_corneum 2.0e8 Pa (wall cap 21.6 MPa): derived ...".
 std::string resolved_loads_text(const Scene& scene);
 
-}  // namespace mneedle::cli
+}  // namespace mneedle

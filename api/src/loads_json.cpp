@@ -1,4 +1,4 @@
-#include "loads_json.h"
+#include "mneedle/api/loads_json.h"
 
 #include <cmath>
 #include <sstream>
@@ -6,7 +6,7 @@
 #include "mneedle/base/units.h"
 #include "mneedle/insertion/surface_loads.h"
 
-namespace mneedle::cli {
+namespace mneedle {
 
 nlohmann::json resolved_loads_json(const Scene& scene) {
   const LoadConstants constants = load_constants(scene);
@@ -57,4 +57,4 @@ std::string resolved_loads_text(const Scene& scene) {
   return out.str();
 }
 
-}  // namespace mneedle::cli
+}  // namespace mneedle

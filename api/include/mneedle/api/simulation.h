@@ -1,0 +1,44 @@
+#pragma once
+// `simulate` as a library call: the settings a user gives (the CLI's options, the Python
+// keywords) turned into run options, and a finished run turned into the JSON tree both print.
+// One tree for both, so the CLI and Python give the same keys and the same numbers
+// (docs/cli.md, "simulate"; docs/python.md).
+
+#include <cstddef>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "mneedle/insertion/insertion_run.h"
+#include "mneedle/scene/scene.h"
+
+namespace mneedle {
+
+/// What may override the scene's own choices; an empty string keeps the scene's.
+struct SimulateSettings {
+  std::string fidelity;        // fast | standard | fine
+  std::string contact;         // sticking | frictionless
+  std::string criterion;       // pressure | energy | stress
+  std::string model = "auto";  // auto | analytic | axisymmetric | 3d
+  std::string axis;            // the scene's STL needles' axis (parse_axis_choice)
+  std::size_t max_needles = 16;
+  bool no_reductions = false;
+};
+
+/// Checks every setting (one-line InputError naming it) and applies `axis` to the scene's mesh
+/// file needles.
+void apply_simulate_settings(Scene& scene, const SimulateSettings& settings);
+
+/// The scene's run options with the settings applied (fields output is the caller's).
+InsertionRunOptions simulate_run_options(const Scene& scene, const SimulateSettings& settings);
+
+/// The run as `simulate --json` prints it (without provenance): needles with curves and
+/// punctures, mesh, total curve, models, reductions, criterion, loads, energy check, memory and
+/// time; each needle's mesh hash; `axis` when the settings gave one. Checked finite
+/// (SolverError naming the first NaN or Inf).
+nlohmann::json simulation_json(const InsertionRun& run, const Scene& scene,
+                               const std::vector<PreparedNeedle>& needles,
+                               const SimulateSettings& settings);
+
+}  // namespace mneedle

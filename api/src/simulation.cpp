@@ -1,0 +1,167 @@
+#include "mneedle/api/simulation.h"
+
+#include <initializer_list>
+#include <optional>
+#include <string>
+#include <variant>
+
+#include "mneedle/api/finite_json.h"
+#include "mneedle/api/loads_json.h"
+#include "mneedle/base/error.h"
+#include "mneedle/fe/tissue_mesh.h"
+#include "mneedle/insertion/energy_check.h"
+#include "mneedle/needle/mesh.h"
+#include "mneedle/needle/needle_frame.h"
+
+namespace mneedle {
+namespace {
+
+// A setting outside its list is a one-line error naming it (the CLI's own check says the same
+// before this; a Python caller meets this one).
+void check_choice(const std::string& name, const std::string& value,
+                  std::initializer_list<const char*> allowed, bool empty_ok) {
+  if (empty_ok && value.empty()) return;
+  std::string list;
+  for (const char* a : allowed) {
+    if (value == a) return;
+    list += (list.empty() ? "" : ", ") + std::string(a);
+  }
+  throw InputError("simulate: " + name + " '" + value + "' is not one of " + list);
+}
+
+nlohmann::json point_json(const RunPoint& p, std::optional<PunctureCriterion> criterion) {
+  nlohmann::json j = {
+      {"depth_m", p.depth_m}, {"force_N", p.force_N}, {"stage", std::string(to_string(p.stage))}};
+  if (p.stage == Stage::Pre) {
+    j["lateral_force_N"] = {p.lateral_force_N[0], p.lateral_force_N[1]};
+    j["contact_area_m2"] = p.contact_area_m2;
+    j["contact_pressure_Pa"] = p.contact_pressure_Pa;
+    j["section_area_m2"] = p.section_area_m2;
+    j["section_pressure_Pa"] = p.section_pressure_Pa;
+    j["strain_energy_J"] = p.strain_energy_J;
+    if (criterion == PunctureCriterion::Stress) j["tip_stress_Pa"] = p.tip_stress_Pa;
+    if (criterion == PunctureCriterion::Energy)
+      j["energy_release_rate_J_per_m2"] = p.energy_release_rate_J_per_m2;
+  } else {
+    j["alpha_N"] = p.alpha_N;
+    j["beta_N"] = p.beta_N;
+    j["friction_N"] = p.friction_N;
+  }
+  return j;
+}
+
+nlohmann::json curve_json(const std::vector<RunPoint>& curve,
+                          std::optional<PunctureCriterion> criterion) {
+  nlohmann::json c = nlohmann::json::array();
+  for (const RunPoint& p : curve) c.push_back(point_json(p, criterion));
+  return c;
+}
+
+nlohmann::json energy_check_json(const std::optional<EnergyCheck>& check) {
+  if (!check) return nullptr;
+  return {{"depth_m", check->depth_m},
+          {"work_J", check->work_J},
+          {"strain_energy_J", check->strain_energy_J},
+          {"relative_difference", check->relative_difference},
+          {"tolerance", kEnergyCheckTolerance},
+          {"passes", check->passes}};
+}
+
+nlohmann::json run_json(const InsertionRun& run, const Scene& scene) {
+  nlohmann::json needles = nlohmann::json::array();
+  for (const NeedleRun& n : run.needles) {
+    nlohmann::json puncture = nullptr;
+    if (n.puncture)
+      puncture = {{"depth_m", n.puncture->depth_m},
+                  {"force_N", n.puncture->force_N},
+                  {"criterion", to_string(n.puncture->criterion)},
+                  {"post_force_N", n.puncture->post_force_N},
+                  {"at_first_contact", n.puncture->at_first_contact}};
+    needles.push_back({{"name", n.name},
+                       {"curve", curve_json(n.curve, run.criterion)},
+                       {"puncture", puncture},
+                       {"max_force_N", n.max_force_N}});
+  }
+  nlohmann::json mesh = {{"nodes", run.nodes},
+                         {"elements", run.elements},
+                         {"order", run.order},
+                         {"axisymmetric", run.axisymmetric}};
+  if (run.min_dihedral_deg > 0.0) {
+    mesh["min_dihedral_deg"] = run.min_dihedral_deg;
+    mesh["max_aspect_ratio"] = run.max_aspect_ratio;
+  }
+  nlohmann::json reductions = nlohmann::json::array();
+  for (const Reduction& r : run.reductions) {
+    nlohmann::json j = {{"name", r.name}, {"detail", r.detail}};
+    j["measured_effect"] = r.measured_effect ? nlohmann::json(*r.measured_effect) : nullptr;
+    reductions.push_back(j);
+  }
+  nlohmann::json criterion = nullptr;
+  if (run.criterion) {
+    criterion = {{"name", to_string(*run.criterion)}, {"threshold", *run.threshold}};
+    if (*run.criterion == PunctureCriterion::Energy) criterion["crack_depth_m"] = run.crack_depth_m;
+  }
+  return {{"needles", needles},
+          {"mesh", mesh},
+          {"total_curve", curve_json(run.total_curve, std::nullopt)},
+          {"models_run", run.models_run},
+          {"reductions", reductions},
+          {"fidelity", fe::to_string(run.fidelity)},
+          {"criterion", criterion},
+          {"loads", resolved_loads_json(scene)},
+          {"pre_puncture_horizon_m", run.horizon_m},
+          {"pre_puncture_step_m", run.first_step_m},
+          {"energy_check", energy_check_json(run.energy_check)},
+          {"peak_memory_bytes", run.peak_memory_bytes},
+          {"seconds", run.seconds}};
+}
+
+}  // namespace
+
+void apply_simulate_settings(Scene& scene, const SimulateSettings& s) {
+  check_choice("fidelity", s.fidelity, {"fast", "standard", "fine"}, true);
+  check_choice("contact", s.contact, {"sticking", "frictionless"}, true);
+  check_choice("criterion", s.criterion, {"pressure", "energy", "stress"}, true);
+  check_choice("model", s.model, {"auto", "analytic", "axisymmetric", "3d"}, false);
+  if (s.max_needles < 1 || s.max_needles > 100000)
+    throw InputError("simulate: max_needles " + std::to_string(s.max_needles) +
+                     " (from 1 to 100000)");
+  if (s.axis.empty()) return;
+  parse_axis_choice(s.axis);
+  for (NeedleSpec& n : scene.needles) {
+    if (auto* stl = std::get_if<StlGeometry>(&n.geometry)) stl->axis = s.axis;
+  }
+}
+
+InsertionRunOptions simulate_run_options(const Scene& scene, const SimulateSettings& s) {
+  InsertionRunOptions r = scene_run_options(scene);
+  if (s.fidelity == "fast") r.fidelity = fe::Fidelity::Fast;
+  if (s.fidelity == "standard") r.fidelity = fe::Fidelity::Standard;
+  if (s.fidelity == "fine") r.fidelity = fe::Fidelity::Fine;
+  if (s.contact == "sticking") r.contact = Contact::Sticking;
+  if (s.contact == "frictionless") r.contact = Contact::Frictionless;
+  if (s.criterion == "pressure") r.criterion = PunctureCriterion::Pressure;
+  if (s.criterion == "energy") r.criterion = PunctureCriterion::Energy;
+  if (s.criterion == "stress") r.criterion = PunctureCriterion::Stress;
+  r.model = s.model == "analytic"       ? PreModel::Analytic
+            : s.model == "axisymmetric" ? PreModel::Axisymmetric
+            : s.model == "3d"           ? PreModel::Full3d
+                                        : PreModel::Auto;
+  r.max_fe_needles = s.max_needles;
+  r.allow_reductions = !s.no_reductions;
+  return r;
+}
+
+nlohmann::json simulation_json(const InsertionRun& run, const Scene& scene,
+                               const std::vector<PreparedNeedle>& needles,
+                               const SimulateSettings& settings) {
+  nlohmann::json tree = run_json(run, scene);
+  // What lets a report rebuild and check each needle: its mesh's hash and the axis override.
+  for (std::size_t i = 0; i < needles.size() && i < tree["needles"].size(); ++i)
+    tree["needles"][i]["mesh_sha256"] = mesh_sha256(needles[i].mesh);
+  if (!settings.axis.empty()) tree["axis"] = settings.axis;
+  require_finite_json(tree, scene.source_name);
+  return tree;
+}
+
+}  // namespace mneedle

@@ -1,0 +1,77 @@
+#include "mneedle/api/strength_report.h"
+
+#include <cmath>
+#include <vector>
+
+#include "mneedle/api/finite_json.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
+#include "mneedle/strength/needle_strength.h"
+#include "mneedle/strength/section_table.h"
+
+namespace mneedle {
+namespace {
+
+// The plugin's analytic hook when it has one (exact, cheap); the sliced mesh otherwise.
+SectionTable section_table(const PluginRegistry& registry, const NeedleSource& needle) {
+  const int samples = 200;
+  if (!needle.plugin || !registry.shape(*needle.plugin).has_section_properties)
+    return SectionTable::from_mesh(needle.mesh, samples);
+  const double length = bounding_box(needle.mesh).max[2];
+  std::vector<double> heights;
+  std::vector<SectionProperties> sections;
+  for (int i = 0; i <= samples; ++i) {
+    const double h = length * i / samples;
+    const auto s = registry.section_properties(*needle.plugin, needle.params, h);
+    // The hook gives no fibre distance: 2√(I/A) is exact for a solid circle, an upper bound
+    // for a tube (conservative for the bending check).
+    const double fibre = s->area_m2 > 0 ? 2.0 * std::sqrt(s->i_min_m4 / s->area_m2) : 0.0;
+    heights.push_back(h);
+    sections.push_back({s->area_m2, s->i_min_m4, fibre});
+  }
+  return SectionTable(std::move(heights), std::move(sections));
+}
+
+}  // namespace
+
+nlohmann::json strength_report(const PluginRegistry& registry, const NeedleSource& needle,
+                               const StrengthSettings& settings) {
+  if (settings.material.empty()) throw InputError("strength: no needle material given");
+  if (!std::isfinite(settings.lateral_ratio) || settings.lateral_ratio < 0.0)
+    throw InputError("strength: lateral ratio " + std::to_string(settings.lateral_ratio) +
+                     " (a finite value >= 0)");
+  const NeedleMaterial material = find_needle_material(settings.material);
+  const SectionTable table = section_table(registry, needle);
+
+  StrengthOptions options;
+  options.length_m = table.length_m();
+  options.end = parse_end_condition(settings.end);
+  options.lateral_ratio = settings.lateral_ratio;
+  options.load_height_m = settings.depth.empty()
+                              ? table.tip_length_m()
+                              : parse_quantity(settings.depth, Dimension::Length);
+  const StrengthReport r = needle_strength(table.profile(), material, options);
+
+  const nlohmann::json out = {{"needle", needle.name},
+                              {"material", material.name},
+                              {"E_Pa", material.youngs_modulus_pa},
+                              {"strength_Pa", material.strength_pa},
+                              {"failure_mode", failure_mode_name(material.failure)},
+                              {"end", end_condition_name(options.end)},
+                              {"effective_length_factor", effective_length_factor(options.end)},
+                              {"length_m", options.length_m},
+                              {"load_height_m", options.load_height_m},
+                              {"I_min_m4", r.i_min_m4},
+                              {"A_min_m2", r.a_min_m2},
+                              {"elastic_buckling_N", r.elastic_buckling_n},
+                              {"johnson", r.johnson},
+                              {"buckling_N", r.buckling_n},
+                              {"strength_N", r.strength_n},
+                              {"critical_height_m", r.critical_height_m},
+                              {"capacity_N", r.capacity_n},
+                              {"governing", r.governing}};
+  require_finite_json(out, "strength");
+  return out;
+}
+
+}  // namespace mneedle

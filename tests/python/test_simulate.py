@@ -1,0 +1,104 @@
+"""mneedle.simulate: the same dict as `mneedle simulate --json`, from a file or from values."""
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import mneedle
+from conftest import strip_timing
+
+PUNCH = "tests/assets/scenes/puncture_punch.toml"  # axisymmetric FE, punctures at fast fidelity
+
+
+def test_file_scene_gives_the_cli_dict_number_for_number(cli, source):
+    scene = source / PUNCH
+    ours = mneedle.simulate(scene, fidelity="fast")
+    theirs = cli.json("simulate", scene, "--fidelity", "fast")
+    assert strip_timing(ours) == strip_timing(theirs)
+    assert ours["needles"][0]["puncture"] is not None
+
+
+def test_scene_values_run_as_the_file_they_came_from(source):
+    scene = source / PUNCH
+    values = mneedle.read_scene(scene)
+    assert values["tissue"]["layers"][0]["material"]["E"] == "0.2 MPa"
+    assert strip_timing(mneedle.simulate(values)) == strip_timing(mneedle.simulate(scene))
+
+
+def test_a_changed_value_runs_as_the_cli_runs_the_changed_file(cli, source, tmp_path):
+    values = mneedle.read_scene(source / PUNCH)
+    values["tissue"]["layers"][0]["material"]["E"] = "0.4 MPa"
+    changed = tmp_path / "stiffer.toml"
+    changed.write_text(mneedle.scene_toml(values))
+    ours = mneedle.simulate(values)
+    assert strip_timing(ours) == strip_timing(cli.json("simulate", changed))
+    # Twice the modulus, the same critical pressure: the criterion fires earlier.
+    before = mneedle.simulate(source / PUNCH)
+    assert (ours["needles"][0]["puncture"]["depth_m"]
+            < before["needles"][0]["puncture"]["depth_m"])
+
+
+def test_curves_are_numpy_arrays_of_the_json_points(source):
+    result = mneedle.simulate(source / PUNCH)
+    curve = mneedle.curves(result)["punch"]
+    points = result["needles"][0]["curve"]
+    assert isinstance(curve["depth_m"], np.ndarray)
+    assert curve["depth_m"].tolist() == [p["depth_m"] for p in points]
+    assert curve["force_N"].tolist() == [p["force_N"] for p in points]
+    assert set(curve["stage"].tolist()) == {"pre", "post"}
+    # Depth never goes back; it repeats once, where the post-puncture stage starts at the
+    # puncture depth with the force after the drop.
+    steps = np.diff(curve["depth_m"])
+    assert np.all(steps >= 0)
+    assert np.count_nonzero(steps == 0) == 1
+    puncture = result["needles"][0]["puncture"]
+    assert curve["depth_m"][np.argmin(steps)] == puncture["depth_m"]
+
+
+def test_missing_file_raises_the_cli_message(cli, tmp_path):
+    missing = tmp_path / "nowhere.toml"
+    with pytest.raises(mneedle.InputError) as error:
+        mneedle.simulate(missing)
+    assert str(error.value) == cli.error("simulate", missing)
+
+
+def test_a_bad_value_in_a_dict_names_its_key(source):
+    values = mneedle.read_scene(source / PUNCH)
+    values["tissue"]["layers"][0]["material"]["E"] = "0.2"  # no unit
+    with pytest.raises(mneedle.InputError, match=r"my scene.*E"):
+        mneedle.simulate(values, source="my scene")
+    values["tissue"]["layers"][0]["material"]["E"] = None
+    with pytest.raises(mneedle.InputError, match=r"tissue\.layers\[0\]\.material\.E"):
+        mneedle.simulate(values)
+
+
+def test_a_setting_outside_its_list_is_an_input_error(source):
+    with pytest.raises(mneedle.InputError, match="fidelity 'fst' is not one of fast"):
+        mneedle.simulate(source / PUNCH, fidelity="fst")
+
+
+def test_the_interpreter_runs_on_while_a_simulation_works(source):
+    """The lock is released during the solve: the main thread counts on meanwhile."""
+    done = threading.Event()
+    results = []
+
+    def work():
+        results.append(mneedle.simulate(source / PUNCH, fidelity="standard"))
+        done.set()
+
+    worker = threading.Thread(target=work)
+    start = time.perf_counter()
+    worker.start()
+    count = 0
+    while not done.is_set():
+        count += 1
+    worker.join()
+    elapsed = time.perf_counter() - start
+    assert results and results[0]["needles"][0]["puncture"] is not None
+    # Held, the lock would let the main thread count only until the worker enters C++ (one
+    # 5 ms switch interval, some 10^4 steps) and after it returns; released, it counts the
+    # whole run at over 10^6 steps per second even on a shared core. The floor, one step per
+    # 5 us of the run, lies between the two by a factor of 10 or more either way.
+    assert elapsed > 0.1, "the run was too short to tell"
+    assert count > elapsed / 5e-6
