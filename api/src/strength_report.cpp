@@ -37,9 +37,6 @@ SectionTable section_table(const PluginRegistry& registry, const NeedleSource& n
 nlohmann::json strength_report(const PluginRegistry& registry, const NeedleSource& needle,
                                const StrengthSettings& settings) {
   if (settings.material.empty()) throw InputError("strength: no needle material given");
-  if (!std::isfinite(settings.lateral_ratio) || settings.lateral_ratio < 0.0)
-    throw InputError("strength: lateral ratio " + std::to_string(settings.lateral_ratio) +
-                     " (a finite value >= 0)");
   const NeedleMaterial material = find_needle_material(settings.material);
   const SectionTable table = section_table(registry, needle);
 
