@@ -25,12 +25,12 @@ void add_value(const nlohmann::json& v, const std::string& where, Insert insert)
     insert(v.get<std::string>());
   } else if (v.is_boolean()) {
     insert(v.get<bool>());
-  } else if (v.is_number_integer()) {
-    insert(v.get<std::int64_t>());
-  } else if (v.is_number_unsigned()) {
+  } else if (v.is_number_unsigned()) {  // before is_number_integer, which is also true here
     if (v.get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX))
       throw InputError(where + ": integer too large for a scene");
     insert(static_cast<std::int64_t>(v.get<std::uint64_t>()));
+  } else if (v.is_number_integer()) {
+    insert(v.get<std::int64_t>());
   } else if (v.is_number_float()) {
     if (!std::isfinite(v.get<double>())) throw InputError(where + ": not a finite number");
     insert(v.get<double>());
@@ -60,6 +60,7 @@ toml::table to_toml_table(const nlohmann::json& values, const std::string& where
 }  // namespace
 
 nlohmann::json read_scene_values(const std::filesystem::path& scene_file) {
+  load_scene(scene_file);  // checked as `scene check` checks it: the same errors, word for word
   return nlohmann::json::parse(scene_values_json(scene_file));
 }
 

@@ -15,6 +15,7 @@
 #include "mneedle/screening.h"
 #include "mneedle/screening_mpi.h"
 #include "mneedle/uncertainty.h"
+#include "mpi_start.h"
 #include "report_needles.h"
 #include "run_provenance.h"
 
@@ -164,40 +165,12 @@ ScreenSetup prepare_screen(const ScreenArgs& args, bool writer) {
 }
 
 void run_screen(const ScreenArgs& args) {
-  if (const auto n = mpi_launch_size(); n && *n > 1 && !args.mpi) {
-    if (mpi_launch_rank() != 0) throw QuietExit{0};  // rank 0 says why, once
-    throw InputError("screen: started by an MPI launcher as " + std::to_string(*n) +
-                     " processes without --mpi: each would screen every design into the same "
-                     "files; add --mpi");
-  }
-  // A rank > 0 exits quietly and with status 0 whenever rank 0 reports the reason: the job's one
-  // error line and its status are rank 0's (Open MPI ends a job at the first non-zero exit,
-  // which could cut rank 0 off before it has said why).
   std::optional<MpiSession> session;
-  if (args.mpi) {
-    try {
-      session.emplace(args.jobs);
-    } catch (const InputError&) {
-      if (mpi_launch_rank() != 0) throw QuietExit{0};  // every rank fails alike here
-      throw;
-    }
-  }
+  start_mpi(session, args.mpi, args.jobs, "screen", "screen every design into the same files");
   const bool writer = !session || session->rank() == 0;
-  // Under MPI a rank whose setup fails must not leave the others waiting: every rank says
-  // whether it got through, rank 0 reports its own error, another rank only one rank 0 lacks.
   std::optional<ScreenSetup> setup;
-  try {
-    setup.emplace(prepare_screen(args, writer));
-  } catch (const std::exception&) {
-    if (!session) throw;
-    const auto agreement = session->agree(false);
-    if (writer || agreement.rank0) throw;
-    throw QuietExit{0};  // rank 0 failed too and says so, once
-  }
-  if (session && !session->agree(true).all) {
-    if (writer) throw InputError("screen --mpi: another rank could not start (its line says why)");
-    throw QuietExit{0};
-  }
+  setup_on_every_rank(
+      session, [&] { setup.emplace(prepare_screen(args, writer)); }, "screen");
   const Scene& scene = setup->scene;
   const ScreeningOptions& options = setup->options;
   const auto on_row = [&](const ScreeningRow& row) {

@@ -4,8 +4,10 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
@@ -13,7 +15,10 @@
 #include "json_output.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
+#include "mneedle/plot/figure.h"
+#include "mneedle/screening_mpi.h"
 #include "mneedle/uncertainty.h"
+#include "mpi_start.h"
 #include "run_provenance.h"
 
 namespace mneedle::cli {
@@ -31,6 +36,8 @@ struct UncertaintyArgs {
   std::string material;
   bool no_sensitivity = false;
   bool json = false;
+  bool mpi = false;
+  std::string plot;  // SVG: the distribution of puncture depth (or peak force)
   std::vector<std::string> plugin_dirs;
 };
 
@@ -84,14 +91,58 @@ void print_row(const char* what, const Percentiles& p, Dimension d) {
               format_quantity(p.p50, d).c_str(), format_quantity(p.p95, d).c_str(), p.count);
 }
 
+// The empirical distribution function of the resolved puncture depths (or, when no sample has
+// one, of the peak forces), with the 5 %, 50 % and 95 % percentiles marked.
+plot::Figure distribution_figure(const UncertaintyResult& r, const std::string& scene) {
+  const bool depths = r.puncture_depth_m.count > 0;
+  std::vector<double> values;
+  for (const auto& s : r.samples) {
+    if (!s.ok) continue;
+    if (!depths)
+      values.push_back(s.peak_force_n);
+    else if (s.puncture_depth_m && !s.puncture_at_first_contact)
+      values.push_back(*s.puncture_depth_m);
+  }
+  std::sort(values.begin(), values.end());
+  plot::Figure f;
+  f.title = "uncertainty: " + std::filesystem::path(scene).filename().string() + ", " +
+            std::to_string(values.size()) + " samples" +
+            (depths ? " with a resolved puncture" : " (none punctures: peak force)");
+  f.x = {depths ? "puncture depth" : "peak force", depths ? Dimension::Length : Dimension::Force,
+         "", false};
+  f.y = {"share of samples at or below", Dimension::Dimensionless, "%", false};
+  plot::Series cdf;
+  cdf.label = "samples";
+  const double n = static_cast<double>(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {  // a step at every sample
+    cdf.x.insert(cdf.x.end(), {values[i], values[i]});
+    cdf.y.insert(cdf.y.end(),
+                 {100.0 * static_cast<double>(i) / n, 100.0 * static_cast<double>(i + 1) / n});
+  }
+  f.series.push_back(std::move(cdf));
+  const Percentiles& p = depths ? r.puncture_depth_m : r.peak_force_n;
+  f.lines = {{"5 %", p.p5}, {"median", p.p50}, {"95 %", p.p95}};
+  return f;
+}
+
 void run_uncertainty_command(const UncertaintyArgs& args) {
+  std::optional<MpiSession> session;
+  start_mpi(session, args.mpi, args.jobs, "uncertainty",
+            "run every sample and print the same result");
+  const bool writer = !session || session->rank() == 0;
   std::vector<VariedValue> inputs;
-  for (const auto& spec : args.vary) inputs.push_back(parse_varied_value(spec));
-  if (args.method != "mc" && args.method != "lhs")
-    throw InputError("uncertainty: --method '" + args.method + "' (mc or lhs)");
-  record_input("scene", args.scene);
-  const auto registry =
-      PluginRegistry::discover({args.plugin_dirs.begin(), args.plugin_dirs.end()});
+  std::optional<PluginRegistry> found;
+  setup_on_every_rank(
+      session,
+      [&] {
+        for (const auto& spec : args.vary) inputs.push_back(parse_varied_value(spec));
+        if (args.method != "mc" && args.method != "lhs")
+          throw InputError("uncertainty: --method '" + args.method + "' (mc or lhs)");
+        found.emplace(PluginRegistry::discover({args.plugin_dirs.begin(), args.plugin_dirs.end()}));
+      },
+      "uncertainty");
+  if (writer) record_input("scene", args.scene);
+  const PluginRegistry& registry = *found;
   UncertaintyOptions options;
   options.samples = args.samples;
   options.seed = args.seed;
@@ -101,12 +152,23 @@ void run_uncertainty_command(const UncertaintyArgs& args) {
   options.model = args.model;
   if (!args.material.empty()) options.material = args.material;
   options.sensitivity = !args.no_sensitivity;
-  const bool terminal = !args.json && ::isatty(STDERR_FILENO) == 1;
-  const UncertaintyResult r =
-      run_uncertainty(args.scene, inputs, registry, options, [&](int done, int total) {
-        if (terminal && (done == total || done % 10 == 0))
-          std::cerr << "\runcertainty: " << done << " of " << total << " runs" << std::flush;
-      });
+  const bool terminal = writer && !args.json && ::isatty(STDERR_FILENO) == 1;
+  const auto progress = [&](int done, int total) {
+    if (terminal && (done == total || done % 10 == 0))
+      std::cerr << "\runcertainty: " << done << " of " << total << " runs" << std::flush;
+  };
+  std::optional<UncertaintyResult> result;
+  if (session) {
+    try {
+      result = run_uncertainty_mpi(*session, args.scene, inputs, registry, options, progress);
+    } catch (const RankStopped&) {
+      throw QuietExit{0};
+    }
+    if (!result) return;  // a rank > 0: rank 0 reports the run
+  } else {
+    result = run_uncertainty(args.scene, inputs, registry, options, progress);
+  }
+  const UncertaintyResult& r = *result;
   if (terminal) std::cerr << "\n";
 
   nlohmann::json out = {{"scene", args.scene},       {"samples", args.samples},
@@ -199,6 +261,8 @@ void run_uncertainty_command(const UncertaintyArgs& args) {
             "(docs/model.md, \"Optimisation\"), not a puncture depth\n");
     }
   }
+  // After the result is out: a plot that cannot be written loses nothing.
+  if (!args.plot.empty()) plot::write_svg(args.plot, distribution_figure(r, args.scene));
 }
 
 }  // namespace
@@ -241,6 +305,12 @@ void add_uncertainty_command(CLI::App& app) {
   cmd->add_option("--plugin-dir", args->plugin_dirs, "Extra plugin folder (repeatable)")
       ->allow_extra_args(false);
   cmd->add_flag("--json", args->json, "Print one JSON object (every sample in rows)");
+  cmd->add_option("--plot", args->plot,
+                  "Write the distribution of the puncture depth (or, if no sample punctures, of "
+                  "the peak force) as SVG");
+  cmd->add_flag("--mpi", args->mpi,
+                "Share the runs among the processes of mpirun -n N (rank 0 prints; each rank "
+                "runs --jobs threads)");
   cmd->callback([args] { run_uncertainty_command(*args); });
 }
 

@@ -215,9 +215,14 @@ fs::path PluginRegistry::builtin_plugin_dir() {
 }
 
 PluginRegistry PluginRegistry::discover(const std::vector<fs::path>& extra_dirs) {
+  return discover_from(builtin_plugin_dir(), extra_dirs);
+}
+
+PluginRegistry PluginRegistry::discover_from(const fs::path& builtin_dir,
+                                             const std::vector<fs::path>& extra_dirs) {
   PluginRegistry registry;
   auto& warnings = registry.impl_->warnings;
-  std::vector<fs::path> dirs{builtin_plugin_dir()};
+  std::vector<fs::path> dirs{builtin_dir};
   const auto from_environment = plugin_path_from_environment(warnings);
   dirs.insert(dirs.end(), from_environment.begin(), from_environment.end());
   for (const auto& dir : extra_dirs) {

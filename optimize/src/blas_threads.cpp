@@ -2,6 +2,8 @@
 
 #include <dlfcn.h>
 
+#include <mutex>
+
 namespace mneedle {
 namespace {
 
@@ -18,6 +20,13 @@ SetThreads set_threads() {
   return reinterpret_cast<SetThreads>(::dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
 }
 
+// Limits may overlap (two Python threads each screening with jobs > 1): the first one saves the
+// count and sets the limit, the last one restores it, so overlapping limits never leave
+// OpenBLAS at the limit.
+std::mutex limit_mutex;
+int active_limits = 0;
+int saved_threads = 0;
+
 }  // namespace
 
 int blas_threads() {
@@ -25,12 +34,17 @@ int blas_threads() {
   return get ? get() : 0;
 }
 
-BlasThreadLimit::BlasThreadLimit(int threads) : previous_(blas_threads()) {
-  if (const SetThreads set = set_threads(); set && previous_ > 0) set(threads);
+BlasThreadLimit::BlasThreadLimit(int threads) {
+  std::lock_guard<std::mutex> lock(limit_mutex);
+  if (active_limits++ > 0) return;
+  saved_threads = blas_threads();
+  if (const SetThreads set = set_threads(); set && saved_threads > 0) set(threads);
 }
 
 BlasThreadLimit::~BlasThreadLimit() {
-  if (const SetThreads set = set_threads(); set && previous_ > 0) set(previous_);
+  std::lock_guard<std::mutex> lock(limit_mutex);
+  if (--active_limits > 0) return;
+  if (const SetThreads set = set_threads(); set && saved_threads > 0) set(saved_threads);
 }
 
 }  // namespace mneedle

@@ -11,7 +11,9 @@
 #include <thread>
 
 #include "mneedle/base/error.h"
+#include "mneedle/base/provenance.h"
 #include "mneedle/blas_threads.h"
+#include "mpi_dealer.h"
 #include "screening_batch.h"
 
 #if MNEEDLE_HAVE_MPI
@@ -50,39 +52,22 @@ int mpi_launch_rank() {
 namespace {
 
 // The messages (docs/performance.md, "Screening on a cluster"): a thread of rank r > 0 sends
-// kRequest and waits for kIndex (a design's index, or -1: no more designs); when it has
-// evaluated the design it sends kRow, "index\n" followed by the row as results.jsonl holds it.
+// kRequest and waits for kIndex (a task's index, or -1: no more tasks); when it has run the task
+// it sends kResult, "index\n" followed by the result's text.
 constexpr int kRequest = 1;
 constexpr int kIndex = 2;
-constexpr int kRow = 3;
+constexpr int kResult = 3;
 
-std::vector<ScreeningRow> coordinate_loop(const MpiSession& session, ScreeningBatch& batch,
-                                          int jobs);
-
-// Rank 0: deals designs to its own threads and to every other rank's threads, and records every
-// row. Its main thread only talks MPI (polling, so that a row is written the moment it arrives);
-// `jobs` threads evaluate.
-std::vector<ScreeningRow> coordinate(const MpiSession& session, ScreeningBatch& batch, int jobs) {
-  try {
-    return coordinate_loop(session, batch, jobs);
-  } catch (const std::exception& e) {
-    // Out of memory or the like in the loop itself: the other ranks wait on rank 0 and would
-    // wait for ever, so the job ends here (rows already written stay written).
-    std::fprintf(stderr, "mneedle: internal error: screen --mpi, rank 0: %s\n", e.what());
-    std::fflush(stderr);
-    MPI_Abort(MPI_COMM_WORLD, 4);
-    throw;
-  }
-}
-
-std::vector<ScreeningRow> coordinate_loop(const MpiSession& session, ScreeningBatch& batch,
-                                          int jobs) {
+// Rank 0: deals tasks to its own threads and to every other rank's threads, and records every
+// result. Its main thread only talks MPI (polling, so that a result is recorded the moment it
+// arrives); `jobs` threads run tasks.
+void coordinate_loop(const MpiSession& session, int jobs, const DealtTasks& tasks) {
   std::vector<std::thread> pool;
   for (int j = 0; j < jobs; ++j)
     pool.emplace_back([&] {
-      while (const auto i = batch.claim()) batch.record(*i, batch.evaluate(*i));
+      while (const auto i = tasks.claim()) tasks.run_here(*i);
     });
-  // Every thread of every other rank asks until it is told -1; a row is owed for every index
+  // Every thread of every other rank asks until it is told -1; a result is owed for every index
   // dealt. Both must be settled before rank 0 may stop listening.
   const long remote_threads = static_cast<long>(session.size() - 1) * jobs;
   long stopped = 0;
@@ -99,49 +84,36 @@ std::vector<ScreeningRow> coordinate_loop(const MpiSession& session, ScreeningBa
       int nothing = 0;
       MPI_Recv(&nothing, 1, MPI_INT, status.MPI_SOURCE, kRequest, MPI_COMM_WORLD,
                MPI_STATUS_IGNORE);
-      const auto i = batch.claim();
+      const auto i = tasks.claim();
       long long index = i ? static_cast<long long>(*i) : -1;
       (i ? owed : stopped) += 1;
       MPI_Send(&index, 1, MPI_LONG_LONG, status.MPI_SOURCE, kIndex, MPI_COMM_WORLD);
-    } else if (status.MPI_TAG == kRow) {
+    } else if (status.MPI_TAG == kResult) {
       int bytes = 0;
       MPI_Get_count(&status, MPI_CHAR, &bytes);
       std::string message(static_cast<std::size_t>(bytes), '\0');
-      MPI_Recv(message.data(), bytes, MPI_CHAR, status.MPI_SOURCE, kRow, MPI_COMM_WORLD,
+      MPI_Recv(message.data(), bytes, MPI_CHAR, status.MPI_SOURCE, kResult, MPI_COMM_WORLD,
                MPI_STATUS_IGNORE);
       --owed;
-      // Our own ranks wrote it; a message that names no design of the batch would be a bug in
-      // this file, and is dropped rather than written anywhere.
+      // Our own ranks wrote it; a message that names no task would be a bug in this file, and
+      // is dropped rather than recorded anywhere (the caller finds the task without a result).
       const auto newline = message.find('\n');
-      std::size_t i = batch.size();
+      std::size_t i = tasks.count;
       try {
         i = std::stoul(message.substr(0, newline));
       } catch (const std::exception&) {
       }
-      if (newline == std::string::npos || i >= batch.size()) continue;
-      try {
-        batch.record(i, screening_row_from_json(message.substr(newline + 1)));
-      } catch (const std::exception& e) {
-        batch.record(
-            i, screening_error_row(batch.design(i), std::string("the row sent by another rank is "
-                                                                "unreadable (") +
-                                                        e.what() + ")"));
-      }
+      if (newline == std::string::npos || i >= tasks.count) continue;
+      tasks.record_text(i, message.substr(newline + 1));
     }
   }
   for (auto& t : pool) t.join();
-  // Every design dealt had its row back (owed = 0); should one ever not, it gets an error row
-  // rather than an empty one.
-  for (std::size_t i = 0; i < batch.size(); ++i)
-    if (!batch.recorded(i))
-      batch.record(i, screening_error_row(batch.design(i), "no row came back for this design"));
-  return batch.take_rows();
 }
 
-// Rank r > 0: `jobs` threads, each asking rank 0 for a design, evaluating it and sending the row
+// Rank r > 0: `jobs` threads, each asking rank 0 for a task, running it and sending the result
 // back. MPI calls are serialised by one mutex (MPI_THREAD_SERIALIZED); a thread holds it from
 // its request to the answer, so every answer reaches the thread that asked.
-void work(ScreeningBatch& batch, int jobs) {
+void work(int jobs, const DealtTasks& tasks) {
   std::mutex mpi;
   auto worker = [&] {
     for (;;) {
@@ -153,20 +125,14 @@ void work(ScreeningBatch& batch, int jobs) {
         MPI_Recv(&index, 1, MPI_LONG_LONG, 0, kIndex, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
       }
       if (index < 0) return;
-      // The fingerprints agreed, so rank 0 deals only indices of this batch; an index beyond it
-      // would be a bug, answered with an error row rather than a read past the designs.
-      ScreeningRow row;
-      if (static_cast<std::size_t>(index) < batch.size()) {
-        row = batch.evaluate(static_cast<std::size_t>(index));
-      } else {
-        row.json = nlohmann::json{{"design", "index " + std::to_string(index)},
-                                  {"ok", false},
-                                  {"error", "no such design on this rank"}}
-                       .dump();
-      }
-      const std::string message = std::to_string(index) + "\n" + row.json;
+      // The ranks agreed on the tasks, so rank 0 deals only indices below count; one beyond it
+      // would be a bug, answered with no text (rank 0 drops it) rather than a read past the end.
+      const auto i = static_cast<std::size_t>(index);
+      const std::string message =
+          std::to_string(index) + "\n" + (i < tasks.count ? tasks.run_for_rank0(i) : "");
       std::lock_guard<std::mutex> lock(mpi);
-      MPI_Send(message.data(), static_cast<int>(message.size()), MPI_CHAR, 0, kRow, MPI_COMM_WORLD);
+      MPI_Send(message.data(), static_cast<int>(message.size()), MPI_CHAR, 0, kResult,
+               MPI_COMM_WORLD);
     }
   };
   std::vector<std::thread> pool;
@@ -208,6 +174,33 @@ MpiSession::Agreement MpiSession::agree(bool ok) const {
   return {all[0] == 1, all[1] == 1};
 }
 
+void deal_over_ranks(const MpiSession& session, int jobs, const DealtTasks& tasks,
+                     const char* command) {
+  jobs = std::max(1, jobs);
+  if (session.rank() != 0) {
+    work(jobs, tasks);
+    return;
+  }
+  try {
+    coordinate_loop(session, jobs, tasks);
+  } catch (const std::exception& e) {
+    // Out of memory or the like in the loop itself: the other ranks wait on rank 0 and would
+    // wait for ever, so the job ends here (results already written stay written).
+    std::fprintf(stderr, "mneedle: internal error: %s --mpi, rank 0: %s\n", command, e.what());
+    std::fflush(stderr);
+    MPI_Abort(MPI_COMM_WORLD, 4);
+    throw;
+  }
+}
+
+bool MpiSession::matches_rank0(const std::string& definition) const {
+  std::string mine = sha256_hex(definition);  // 64 hex digits
+  mine.resize(64, ' ');
+  std::string rank0 = mine;
+  MPI_Bcast(rank0.data(), 64, MPI_CHAR, 0, MPI_COMM_WORLD);
+  return mine == rank0;
+}
+
 std::vector<ScreeningRow> screen_designs_mpi(
     const MpiSession& session, const std::vector<DesignInput>& designs, const Scene& scene,
     const std::filesystem::path& scene_file, const PluginRegistry& registry,
@@ -230,10 +223,7 @@ std::vector<ScreeningRow> screen_designs_mpi(
     failure = e.what();
   }
   // Collective: every rank takes part, whether its batch started or not.
-  fingerprint.resize(64, ' ');
-  std::string rank0 = fingerprint;
-  MPI_Bcast(rank0.data(), 64, MPI_CHAR, 0, MPI_COMM_WORLD);
-  if (failure.empty() && fingerprint != rank0)
+  if (!session.matches_rank0(fingerprint) && failure.empty())
     failure = "screen --mpi: rank " + std::to_string(session.rank()) +
               " sees other designs or another scene than rank 0 (every rank must read the same "
               "files)";
@@ -244,9 +234,29 @@ std::vector<ScreeningRow> screen_designs_mpi(
       throw InputError("screen --mpi: another rank could not start (its line says why)");
     throw RankStopped();
   }
-  if (coordinator) return coordinate(session, *batch, jobs);
-  work(*batch, jobs);
-  return {};
+  DealtTasks tasks;
+  tasks.count = batch->size();
+  tasks.claim = [&] { return batch->claim(); };
+  tasks.run_here = [&](std::size_t i) { batch->record(i, batch->evaluate(i)); };
+  tasks.run_for_rank0 = [&](std::size_t i) { return batch->evaluate(i).json; };
+  tasks.record_text = [&](std::size_t i, const std::string& text) {
+    try {
+      batch->record(i, screening_row_from_json(text));
+    } catch (const std::exception& e) {
+      batch->record(
+          i, screening_error_row(batch->design(i), std::string("the row sent by another rank is "
+                                                               "unreadable (") +
+                                                       e.what() + ")"));
+    }
+  };
+  deal_over_ranks(session, jobs, tasks, "screen");
+  if (!coordinator) return {};
+  // Every design dealt had its row back; should one ever not, it gets an error row rather than
+  // an empty one.
+  for (std::size_t i = 0; i < batch->size(); ++i)
+    if (!batch->recorded(i))
+      batch->record(i, screening_error_row(batch->design(i), "no row came back for this design"));
+  return batch->take_rows();
 }
 
 #else  // built without MPI
@@ -263,8 +273,16 @@ MpiSession::MpiSession(int) {
 
 MpiSession::~MpiSession() = default;
 
+void deal_over_ranks(const MpiSession&, int, const DealtTasks&, const char*) {
+  throw InputError("--mpi: this mneedle was built without MPI");
+}
+
 MpiSession::Agreement MpiSession::agree(bool ok) const {
   return {ok, ok};
+}
+
+bool MpiSession::matches_rank0(const std::string&) const {
+  return true;
 }
 
 std::vector<ScreeningRow> screen_designs_mpi(const MpiSession&, const std::vector<DesignInput>&,

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -20,6 +21,8 @@
 #include "mneedle/blas_threads.h"
 #include "mneedle/design_evaluation.h"
 #include "mneedle/design_source.h"
+#include "mneedle/screening_mpi.h"
+#include "mpi_dealer.h"
 
 namespace mneedle {
 namespace {
@@ -245,15 +248,15 @@ Percentiles percentiles(std::vector<double> values) {
   return p;
 }
 
-UncertaintyResult run_uncertainty(const std::filesystem::path& scene_file,
-                                  const std::vector<VariedValue>& inputs,
-                                  const PluginRegistry& registry, const UncertaintyOptions& options,
-                                  const std::function<void(int, int)>& on_sample) {
+namespace {
+
+// The scene's own first needle, built again in each sampled scene (a varied needle.KEY moves it).
+SceneEvaluator scene_needle_evaluator(const PluginRegistry& registry,
+                                      const UncertaintyOptions& options,
+                                      const std::string& source) {
   const fe::Fidelity fidelity = parse_fidelity(options.fidelity);
   const PreModel model = parse_pre_model(options.model);
-  const std::string source = scene_file.string();
-  // The scene's own first needle, built again in each sampled scene (a varied needle.KEY moves it).
-  const SceneEvaluator evaluate = [&](const Scene& scene) {
+  return [&registry, fidelity, model, source, material = options.material](const Scene& scene) {
     if (scene.needles.empty()) throw InputError(source + ": the scene has no needle to evaluate");
     const NeedleSource needle = needle_from_scene(registry, scene.needles.front());
     EvaluationOptions o;
@@ -261,9 +264,61 @@ UncertaintyResult run_uncertainty(const std::filesystem::path& scene_file,
     o.model = model;
     o.axisymmetric = axisymmetric_profile(registry, needle, source);
     o.mirror_symmetric_y0 = o.axisymmetric.has_value() || mirror_symmetric_y0(needle.mesh);
-    return evaluate_design(needle.mesh, scene, design_material(scene, options.material), o);
+    return evaluate_design(needle.mesh, scene, design_material(scene, material), o);
   };
-  return run_uncertainty(read_input_file(scene_file), source, inputs, options, evaluate, on_sample);
+}
+
+// Runs tasks 0 … runs − 1 of `run` into `done`, calling `on_done` (serialised) as each finishes;
+// false on an MPI rank other than 0, which has no results.
+using RunAll =
+    std::function<bool(std::size_t runs, const std::function<UncertaintySample(std::size_t)>& run,
+                       std::vector<UncertaintySample>& done, const std::function<void()>& on_done)>;
+
+// Called by every process after the scene as written ran (or failed: `failure`): rethrows the
+// failure, or under MPI stops every rank when any failed (each error said once).
+using Settle = std::function<void(const std::exception_ptr& failure)>;
+
+void settle_alone(const std::exception_ptr& failure) {
+  if (failure) std::rethrow_exception(failure);
+}
+
+// The runs on `jobs` threads of this process.
+RunAll threads_run_all(int requested_jobs) {
+  return
+      [requested_jobs](std::size_t runs, const std::function<UncertaintySample(std::size_t)>& run,
+                       std::vector<UncertaintySample>& done, const std::function<void()>& on_done) {
+        std::atomic<std::size_t> next{0};
+        std::mutex report;
+        const auto worker = [&] {
+          for (std::size_t r = next++; r < runs; r = next++) {
+            done[r] = run(r);
+            std::lock_guard<std::mutex> lock(report);
+            on_done();
+          }
+        };
+        const int jobs = std::max(1, std::min<int>(requested_jobs, static_cast<int>(runs)));
+        std::vector<std::thread> pool;
+        for (int t = 1; t < jobs; ++t) pool.emplace_back(worker);
+        worker();
+        for (auto& t : pool) t.join();
+        return true;
+      };
+}
+
+std::optional<UncertaintyResult> uncertainty_core(
+    const std::string& text, const std::string& source, const std::vector<VariedValue>& inputs,
+    const UncertaintyOptions& options, const SceneEvaluator& evaluate_scene,
+    const std::function<void(int, int)>& on_sample, const RunAll& run_all, const Settle& settle);
+
+}  // namespace
+
+UncertaintyResult run_uncertainty(const std::filesystem::path& scene_file,
+                                  const std::vector<VariedValue>& inputs,
+                                  const PluginRegistry& registry, const UncertaintyOptions& options,
+                                  const std::function<void(int, int)>& on_sample) {
+  const std::string source = scene_file.string();
+  return run_uncertainty(read_input_file(scene_file), source, inputs, options,
+                         scene_needle_evaluator(registry, options, source), on_sample);
 }
 
 UncertaintyResult run_uncertainty(const std::string& text, const std::string& source,
@@ -271,13 +326,21 @@ UncertaintyResult run_uncertainty(const std::string& text, const std::string& so
                                   const UncertaintyOptions& options,
                                   const SceneEvaluator& evaluate_scene,
                                   const std::function<void(int, int)>& on_sample) {
-  if (inputs.empty()) throw InputError("uncertainty: nothing to vary (give --vary PATH=DIST)");
-  if (inputs.size() > kMaxInputs)
-    throw InputError("uncertainty: " + std::to_string(inputs.size()) + " --vary values (at most " +
-                     std::to_string(kMaxInputs) + ")");
-  if (options.samples < 1 || options.samples > kMaxSamples)
-    throw InputError("uncertainty: --samples " + std::to_string(options.samples) + " (from 1 to " +
-                     std::to_string(kMaxSamples) + ")");
+  // As in screen: one OpenBLAS thread per job, so that jobs share the cores and each run's
+  // arithmetic does not depend on how many run beside it; held from the nominal run on, as under
+  // MPI, so that every run of the command is at the same thread count.
+  std::optional<BlasThreadLimit> blas;
+  if (options.jobs > 1) blas.emplace(1);
+  return *uncertainty_core(text, source, inputs, options, evaluate_scene, on_sample,
+                           threads_run_all(options.jobs), settle_alone);
+}
+
+namespace {
+
+std::optional<UncertaintyResult> uncertainty_core(
+    const std::string& text, const std::string& source, const std::vector<VariedValue>& inputs,
+    const UncertaintyOptions& options, const SceneEvaluator& evaluate_scene,
+    const std::function<void(int, int)>& on_sample, const RunAll& run_all, const Settle& settle) {
   // A scene with drawn values is the file re-serialised (keys sorted, comments gone): its
   // messages must not point at lines of the file.
   const std::string drawn_source = source + " (with drawn values)";
@@ -285,15 +348,6 @@ UncertaintyResult run_uncertainty(const std::string& text, const std::string& so
   UncertaintyResult result;
   result.inputs = inputs;
   using Edit = std::vector<std::pair<VariedValue, double>>;
-  // Every value is checked against the scene once, before any run: a misspelt path, a wrong unit
-  // or the same value twice fails here.
-  {
-    Edit medians;
-    for (const auto& v : inputs)
-      medians.emplace_back(v, distribution_quantile(v.distribution, 0.5));
-    parse_scene(scene_with_values(text, source, medians), drawn_source);
-  }
-
   // Evaluates the scene with `set` (none: as written); throws what the evaluation throws.
   const auto evaluate_or_throw = [&](const Edit& set) {
     UncertaintySample s;
@@ -331,7 +385,26 @@ UncertaintyResult run_uncertainty(const std::string& text, const std::string& so
   };
   // The scene as written first, alone: if it cannot run, nothing else is worth running, and its
   // error keeps its kind (input or solver).
-  result.nominal = evaluate_or_throw({});
+  std::exception_ptr failure;
+  try {
+    if (inputs.empty()) throw InputError("uncertainty: nothing to vary (give --vary PATH=DIST)");
+    if (inputs.size() > kMaxInputs)
+      throw InputError("uncertainty: " + std::to_string(inputs.size()) +
+                       " --vary values (at most " + std::to_string(kMaxInputs) + ")");
+    if (options.samples < 1 || options.samples > kMaxSamples)
+      throw InputError("uncertainty: --samples " + std::to_string(options.samples) +
+                       " (from 1 to " + std::to_string(kMaxSamples) + ")");
+    // Every value is checked against the scene once, before any run: a misspelt path, a wrong
+    // unit or the same value twice fails here.
+    Edit medians;
+    for (const auto& v : inputs)
+      medians.emplace_back(v, distribution_quantile(v.distribution, 0.5));
+    parse_scene(scene_with_values(text, source, medians), drawn_source);
+    result.nominal = evaluate_or_throw({});
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  settle(failure);
 
   // The draws, in a fixed order and before any run: sample i, value k takes the (i K + k)-th draw
   // (Monte Carlo), or a point of stratum perm_k(i) (Latin hypercube). Plain numbers only: the
@@ -375,26 +448,14 @@ UncertaintyResult run_uncertainty(const std::string& text, const std::string& so
   };
 
   std::vector<UncertaintySample> done(runs);
-  std::atomic<std::size_t> next{0};
-  std::mutex report;
   int finished = 0;
-  const auto worker = [&] {
-    for (std::size_t r = next++; r < runs; r = next++) {
-      done[r] = evaluate(edit_of(r));
-      std::lock_guard<std::mutex> lock(report);
-      ++finished;
-      if (on_sample) on_sample(finished, static_cast<int>(runs));
-    }
+  const auto on_done = [&] {
+    ++finished;
+    if (on_sample) on_sample(finished, static_cast<int>(runs));
   };
-  const int jobs = std::max(1, std::min<int>(options.jobs, static_cast<int>(runs)));
-  // As in screen: one OpenBLAS thread per job, so that jobs share the cores (and each run's
-  // arithmetic does not depend on how many run beside it).
-  std::optional<BlasThreadLimit> blas;
-  if (jobs > 1) blas.emplace(1);
-  std::vector<std::thread> pool;
-  for (int t = 1; t < jobs; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+  if (!run_all(
+          runs, [&](std::size_t r) { return evaluate(edit_of(r)); }, done, on_done))
+    return std::nullopt;  // an MPI rank other than 0: rank 0 has the results
 
   result.samples.assign(done.begin(), done.begin() + static_cast<std::ptrdiff_t>(n));
   std::vector<double> depth, force, peak, margin;
@@ -460,6 +521,132 @@ UncertaintyResult run_uncertainty(const std::string& text, const std::string& so
                      });
   }
   return result;
+}
+
+}  // namespace
+
+namespace {
+
+// A run's result as the text one rank sends another: every number as JSON writes it (the
+// shortest text that reads back to the same double, so the result arrives bit for bit); an
+// infinite margin (no force) as null.
+std::string sample_text(const UncertaintySample& s) {
+  return nlohmann::json{
+      {"values", s.values},
+      {"ok", s.ok},
+      {"error", s.error},
+      {"depth", s.puncture_depth_m ? nlohmann::json(*s.puncture_depth_m) : nlohmann::json()},
+      {"force", s.puncture_force_n},
+      {"first_contact", s.puncture_at_first_contact},
+      {"objective", s.puncture_objective_m},
+      {"peak", s.peak_force_n},
+      {"margin", std::isinf(s.margin) ? nlohmann::json() : nlohmann::json(s.margin)},
+      {"passes", s.passes}}
+      .dump();
+}
+
+UncertaintySample sample_from_text(const std::string& text) {
+  const auto j = nlohmann::json::parse(text);
+  UncertaintySample s;
+  s.values = j.at("values").get<std::vector<double>>();
+  s.ok = j.at("ok").get<bool>();
+  s.error = j.at("error").get<std::string>();
+  if (!j.at("depth").is_null()) s.puncture_depth_m = j.at("depth").get<double>();
+  s.puncture_force_n = j.at("force").get<double>();
+  s.puncture_at_first_contact = j.at("first_contact").get<bool>();
+  s.puncture_objective_m = j.at("objective").get<double>();
+  s.peak_force_n = j.at("peak").get<double>();
+  s.margin = j.at("margin").is_null() ? INFINITY : j.at("margin").get<double>();
+  s.passes = j.at("passes").get<bool>();
+  return s;
+}
+
+}  // namespace
+
+std::optional<UncertaintyResult> run_uncertainty_mpi(
+    const MpiSession& session, const std::filesystem::path& scene_file,
+    const std::vector<VariedValue>& inputs, const PluginRegistry& registry,
+    const UncertaintyOptions& options, const std::function<void(int, int)>& on_sample) {
+  const bool coordinator = session.rank() == 0;
+  const std::string source = scene_file.string();
+  // Every rank must draw the same samples of the same scene: what defines them is compared with
+  // rank 0's before anything runs (a rank that reads another file stops the run).
+  std::string text, failure;
+  try {
+    text = read_input_file(scene_file);
+  } catch (const std::exception& e) {
+    failure = e.what();
+  }
+  std::string definition =
+      text + "|" + std::to_string(options.samples) + "|" + std::to_string(options.seed) + "|" +
+      (options.latin_hypercube ? "lhs" : "mc") + "|" + options.fidelity + "|" + options.model +
+      "|" + options.material.value_or("") + "|" + (options.sensitivity ? "s" : "");
+  for (const auto& v : inputs) definition += "|" + v.text;
+  if (!session.matches_rank0(definition) && failure.empty())
+    failure = "uncertainty --mpi: rank " + std::to_string(session.rank()) +
+              " sees another scene or other settings than rank 0 (every rank must read the "
+              "same files)";
+  // Under MPI every failure before the samples stops every rank; each error is said once.
+  const auto stop_if_any_failed = [&](bool ok, const std::function<void()>& rethrow) {
+    const auto agreement = session.agree(ok);
+    if (agreement.all) return;
+    if (!ok && (coordinator || agreement.rank0)) rethrow();
+    if (coordinator)
+      throw InputError("uncertainty --mpi: another rank could not start (its line says why)");
+    throw RankStopped();
+  };
+  stop_if_any_failed(failure.empty(), [&] { throw InputError(failure); });
+
+  const int jobs = std::max(1, options.jobs);
+  // Several ranks on one machine, or several threads in one rank: one OpenBLAS thread each, as
+  // the threads of the serial run (the same factorisations, so the same samples).
+  std::optional<BlasThreadLimit> blas;
+  if (jobs > 1 || session.size() > 1) blas.emplace(1);
+  const RunAll over_ranks = [&](std::size_t runs,
+                                const std::function<UncertaintySample(std::size_t)>& run,
+                                std::vector<UncertaintySample>& done,
+                                const std::function<void()>& on_done) {
+    std::atomic<std::size_t> next{0};
+    std::mutex record;
+    std::vector<char> recorded(runs, 0);
+    const auto keep = [&](std::size_t i, UncertaintySample s) {
+      std::lock_guard<std::mutex> lock(record);
+      if (recorded[i]) return;
+      done[i] = std::move(s);
+      recorded[i] = 1;
+      on_done();
+    };
+    DealtTasks tasks;
+    tasks.count = runs;
+    tasks.claim = [&]() -> std::optional<std::size_t> {
+      const std::size_t i = next++;
+      if (i < runs) return i;
+      return std::nullopt;
+    };
+    tasks.run_here = [&](std::size_t i) { keep(i, run(i)); };
+    tasks.run_for_rank0 = [&](std::size_t i) { return sample_text(run(i)); };
+    tasks.record_text = [&](std::size_t i, const std::string& text) {
+      UncertaintySample s;
+      try {
+        s = sample_from_text(text);
+      } catch (const std::exception& e) {
+        s.error = std::string("the result sent by another rank is unreadable (") + e.what() + ")";
+      }
+      keep(i, std::move(s));
+    };
+    deal_over_ranks(session, jobs, tasks, "uncertainty");
+    if (!coordinator) return false;
+    // Every run dealt had its result back; should one ever not, it is an error row, not zeros.
+    for (std::size_t i = 0; i < runs; ++i)
+      if (!recorded[i]) done[i].error = "no result came back for this run";
+    return true;
+  };
+  const Settle settle = [&](const std::exception_ptr& e) {
+    stop_if_any_failed(e == nullptr, [&] { std::rethrow_exception(e); });
+  };
+  return uncertainty_core(text, source, inputs, options,
+                          scene_needle_evaluator(registry, options, source), on_sample, over_ranks,
+                          settle);
 }
 
 }  // namespace mneedle

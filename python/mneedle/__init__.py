@@ -10,6 +10,7 @@ Dimensional values are strings with units, as in scene files: ``"120 kPa"``, ``"
 """
 
 import os
+import warnings
 from os import PathLike
 from typing import Any, Dict, Iterable, List, Optional, Union
 
@@ -17,6 +18,11 @@ import numpy as np
 
 from . import _core
 from ._core import InputError, SolverError, __version__
+from ._paths import PLUGIN_DIR
+
+# The package's own plugins (the build tree's, or the installed ones beside it): the C++ side
+# cannot tell them from the executable, which is python3.
+_core._set_plugin_folder(PLUGIN_DIR)
 
 __all__ = [
     "InputError",
@@ -33,24 +39,41 @@ __all__ = [
 
 Scene = Union[str, "PathLike[str]", Dict[str, Any]]
 
-# Installed beside an installed mneedle (lib/python3/dist-packages/mneedle → lib/mneedle/plugins);
-# in the build tree the C++ side finds the built plugins itself.
-_INSTALLED_PLUGINS = os.path.normpath(
-    os.path.join(os.path.dirname(__file__), "..", "..", "..", "mneedle", "plugins")
-)
+Paths = Union[str, "PathLike[str]", Iterable[Union[str, "PathLike[str]"]]]
 
 
-def _plugin_dirs(extra: Iterable[Union[str, "PathLike[str]"]]) -> List[str]:
-    dirs = [os.fspath(d) for d in extra]
-    if os.path.isdir(_INSTALLED_PLUGINS) and _INSTALLED_PLUGINS not in dirs:
-        dirs.insert(0, _INSTALLED_PLUGINS)
-    return dirs
+def _list(values, what: str) -> List[str]:
+    """A list of strings; one string or path alone is a list of one (never split into letters)."""
+    if isinstance(values, (str, PathLike)):
+        return [os.fspath(values)]
+    try:
+        return [os.fspath(v) if isinstance(v, PathLike) else str(v) for v in values]
+    except TypeError:
+        raise InputError(f"{what}: a string or a list of strings, not {type(values).__name__}")
+
+
+def _plain(value, where: str):
+    """Scene values as the C++ side reads them: NumPy scalars as Python numbers, paths as
+    strings, tuples as lists; anything else that is no scene value is an InputError naming it."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v, f"{where}.{k}" if where else str(k)) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v, f"{where}[{i}]") for i, v in enumerate(value)]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, PathLike):
+        return os.fspath(value)
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value  # None: the C++ side names the key
+    raise InputError(f"{where}: a {type(value).__name__} is not a scene value "
+                     "(strings with units, numbers, booleans, lists and tables)")
 
 
 def _scene_args(scene: Scene, source: Optional[str]):
     """(file, values, source) for the C++ side: a path is read there, a dict is checked there."""
+    name = source if source is not None else "<scene dict>"
     if isinstance(scene, dict):
-        return "", scene, source if source is not None else "<scene dict>"
+        return "", _plain(scene, ""), name
     if isinstance(scene, (str, PathLike)):
         return os.fspath(scene), {}, ""
     raise TypeError("scene: a file path or a dict of scene values, not " + type(scene).__name__)
@@ -63,7 +86,7 @@ def read_scene(file: Union[str, "PathLike[str]"]) -> Dict[str, Any]:
 
 def scene_toml(scene: Dict[str, Any], source: str = "<scene dict>") -> str:
     """The dict as scene-file text (TOML), e.g. to save a changed scene."""
-    return _core.scene_toml(scene, source)
+    return _core.scene_toml(_plain(scene, ""), source)
 
 
 def simulate(
@@ -86,10 +109,19 @@ def simulate(
     keep the scene's own choices.
     """
     file, values, name = _scene_args(scene, source)
-    return _core.simulate(
+    result = _core.simulate(
         file, values, name, fidelity, contact, criterion, model, axis, int(max_needles),
-        bool(no_reductions), _plugin_dirs(plugin_dirs),
+        bool(no_reductions), _list(plugin_dirs, "plugin_dirs"),
     )
+    check = result.get("energy_check")
+    if check and not check["passes"]:
+        # As the CLI warns on stderr (docs/model.md, "Energy check").
+        warnings.warn(
+            f"{file or name}: the tissue stores {100 * (1 + check['relative_difference']):.3g} % "
+            f"of the work the needle did on it up to {check['depth_m']:.3g} m (more than "
+            f"{100 * check['tolerance']:.3g} % apart: the contact or the mesh is not resolved)",
+            RuntimeWarning, stacklevel=2)
+    return result
 
 
 def strength(
@@ -109,15 +141,16 @@ def strength(
 
     ``set`` gives plugin parameters as ``{"diameter": "200 um"}`` or ``["diameter=200um"]``.
     """
-    settings = [f"{k}={v}" for k, v in set.items()] if isinstance(set, dict) else list(set)
+    settings = ([f"{k}={v}" for k, v in set.items()] if isinstance(set, dict)
+                else _list(set, "set"))
     return _core.strength(
         "" if file is None else os.fspath(file), plugin, settings, unit, axis, material, end,
-        depth, float(lateral_ratio), _plugin_dirs(plugin_dirs),
+        depth, float(lateral_ratio), _list(plugin_dirs, "plugin_dirs"),
     )
 
 
 def screen(
-    designs: Iterable[Union[str, "PathLike[str]"]],
+    designs: Paths,
     scene: Union[str, "PathLike[str]"],
     *,
     fidelity: str = "fast",
@@ -131,16 +164,18 @@ def screen(
 ) -> Dict[str, Any]:
     """``mneedle screen DESIGNS… --scene SCENE --json``: every design ranked on the scene.
 
+    ``designs`` are mesh files, folders of them or design lists, as on the CLI (one path alone
+    is a list of one). The scene is a file: write a changed dict with :func:`scene_toml` first.
     A design that fails is a row with ``"ok": False`` and its error; the others still run.
     """
     return _core.screen(
-        [os.fspath(d) for d in designs], os.fspath(scene), fidelity, model, material, int(jobs),
-        unit, axis, bool(repair), _plugin_dirs(plugin_dirs),
+        _list(designs, "designs"), os.fspath(scene), fidelity, model, material, int(jobs),
+        unit, axis, bool(repair), _list(plugin_dirs, "plugin_dirs"),
     )
 
 
 def fit(
-    files: Iterable[Union[str, "PathLike[str]"]],
+    files: Paths,
     *,
     depth_col: str = "",
     force_col: str = "",
@@ -156,8 +191,9 @@ def fit(
 ) -> Dict[str, Any]:
     """``mneedle fit CURVES… --json``: paper B's tri-force model fitted to recordings jointly."""
     return _core.fit(
-        [os.fspath(f) for f in files], depth_col, force_col, depth_unit, force_unit, speed,
-        angle, list(fix), list(free), list(layer_starts), int(detect_layers), int(starts),
+        _list(files, "files"), depth_col, force_col, depth_unit, force_unit, speed, angle,
+        _list(fix, "fix"), _list(free, "free"), _list(layer_starts, "layer_starts"),
+        int(detect_layers), int(starts),
     )
 
 
@@ -165,24 +201,33 @@ def curves(result: Dict[str, Any]) -> Dict[str, Dict[str, np.ndarray]]:
     """A ``simulate`` result's force–depth curves as NumPy arrays.
 
     ``{needle name: {"depth_m": array, "force_N": array, "stage": array of "pre"/"post", ...}}``
-    with every per-point number the JSON has for all of the needle's points; the sum of the
-    needles' curves as ``"total"`` when the scene has more than one needle.
+    with every per-point value the JSON has (a pair such as ``lateral_force_N`` as an n × 2
+    array); a value a point does not have is NaN (the pre-puncture quantities after puncture,
+    ``alpha_N`` before it). The sum of the needles' curves is ``"total"`` when the scene has more
+    than one needle.
     """
     out: Dict[str, Dict[str, np.ndarray]] = {}
 
     def columns(points: List[Dict[str, Any]]) -> Dict[str, np.ndarray]:
-        keys = [k for k in points[0] if all(k in p for p in points)] if points else []
+        keys: List[str] = []
+        for p in points:
+            keys += [k for k in p if k not in keys]
         cols: Dict[str, np.ndarray] = {}
         for k in keys:
-            values = [p[k] for p in points]
-            if isinstance(values[0], str):
-                cols[k] = np.array(values)
-            elif isinstance(values[0], (int, float)):
-                cols[k] = np.asarray(values, dtype=float)
+            present = [p[k] for p in points if k in p]
+            if isinstance(present[0], str):
+                cols[k] = np.array([p.get(k, "") for p in points])
+            elif isinstance(present[0], list):
+                width = len(present[0])
+                cols[k] = np.array([p.get(k, [np.nan] * width) for p in points], dtype=float)
+            elif isinstance(present[0], (int, float)) and not isinstance(present[0], bool):
+                cols[k] = np.array([p.get(k, np.nan) for p in points], dtype=float)
         return cols
 
     for needle in result["needles"]:
         out[needle["name"]] = columns(needle["curve"])
     if len(result["needles"]) > 1:
+        if "total" in out:
+            raise InputError("curves: a needle is named 'total', the name of the needles' sum")
         out["total"] = columns(result["total_curve"])
     return out

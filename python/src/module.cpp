@@ -6,6 +6,9 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <map>
+#include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <pybind11_json/pybind11_json.hpp>
 #include <string>
@@ -35,8 +38,30 @@ std::vector<std::filesystem::path> paths(const std::vector<std::string>& dirs) {
   return {dirs.begin(), dirs.end()};
 }
 
-// A scene is a file or values; the values arrive as JSON text (converted while the GIL is
-// held) and are parsed after it is released.
+// One registry per list of extra plugin folders, for the life of the process: a plugin that is
+// not thread-safe is serialised by its registry, so Python threads must share it (a registry
+// per call would let two threads into the same plugin at once). Plugins are found at the first
+// call that names those folders.
+std::mutex registries_mutex;
+std::filesystem::path builtin_dir;  // the package's own plugin folder (_paths.py)
+std::map<std::vector<std::string>, std::unique_ptr<PluginRegistry>> registries;
+
+const PluginRegistry& registry_for(const std::vector<std::string>& plugin_dirs) {
+  std::lock_guard<std::mutex> lock(registries_mutex);
+  auto& registry = registries[plugin_dirs];
+  if (!registry)
+    registry = std::make_unique<PluginRegistry>(
+        PluginRegistry::discover_from(builtin_dir, paths(plugin_dirs)));
+  return *registry;
+}
+
+void set_plugin_folder(const std::string& folder) {
+  std::lock_guard<std::mutex> lock(registries_mutex);
+  builtin_dir = folder;  // once, at import: before any registry exists
+}
+
+// A scene is a file or values; the values arrive converted to JSON (while the GIL is held) and
+// are parsed after it is released.
 Scene scene_of(const std::string& file, const nlohmann::json& values, const std::string& source) {
   if (!file.empty()) return load_scene(file);
   return scene_from_values(values, source);
@@ -47,7 +72,7 @@ nlohmann::json simulate(const std::string& file, const nlohmann::json& values,
                         const std::vector<std::string>& plugin_dirs) {
   Scene scene = scene_of(file, values, source);
   apply_simulate_settings(scene, settings);
-  const PluginRegistry registry = PluginRegistry::discover(paths(plugin_dirs));
+  const PluginRegistry& registry = registry_for(plugin_dirs);
   const std::vector<PreparedNeedle> needles =
       prepare_needles(registry, scene, settings.max_needles);
   const InsertionRun run = run_insertion(scene, needles, simulate_run_options(scene, settings));
@@ -60,7 +85,7 @@ nlohmann::json strength(const std::string& file, const std::string& plugin,
                         const std::vector<std::string>& plugin_dirs) {
   if (file.empty() == plugin.empty())
     throw InputError("strength: give either a mesh file or plugin=NAME");
-  const PluginRegistry registry = PluginRegistry::discover(paths(plugin_dirs));
+  const PluginRegistry& registry = registry_for(plugin_dirs);
   const NeedleSource needle =
       file.empty() ? needle_from_plugin(registry, plugin,
                                         parse_parameter_settings(registry.shape(plugin), set))
@@ -72,7 +97,7 @@ nlohmann::json screen(const std::vector<std::string>& designs, const std::string
                       const ScreeningOptions& options, const std::string& unit,
                       const std::vector<std::string>& plugin_dirs) {
   const Scene scene = load_scene(file);
-  const PluginRegistry registry = PluginRegistry::discover(paths(plugin_dirs));
+  const PluginRegistry& registry = registry_for(plugin_dirs);
   const auto inputs = collect_designs(paths(designs), length_unit_scale(unit));
   if (inputs.empty()) throw InputError("screen: no mesh files or designs found in the inputs");
   parse_axis_choice(options.axis);
@@ -92,19 +117,11 @@ PYBIND11_MODULE(_core, m) {
   using namespace mneedle::python;
   m.doc() = "mneedle's C++ core; use the mneedle package (docs/python.md)";
   // Exceptions map by type; what() is the CLI's message, word for word.
-  static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
-  static py::exception<SolverError> solver_error(m, "SolverError", PyExc_RuntimeError);
-  py::register_exception_translator([](std::exception_ptr p) {
-    try {
-      if (p) std::rethrow_exception(p);
-    } catch (const InputError& e) {
-      input_error(e.what());
-    } catch (const SolverError& e) {
-      solver_error(e.what());
-    }
-  });
+  py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
+  py::register_exception<SolverError>(m, "SolverError", PyExc_RuntimeError);
   m.attr("__version__") = tool_version();
 
+  m.def("_set_plugin_folder", &set_plugin_folder, py::arg("folder"));
   m.def("read_scene", &read_scene_values, py::arg("file"),
         py::call_guard<py::gil_scoped_release>());
   m.def("scene_toml", &scene_values_toml, py::arg("values"), py::arg("source"),

@@ -28,8 +28,16 @@ TEST(SceneValues, ValuesOfAFileGiveTheFilesScene) {
       EXPECT_EQ(values.tissue.layers[i].name, file.tissue.layers[i].name);
       EXPECT_EQ(values.tissue.layers[i].thickness, file.tissue.layers[i].thickness);
     }
-    EXPECT_EQ(values.needles.size(), file.needles.size());
+    ASSERT_EQ(values.needles.size(), file.needles.size());
+    for (std::size_t i = 0; i < file.needles.size(); ++i) {
+      EXPECT_EQ(values.needles[i].name, file.needles[i].name);
+      EXPECT_EQ(values.needles[i].at, file.needles[i].at);
+    }
     EXPECT_EQ(values.insertion.depth, file.insertion.depth);
+    EXPECT_EQ(values.tissue.size, file.tissue.size);
+    EXPECT_EQ(values.model.criterion, file.model.criterion);
+    EXPECT_EQ(values.loads.friction_coefficient, file.loads.friction_coefficient);
+    EXPECT_EQ(values.requirements.safety_factor, file.requirements.safety_factor);
   }
 }
 
@@ -45,12 +53,23 @@ TEST(SceneValues, NullAndNonFiniteNumbersAreNamedByTheirKey) {
             "s: a scene is a table of values (a dict)");
 }
 
+TEST(SceneValues, IntegersStandForNumbersAndHugeOnesAreRefused) {
+  nlohmann::json v = read_scene_values(kScenes + "silicone_phantom.toml");
+  v["loads"]["friction_coefficient"] = 1;  // an integer where a number is read
+  EXPECT_EQ(scene_from_values(v, "s").loads.friction_coefficient, 1.0);
+  v["loads"]["friction_coefficient"] = std::uint64_t{1} << 63;  // beyond a TOML integer
+  EXPECT_EQ(message_of([&] { scene_values_toml(v, "s"); }),
+            "s: loads.friction_coefficient: integer too large for a scene");
+}
+
 TEST(SceneValues, TheParserChecksValuesAsItChecksFiles) {
   nlohmann::json v = read_scene_values(kScenes + "silicone_phantom.toml");
   v["tissue"]["layers"][0]["material"]["E"] = "0.2";  // no unit
   const std::string m = message_of([&] { scene_from_values(v, "changed"); });
-  EXPECT_EQ(m.rfind("changed", 0), 0u) << m;
-  EXPECT_NE(m.find("E"), std::string::npos) << m;
+  EXPECT_EQ(m.rfind("changed:", 0), 0u) << m;
+  EXPECT_NE(m.find(": tissue.layers[0].material.E: \"0.2\" needs a unit: a pressure"),
+            std::string::npos)
+      << m;
 }
 
 }  // namespace

@@ -5,10 +5,12 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace mneedle::test {
 
@@ -48,6 +50,28 @@ inline CommandRun run_command(const std::string& command_line) {
 inline CommandRun run_mneedle(const std::string& arguments) {
   return run_command("'" + mneedle_binary() + "' " + arguments);
 }
+
+#ifdef MNEEDLE_MPIEXEC
+/// The words of `mpirun -n RANKS --oversubscribe mneedle ARGUMENTS… --mpi` under the MPI
+/// launcher CMake found (docs/performance.md, "Screening on a cluster"): two ranks on any
+/// machine; as root Open MPI wants the two variables set here.
+inline std::vector<std::string> mpirun(int ranks, std::vector<std::string> arguments) {
+  ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+  ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+  std::vector<std::string> words{"-n", std::to_string(ranks), "--oversubscribe", mneedle_binary()};
+  words.insert(words.end(), arguments.begin(), arguments.end());
+  words.push_back("--mpi");
+  return words;
+}
+
+/// The launcher's command line, under coreutils' timeout: a hang in the ranks' protocol must
+/// fail the test, not hold up the suite.
+inline std::string shell_words(const std::vector<std::string>& words) {
+  std::string line = std::string("timeout 300 '") + MNEEDLE_MPIEXEC + "'";
+  for (const auto& w : words) line += " '" + w + "'";
+  return line;
+}
+#endif
 
 /// A whole output file as text ("" when it is missing).
 inline std::string file_text(const std::filesystem::path& file) {

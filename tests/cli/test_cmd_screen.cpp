@@ -426,23 +426,8 @@ TEST(ScreenCommand, UncertaintyAndVaryNeedEachOtherAndABadPathFailsBeforeAnyDesi
 
 #ifdef MNEEDLE_MPIEXEC
 // screen --mpi under the MPI launcher CMake found (docs/performance.md, "Screening on a cluster").
-// Two ranks on any machine (--oversubscribe); as root Open MPI wants the two variables below.
-std::vector<std::string> mpirun(int ranks, std::vector<std::string> arguments) {
-  ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-  ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-  std::vector<std::string> words{"-n", std::to_string(ranks), "--oversubscribe",
-                                 mneedle::test::mneedle_binary()};
-  words.insert(words.end(), arguments.begin(), arguments.end());
-  words.push_back("--mpi");
-  return words;
-}
-
-// A hang in the ranks' protocol must fail the test, not hold up the suite: coreutils' timeout.
-std::string shell_words(const std::vector<std::string>& words) {
-  std::string line = std::string("timeout 300 '") + MNEEDLE_MPIEXEC + "'";
-  for (const auto& w : words) line += " '" + w + "'";
-  return line;
-}
+using mneedle::test::mpirun;
+using mneedle::test::shell_words;
 
 // The rows of a --json screen by design, without what may differ between runs (timings) or
 // says how the row was reached (resumed).

@@ -1,8 +1,11 @@
 // `mneedle uncertainty` end to end: the JSON a notebook reads, the table, and bad --vary values.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
+#include <string>
 
+#include "../plot/svg_reader.h"
 #include "run_mneedle.h"
 
 namespace {
@@ -10,6 +13,8 @@ namespace {
 using mneedle::test::run_mneedle;
 const std::string kRoot = MNEEDLE_SOURCE_ROOT;
 const std::string kSilicone = kRoot + "/designs/scenes/paper_a_silicone_blunt_bevel.toml";
+// A flat punch on the axisymmetric FE model, puncturing within its insertion at fast fidelity.
+const std::string kPunch = std::string(MNEEDLE_TEST_ASSETS) + "/scenes/puncture_punch.toml";
 
 TEST(UncertaintyCommand, JsonGivesInputsSummarySensitivityAndEverySample) {
   const auto run = run_mneedle("uncertainty '" + kSilicone +
@@ -73,5 +78,77 @@ TEST(UncertaintyCommand, BadVaryIsOneLineNamingItAndExitOne) {
     EXPECT_EQ(run.err.find('\n'), run.err.size() - 1) << "one line: " << run.err;
   }
 }
+
+TEST(UncertaintyCommand, PlotDrawsTheDistributionWithItsPercentiles) {
+  const auto svg = std::filesystem::temp_directory_path() / "mneedle_uncertainty_plot.svg";
+  std::filesystem::remove(svg);
+  const auto run = run_mneedle("uncertainty '" + kPunch +
+                               "' --vary 'silicone.E=lognormal(0.2MPa,20%)' --samples 6 "
+                               "--no-sensitivity --plot '" +
+                               svg.string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto t = mneedle::test::texts(mneedle::test::read_svg(svg));
+  for (const char* label : {"5 %", "median", "95 %", "share of samples at or below [%]", "puncture depth [um]"})
+    EXPECT_TRUE(mneedle::test::has_text(t, label)) << label;
+  bool titled = false;  // the title says how many samples the distribution has
+  for (const auto& x : t)
+    titled = titled || x.text.find("6 samples with a resolved") != std::string::npos;
+  EXPECT_TRUE(titled);
+}
+
+#ifdef MNEEDLE_MPIEXEC
+using mneedle::test::mpirun;
+using mneedle::test::run_command;
+using mneedle::test::shell_words;
+
+// What a run's result is, without the provenance (its time and command line differ).
+nlohmann::json result_of(const std::string& json_text) {
+  auto j = nlohmann::json::parse(json_text);
+  j.erase("provenance");
+  return j;
+}
+
+TEST(UncertaintyCommand, TwoMpiRanksGiveTheSerialResultBitForBit) {
+  // The axisymmetric FE model, Monte Carlo and Latin hypercube; the serial run with two jobs
+  // holds OpenBLAS at one thread per run, as every rank of the MPI job does.
+  for (const char* method : {"mc", "lhs"}) {
+    const std::vector<std::string> arguments{
+        "uncertainty", kPunch, "--vary", "silicone.E=lognormal(0.2MPa,20%)",
+        "--samples",   "6",    "--seed", "7",
+        "--method",    method, "--json"};
+    std::string serial_line = "'" + mneedle::test::mneedle_binary() + "'";
+    for (const auto& w : arguments) serial_line += " '" + w + "'";
+    const auto serial = run_command(serial_line + " --jobs 2");
+    ASSERT_EQ(serial.exit_code, 0) << serial.err;
+    for (const char* jobs : {"1", "2"}) {
+      auto words = mpirun(2, arguments);
+      words.insert(words.end() - 1, {"--jobs", jobs});
+      const auto mpi = run_command(shell_words(words));
+      ASSERT_EQ(mpi.exit_code, 0) << mpi.err;
+      EXPECT_EQ(result_of(mpi.out), result_of(serial.out)) << method << ", --jobs " << jobs;
+    }
+  }
+}
+
+TEST(UncertaintyCommand, MpiFailureBeforeTheSamplesIsOneLineFromRankZero) {
+  const auto run =
+      run_command(shell_words(mpirun(2, {"uncertainty", kPunch, "--vary",
+                                         "silicone.Young=uniform(1MPa,2MPa)", "--samples", "3"})));
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find("mneedle: error: "), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find("mneedle: error: "), run.err.rfind("mneedle: error: ")) << run.err;
+  EXPECT_NE(run.err.find("silicone.Young"), std::string::npos) << run.err;
+}
+
+TEST(UncertaintyCommand, StartedByMpirunWithoutMpiRefusesOnce) {
+  auto words = mpirun(
+      2, {"uncertainty", kPunch, "--vary", "silicone.E=uniform(0.1MPa,0.3MPa)", "--samples", "2"});
+  words.pop_back();  // no --mpi
+  const auto run = run_command(shell_words(words));
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find("without --mpi"), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find("mneedle: error: "), run.err.rfind("mneedle: error: ")) << run.err;
+}
+#endif
 
 }  // namespace

@@ -12,6 +12,7 @@
 
 #include "mneedle/base/error.h"
 #include "mneedle/scene/scene.h"
+#include "mneedle/screening_mpi.h"
 
 namespace {
 
@@ -272,6 +273,31 @@ TEST_F(Uncertainty, SameSeedGivesTheSameSamplesBitForBitWhateverTheJobs) {
   options_.seed = 8;
   const auto other = mneedle::run_uncertainty(scene_, {pc, e}, registry_, options_);
   EXPECT_NE(other.samples[0].values, one.samples[0].values);
+}
+
+TEST_F(Uncertainty, OneMpiRankGivesTheThreadedResultBitForBit) {
+  // A singleton MPI job (no launcher): rank 0 deals every run to its own threads, through the
+  // same dealer as N ranks; two ranks run end to end in tests/cli/test_cmd_uncertainty.cpp.
+  if (!mneedle::mpi_built_in()) GTEST_SKIP() << "built without MPI (MNEEDLE_MPI=OFF)";
+  const auto pc = mneedle::parse_varied_value("fracture.critical_pressure=lognormal(0.663MPa,20%)");
+  options_.samples = 5;
+  options_.jobs = 2;
+  const auto threads = mneedle::run_uncertainty(scene_, {pc}, registry_, options_);
+  mneedle::MpiSession session(options_.jobs);
+  int calls = 0;
+  const auto mpi = mneedle::run_uncertainty_mpi(session, scene_, {pc}, registry_, options_,
+                                                [&](int, int) { ++calls; });
+  ASSERT_TRUE(mpi.has_value());
+  EXPECT_EQ(calls, 5 + 2);  // every sample and both sensitivity ends, reported on rank 0
+  ASSERT_EQ(mpi->samples.size(), threads.samples.size());
+  for (std::size_t i = 0; i < threads.samples.size(); ++i) {
+    EXPECT_EQ(mpi->samples[i].values, threads.samples[i].values) << i;
+    EXPECT_EQ(mpi->samples[i].puncture_depth_m, threads.samples[i].puncture_depth_m) << i;
+    EXPECT_EQ(mpi->samples[i].margin, threads.samples[i].margin) << i;
+  }
+  EXPECT_EQ(mpi->puncture_depth_m.p50, threads.puncture_depth_m.p50);
+  ASSERT_EQ(mpi->sensitivity.size(), 1u);
+  EXPECT_EQ(mpi->sensitivity[0].depth_effect_m, threads.sensitivity[0].depth_effect_m);
 }
 
 TEST_F(Uncertainty, ASampleThatCannotRunIsAnErrorRowAndTheOthersGoOn) {

@@ -41,6 +41,15 @@ def test_screen_ranks_as_the_cli_ranks(cli, source):
     assert all(d["ok"] for d in ours["designs"])
 
 
+def test_one_folder_alone_is_screened_as_the_cli_screens_it(cli, source):
+    scene = source / "designs" / "scenes" / "silicone_phantom.toml"
+    folder = source / "designs"  # a str or a path alone is one input, never its letters
+    ours = mneedle.screen(str(folder), scene, model="analytic")
+    theirs = cli.json("screen", folder, "--scene", scene, "--model", "analytic")
+    assert strip_timing(ours) == strip_timing(theirs)
+    assert len(ours["designs"]) == 4
+
+
 def test_fit_is_the_cli_fit(cli, source):
     curve = source / "tests" / "assets" / "curves" / "loading_hold_retraction.csv"
     ours = mneedle.fit([curve], starts=2)

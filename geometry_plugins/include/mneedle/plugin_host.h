@@ -67,6 +67,12 @@ class PluginRegistry {
   /// with a warning.
   static PluginRegistry discover(const std::vector<std::filesystem::path>& extra_dirs = {});
 
+  /// The same with the built-in folder given by the caller: a library loaded into another
+  /// program (the Python package, whose executable is python3) knows where its plugins are;
+  /// the executable's folder says nothing about that.
+  static PluginRegistry discover_from(const std::filesystem::path& builtin_dir,
+                                      const std::vector<std::filesystem::path>& extra_dirs = {});
+
   /// The built-in plugin folder this executable would search (may not exist).
   static std::filesystem::path builtin_plugin_dir();
 

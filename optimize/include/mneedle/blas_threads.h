@@ -9,16 +9,15 @@ namespace mneedle {
 int blas_threads();
 
 /// Holds OpenBLAS at `threads` for its lifetime and restores the previous count afterwards.
-/// Does nothing when the BLAS is not OpenBLAS (reference BLAS is single-threaded anyway).
+/// Limits that overlap (from several threads) share one: the first sets it, the last restores
+/// the count from before the first (every caller asks for one thread). Does nothing when the
+/// BLAS is not OpenBLAS (reference BLAS is single-threaded anyway).
 class BlasThreadLimit {
  public:
   explicit BlasThreadLimit(int threads);
   ~BlasThreadLimit();
   BlasThreadLimit(const BlasThreadLimit&) = delete;
   BlasThreadLimit& operator=(const BlasThreadLimit&) = delete;
-
- private:
-  int previous_ = 0;
 };
 
 }  // namespace mneedle

@@ -7,6 +7,7 @@
 #include <exception>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "mneedle/screening.h"
@@ -54,6 +55,10 @@ class MpiSession {
     bool rank0 = true;
   };
   Agreement agree(bool ok) const;
+
+  /// Whether `definition` (what the ranks must share: the inputs' bytes and settings) is the
+  /// same as rank 0's; called by every rank at the same point. Compares a hash, not the text.
+  bool matches_rank0(const std::string& definition) const;
 
  private:
   int rank_ = 0;

@@ -135,4 +135,19 @@ UncertaintyResult run_uncertainty(const std::string& scene_text, const std::stri
                                   const UncertaintyOptions& options, const SceneEvaluator& evaluate,
                                   const std::function<void(int, int)>& on_sample = {});
 
+class MpiSession;
+
+/// run_uncertainty over every rank of an MPI job (`uncertainty --mpi`; docs/performance.md,
+/// "Screening on a cluster"): every rank draws the same samples, rank 0 deals the runs one at a
+/// time to whichever thread of any rank asks, and rank 0 returns the same result as the serial
+/// run, bit for bit (one OpenBLAS thread per run, as with jobs > 1); the other ranks return
+/// nothing. Every rank must read the same scene with the same settings (checked). A failure
+/// before the samples stops every rank: rank 0 throws it (or an InputError saying that another
+/// rank could not start), a rank > 0 whose error rank 0 does not share throws it, the others
+/// throw RankStopped. `on_sample` is called on rank 0 only.
+std::optional<UncertaintyResult> run_uncertainty_mpi(
+    const MpiSession& session, const std::filesystem::path& scene_file,
+    const std::vector<VariedValue>& inputs, const PluginRegistry& registry,
+    const UncertaintyOptions& options, const std::function<void(int, int)>& on_sample = {});
+
 }  // namespace mneedle

@@ -11,7 +11,8 @@
 
 namespace mneedle {
 
-/// The file's values (scene_values_json), STL paths absolute.
+/// The file's values (scene_values_json), STL paths absolute; the file is checked first as
+/// load_scene checks it (the same errors as the CLI's).
 nlohmann::json read_scene_values(const std::filesystem::path& scene_file);
 
 /// The values as TOML text: objects become tables, arrays arrays, strings, booleans, integers
