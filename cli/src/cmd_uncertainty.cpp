@@ -139,9 +139,10 @@ void run_uncertainty_command(const UncertaintyArgs& args) {
         if (args.method != "mc" && args.method != "lhs")
           throw InputError("uncertainty: --method '" + args.method + "' (mc or lhs)");
         found.emplace(PluginRegistry::discover({args.plugin_dirs.begin(), args.plugin_dirs.end()}));
+        // Inside the setup: an unreadable scene must stop every rank, not rank 0 alone.
+        if (writer) record_input("scene", args.scene);
       },
       "uncertainty");
-  if (writer) record_input("scene", args.scene);
   const PluginRegistry& registry = *found;
   UncertaintyOptions options;
   options.samples = args.samples;

@@ -61,51 +61,68 @@ constexpr int kResult = 3;
 // Rank 0: deals tasks to its own threads and to every other rank's threads, and records every
 // result. Its main thread only talks MPI (polling, so that a result is recorded the moment it
 // arrives); `jobs` threads run tasks.
-void coordinate_loop(const MpiSession& session, int jobs, const DealtTasks& tasks) {
+void coordinate_loop(const MpiSession& session, int jobs, const DealtTasks& tasks,
+                     const char* command) {
   std::vector<std::thread> pool;
   for (int j = 0; j < jobs; ++j)
     pool.emplace_back([&] {
-      while (const auto i = tasks.claim()) tasks.run_here(*i);
+      while (const auto i = tasks.claim()) {
+        try {
+          tasks.run_here(*i);
+        } catch (...) {
+          // Must not happen (run_here catches its own); the caller finds the task without a
+          // result and says so, rather than the exception ending the process.
+        }
+      }
     });
   // Every thread of every other rank asks until it is told -1; a result is owed for every index
   // dealt. Both must be settled before rank 0 may stop listening.
   const long remote_threads = static_cast<long>(session.size() - 1) * jobs;
-  long stopped = 0;
-  long owed = 0;
-  while (stopped < remote_threads || owed > 0) {
-    int arrived = 0;
-    MPI_Status status;
-    MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &arrived, &status);
-    if (!arrived) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-      continue;
-    }
-    if (status.MPI_TAG == kRequest) {
-      int nothing = 0;
-      MPI_Recv(&nothing, 1, MPI_INT, status.MPI_SOURCE, kRequest, MPI_COMM_WORLD,
-               MPI_STATUS_IGNORE);
-      const auto i = tasks.claim();
-      long long index = i ? static_cast<long long>(*i) : -1;
-      (i ? owed : stopped) += 1;
-      MPI_Send(&index, 1, MPI_LONG_LONG, status.MPI_SOURCE, kIndex, MPI_COMM_WORLD);
-    } else if (status.MPI_TAG == kResult) {
-      int bytes = 0;
-      MPI_Get_count(&status, MPI_CHAR, &bytes);
-      std::string message(static_cast<std::size_t>(bytes), '\0');
-      MPI_Recv(message.data(), bytes, MPI_CHAR, status.MPI_SOURCE, kResult, MPI_COMM_WORLD,
-               MPI_STATUS_IGNORE);
-      --owed;
-      // Our own ranks wrote it; a message that names no task would be a bug in this file, and
-      // is dropped rather than recorded anywhere (the caller finds the task without a result).
-      const auto newline = message.find('\n');
-      std::size_t i = tasks.count;
-      try {
-        i = std::stoul(message.substr(0, newline));
-      } catch (const std::exception&) {
+  try {
+    long stopped = 0;
+    long owed = 0;
+    while (stopped < remote_threads || owed > 0) {
+      int arrived = 0;
+      MPI_Status status;
+      MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &arrived, &status);
+      if (!arrived) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        continue;
       }
-      if (newline == std::string::npos || i >= tasks.count) continue;
-      tasks.record_text(i, message.substr(newline + 1));
+      if (status.MPI_TAG == kRequest) {
+        int nothing = 0;
+        MPI_Recv(&nothing, 1, MPI_INT, status.MPI_SOURCE, kRequest, MPI_COMM_WORLD,
+                 MPI_STATUS_IGNORE);
+        const auto i = tasks.claim();
+        long long index = i ? static_cast<long long>(*i) : -1;
+        (i ? owed : stopped) += 1;
+        MPI_Send(&index, 1, MPI_LONG_LONG, status.MPI_SOURCE, kIndex, MPI_COMM_WORLD);
+      } else if (status.MPI_TAG == kResult) {
+        int bytes = 0;
+        MPI_Get_count(&status, MPI_CHAR, &bytes);
+        std::string message(static_cast<std::size_t>(bytes), '\0');
+        MPI_Recv(message.data(), bytes, MPI_CHAR, status.MPI_SOURCE, kResult, MPI_COMM_WORLD,
+                 MPI_STATUS_IGNORE);
+        --owed;
+        // Our own ranks wrote it; a message that names no task would be a bug in this file, and
+        // is dropped rather than recorded anywhere (the caller finds the task without a result).
+        const auto newline = message.find('\n');
+        std::size_t i = tasks.count;
+        try {
+          i = std::stoul(message.substr(0, newline));
+        } catch (const std::exception&) {
+        }
+        if (newline == std::string::npos || i >= tasks.count) continue;
+        tasks.record_text(i, message.substr(newline + 1));
+      }
     }
+  } catch (const std::exception& e) {
+    // Out of memory or the like in the loop itself: the other ranks wait on rank 0 and would
+    // wait for ever, so the job ends here, before the threads are left unjoined (results
+    // already written stay written).
+    std::fprintf(stderr, "mneedle: internal error: %s --mpi, rank 0: %s\n", command, e.what());
+    std::fflush(stderr);
+    MPI_Abort(MPI_COMM_WORLD, 4);
   }
   for (auto& t : pool) t.join();
 }
@@ -128,8 +145,14 @@ void work(int jobs, const DealtTasks& tasks) {
       // The ranks agreed on the tasks, so rank 0 deals only indices below count; one beyond it
       // would be a bug, answered with no text (rank 0 drops it) rather than a read past the end.
       const auto i = static_cast<std::size_t>(index);
-      const std::string message =
-          std::to_string(index) + "\n" + (i < tasks.count ? tasks.run_for_rank0(i) : "");
+      std::string text;
+      try {
+        if (i < tasks.count) text = tasks.run_for_rank0(i);
+      } catch (...) {
+        // Must not happen (run_for_rank0 catches its own); should it, the task still gets its
+        // answer: empty text, which rank 0 records as an unreadable result.
+      }
+      const std::string message = std::to_string(index) + "\n" + text;
       std::lock_guard<std::mutex> lock(mpi);
       MPI_Send(message.data(), static_cast<int>(message.size()), MPI_CHAR, 0, kResult,
                MPI_COMM_WORLD);
@@ -181,16 +204,7 @@ void deal_over_ranks(const MpiSession& session, int jobs, const DealtTasks& task
     work(jobs, tasks);
     return;
   }
-  try {
-    coordinate_loop(session, jobs, tasks);
-  } catch (const std::exception& e) {
-    // Out of memory or the like in the loop itself: the other ranks wait on rank 0 and would
-    // wait for ever, so the job ends here (results already written stay written).
-    std::fprintf(stderr, "mneedle: internal error: %s --mpi, rank 0: %s\n", command, e.what());
-    std::fflush(stderr);
-    MPI_Abort(MPI_COMM_WORLD, 4);
-    throw;
-  }
+  coordinate_loop(session, jobs, tasks, command);
 }
 
 bool MpiSession::matches_rank0(const std::string& definition) const {
@@ -223,10 +237,11 @@ std::vector<ScreeningRow> screen_designs_mpi(
     failure = e.what();
   }
   // Collective: every rank takes part, whether its batch started or not.
-  if (!session.matches_rank0(fingerprint) && failure.empty())
+  // --jobs too: rank 0 counts every other rank's threads as its own number.
+  if (!session.matches_rank0(fingerprint + "|jobs=" + std::to_string(jobs)) && failure.empty())
     failure = "screen --mpi: rank " + std::to_string(session.rank()) +
-              " sees other designs or another scene than rank 0 (every rank must read the same "
-              "files)";
+              " sees other designs, another scene or another --jobs than rank 0 (every rank must "
+              "read the same files)";
   const auto agreement = session.agree(failure.empty());
   if (!agreement.all) {
     if (!failure.empty() && (coordinator || agreement.rank0)) throw InputError(failure);

@@ -540,9 +540,10 @@ std::string sample_text(const UncertaintySample& s) {
       {"first_contact", s.puncture_at_first_contact},
       {"objective", s.puncture_objective_m},
       {"peak", s.peak_force_n},
-      {"margin", std::isinf(s.margin) ? nlohmann::json() : nlohmann::json(s.margin)},
+      {"margin", s.margin == INFINITY ? nlohmann::json() : nlohmann::json(s.margin)},
       {"passes", s.passes}}
-      .dump();
+      // An error message may hold a path that is not UTF-8: replaced, never a throw.
+      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 UncertaintySample sample_from_text(const std::string& text) {
@@ -580,12 +581,14 @@ std::optional<UncertaintyResult> run_uncertainty_mpi(
   std::string definition =
       text + "|" + std::to_string(options.samples) + "|" + std::to_string(options.seed) + "|" +
       (options.latin_hypercube ? "lhs" : "mc") + "|" + options.fidelity + "|" + options.model +
-      "|" + options.material.value_or("") + "|" + (options.sensitivity ? "s" : "");
+      "|" + options.material.value_or("") + "|" + (options.sensitivity ? "s" : "") +
+      "|jobs=" + std::to_string(std::max(1, options.jobs));  // rank 0 counts the others' threads
   for (const auto& v : inputs) definition += "|" + v.text;
   if (!session.matches_rank0(definition) && failure.empty())
-    failure = "uncertainty --mpi: rank " + std::to_string(session.rank()) +
-              " sees another scene or other settings than rank 0 (every rank must read the "
-              "same files)";
+    failure =
+        "uncertainty --mpi: rank " + std::to_string(session.rank()) +
+        " sees another scene or other settings (or --jobs) than rank 0 (every rank must read the "
+        "same files)";
   // Under MPI every failure before the samples stops every rank; each error is said once.
   const auto stop_if_any_failed = [&](bool ok, const std::function<void()>& rethrow) {
     const auto agreement = session.agree(ok);
@@ -624,7 +627,15 @@ std::optional<UncertaintyResult> run_uncertainty_mpi(
       return std::nullopt;
     };
     tasks.run_here = [&](std::size_t i) { keep(i, run(i)); };
-    tasks.run_for_rank0 = [&](std::size_t i) { return sample_text(run(i)); };
+    tasks.run_for_rank0 = [&](std::size_t i) {
+      try {
+        return sample_text(run(i));
+      } catch (const std::exception& e) {  // run() catches its own; this is text that failed
+        UncertaintySample s;
+        s.error = e.what();
+        return sample_text(s);
+      }
+    };
     tasks.record_text = [&](std::size_t i, const std::string& text) {
       UncertaintySample s;
       try {

@@ -88,7 +88,8 @@ TEST(UncertaintyCommand, PlotDrawsTheDistributionWithItsPercentiles) {
                                svg.string() + "'");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto t = mneedle::test::texts(mneedle::test::read_svg(svg));
-  for (const char* label : {"5 %", "median", "95 %", "share of samples at or below [%]", "puncture depth [um]"})
+  for (const char* label :
+       {"5 %", "median", "95 %", "share of samples at or below [%]", "puncture depth [um]"})
     EXPECT_TRUE(mneedle::test::has_text(t, label)) << label;
   bool titled = false;  // the title says how many samples the distribution has
   for (const auto& x : t)
@@ -138,6 +139,17 @@ TEST(UncertaintyCommand, MpiFailureBeforeTheSamplesIsOneLineFromRankZero) {
   EXPECT_NE(run.err.find("mneedle: error: "), std::string::npos) << run.err;
   EXPECT_EQ(run.err.find("mneedle: error: "), run.err.rfind("mneedle: error: ")) << run.err;
   EXPECT_NE(run.err.find("silicone.Young"), std::string::npos) << run.err;
+}
+
+TEST(UncertaintyCommand, MpiMissingSceneIsOneLineAndEveryRankStops) {
+  // Rank 0 records its inputs' hashes; a scene it cannot read must stop every rank, not leave
+  // the others waiting for it (the launcher's timeout would fail this test after 300 s).
+  const auto run =
+      run_command(shell_words(mpirun(2, {"uncertainty", "/nonexistent/scene.toml", "--vary",
+                                         "silicone.E=uniform(1MPa,2MPa)", "--samples", "2"})));
+  EXPECT_NE(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("/nonexistent/scene.toml"), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find("mneedle: error: "), run.err.rfind("mneedle: error: ")) << run.err;
 }
 
 TEST(UncertaintyCommand, StartedByMpirunWithoutMpiRefusesOnce) {
