@@ -154,8 +154,7 @@ struct Problem {
   DesignEvaluation evaluate(const NeedleSource& n) const {
     if (const auto it = evaluated.find(n.params); it != evaluated.end()) return it->second;
     EvaluationOptions o = evaluation;
-    o.axisymmetric = axisymmetric_profile(registry, n, "optimize: " + args.plugin);
-    o.mirror_symmetric_y0 = o.axisymmetric.has_value() || mirror_symmetric_y0(n.mesh);
+    o.symmetry = needle_symmetry(registry, n, "optimize: " + args.plugin);
     return evaluated[n.params] = evaluate_design(n.mesh, scene, material, o);
   }
 

@@ -70,8 +70,7 @@ void add_insertion(DesignEvaluation& e, const TriangleMesh& mesh, const Scene& s
                    const EvaluationOptions& options) {
   PreparedNeedle needle;
   needle.mesh = mesh;
-  needle.axisymmetric = options.axisymmetric;
-  needle.mirror_symmetric_y0 = options.mirror_symmetric_y0;
+  apply_symmetry(options.symmetry, needle);
   const Scene s = design_scene(scene, e.depth_m);
   needle.name = s.needles.front().name;
   needle.x = s.needles.front().at[0];

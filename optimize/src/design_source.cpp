@@ -193,6 +193,21 @@ bool mirror_symmetric_x0(const TriangleMesh& mesh) {
   return maps_onto_itself(mesh, {-1.0, 1.0, 1.0});
 }
 
+NeedleSymmetry needle_symmetry(const PluginRegistry& registry, const NeedleSource& needle,
+                               const std::string& where) {
+  NeedleSymmetry s;
+  s.axisymmetric = axisymmetric_profile(registry, needle, where);
+  s.mirror_y0 = s.axisymmetric.has_value() || mirror_symmetric_y0(needle.mesh);
+  s.mirror_x0 = mirror_symmetric_x0(needle.mesh);
+  return s;
+}
+
+void apply_symmetry(const NeedleSymmetry& symmetry, PreparedNeedle& needle) {
+  needle.axisymmetric = symmetry.axisymmetric;
+  needle.mirror_symmetric_y0 = symmetry.mirror_y0;
+  needle.mirror_symmetric_x0 = symmetry.mirror_x0;
+}
+
 bool needs_plugins(const Scene& scene) {
   return std::any_of(scene.needles.begin(), scene.needles.end(), [](const NeedleSpec& n) {
     return std::holds_alternative<PluginGeometry>(n.geometry);
@@ -214,9 +229,7 @@ std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, cons
     n.name = spec.name;
     n.x = spec.at[0];
     n.y = spec.at[1];
-    n.axisymmetric = axisymmetric_profile(registry, source, where);
-    n.mirror_symmetric_y0 = n.axisymmetric.has_value() || mirror_symmetric_y0(source.mesh);
-    n.mirror_symmetric_x0 = mirror_symmetric_x0(source.mesh);
+    apply_symmetry(needle_symmetry(registry, source, where), n);
     n.frame_note = source.frame_note;
     n.mesh = std::move(source.mesh);
     prepared.push_back(std::move(n));

@@ -153,9 +153,7 @@ ScreenedNeedle design_needle(const DesignInput& d, const PluginRegistry& registr
   n.params = source.params;
   n.options.fidelity = parse_fidelity(o.fidelity);
   n.options.model = parse_pre_model(o.model);
-  n.options.axisymmetric = axisymmetric_profile(registry, source, where);
-  n.options.mirror_symmetric_y0 =
-      n.options.axisymmetric.has_value() || mirror_symmetric_y0(source.mesh);
+  n.options.symmetry = needle_symmetry(registry, source, where);
   n.mesh = source.mesh;
   return n;
 }

@@ -262,8 +262,7 @@ SceneEvaluator scene_needle_evaluator(const PluginRegistry& registry,
     EvaluationOptions o;
     o.fidelity = fidelity;
     o.model = model;
-    o.axisymmetric = axisymmetric_profile(registry, needle, source);
-    o.mirror_symmetric_y0 = o.axisymmetric.has_value() || mirror_symmetric_y0(needle.mesh);
+    o.symmetry = needle_symmetry(registry, needle, source);
     return evaluate_design(needle.mesh, scene, design_material(scene, material), o);
   };
 }

@@ -36,8 +36,7 @@ void evaluate(const PluginRegistry& registry, const mneedle::Scene& scene, const
     return;
   }
   mneedle::EvaluationOptions o;
-  o.axisymmetric = mneedle::axisymmetric_profile(registry, n, shape);
-  o.mirror_symmetric_y0 = o.axisymmetric.has_value() || mneedle::mirror_symmetric_y0(n.mesh);
+  o.symmetry = mneedle::needle_symmetry(registry, n, shape);
   std::string where = shape;
   for (const auto& [k, v] : params) where += " " + k + "=" + std::to_string(v);
   EXPECT_NO_THROW({

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 #include <unistd.h>
+#include <algorithm>
 #include <map>
 #include <stdexcept>
 
@@ -93,6 +94,18 @@ TEST_F(Screening, BadDesignGetsAnErrorRowAndEveryOtherIsEvaluatedAndWritten) {
   EXPECT_EQ(jsonl_lines().size(), 5u);
   const auto ranked = mneedle::rank_rows(rows);
   EXPECT_FALSE(ranked.back().ok);
+}
+
+TEST_F(Screening, ACylinderStlIsSolvedOnTheQuarterModelAsSimulateSolvesIt) {
+  // Its facets are symmetric about both planes through the axis (design_source.h,
+  // needle_symmetry): screen once solved the half, twice the work of simulate's quarter.
+  const auto designs = mneedle::collect_designs({dir_ / "in" / "cylinder.stl"}, 1e-3);
+  const auto rows = mneedle::screen_designs(designs, scene_, scene_file_, registry_, {});
+  ASSERT_EQ(rows.size(), 1u);
+  ASSERT_TRUE(rows[0].ok) << rows[0].error;
+  const auto reductions = nlohmann::json::parse(rows[0].json)["reductions"];
+  EXPECT_NE(std::find(reductions.begin(), reductions.end(), "quarter_model"), reductions.end())
+      << reductions.dump();
 }
 
 TEST_F(Screening, TwoJobsGiveTheRowsOfOneJobBitForBitAtOneBlasThreadEach) {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "mneedle/design_source.h"
 #include "mneedle/fe/axisymmetric.h"
 #include "mneedle/fe/fidelity.h"
 #include "mneedle/insertion/insertion_run.h"
@@ -78,8 +79,8 @@ struct EvaluationOptions {
   fe::Fidelity fidelity = fe::Fidelity::Fast;
   PreModel model = PreModel::Auto;
   fe::FidelityOverrides overrides;  // e.g. one tip element size for a whole optimisation
-  std::optional<fe::AxisymmetricNeedle> axisymmetric;  // bodies of revolution (cylinder, cone)
-  bool mirror_symmetric_y0 = false;                    // lets the 3-D model solve half
+  /// Bodies of revolution and mirror planes: needle_symmetry(), as simulate takes them.
+  NeedleSymmetry symmetry;
 };
 
 /// Evaluates a validated mesh in the needle frame, placed where the scene's first needle is (the

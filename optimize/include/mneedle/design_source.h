@@ -70,6 +70,22 @@ bool mirror_symmetric_y0(const TriangleMesh& mesh);
 /// The same for the image (-x, y, z): symmetric about its x = 0 plane (bodies of revolution).
 bool mirror_symmetric_x0(const TriangleMesh& mesh);
 
+/// What a needle's shape lets the pre-puncture model reduce (docs/model.md, "Model reductions"):
+/// the body-of-revolution profile and the mirror planes through its axis.
+struct NeedleSymmetry {
+  std::optional<fe::AxisymmetricNeedle> axisymmetric;  // cylinder and cone plugins
+  bool mirror_y0 = false;                              // symmetric about its y = 0 plane
+  bool mirror_x0 = false;                              // symmetric about its x = 0 plane
+};
+
+/// The symmetry of a needle, taken the same way for every command (simulate, screen, optimize,
+/// uncertainty), so that one needle solves one reduced model and gives one number on every path.
+NeedleSymmetry needle_symmetry(const PluginRegistry& registry, const NeedleSource& needle,
+                               const std::string& where);
+
+/// Copies a needle's symmetry into the planner's description of it.
+void apply_symmetry(const NeedleSymmetry& symmetry, PreparedNeedle& needle);
+
 /// True when a needle of the scene is a plugin shape: STL-only scenes run without plugins.
 bool needs_plugins(const Scene& scene);
 

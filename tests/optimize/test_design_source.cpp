@@ -1,0 +1,67 @@
+// Where a needle comes from and what its shape lets the pre-puncture model reduce. The symmetry
+// is taken in one place for every command: a cylinder STL once ran `screen` on a half model while
+// `simulate` solved its quarter (the same numbers to round-off, at twice the cost).
+#include "mneedle/design_source.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "mneedle/design_evaluation.h"
+#include "mneedle/plugin_host.h"
+#include "mneedle/scene/scene.h"
+
+namespace {
+
+const std::string kRoot = MNEEDLE_SOURCE_ROOT;
+
+class DesignSource : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    registry_ = mneedle::PluginRegistry::discover({MNEEDLE_PLUGIN_BUILD_DIR});
+  }
+  mneedle::PluginRegistry registry_;
+};
+
+TEST_F(DesignSource, ABodyOfRevolutionPluginHasItsProfileAndBothMirrorPlanes) {
+  const auto cylinder = mneedle::needle_from_plugin(registry_, "cylinder", {});
+  const auto s = mneedle::needle_symmetry(registry_, cylinder, "cylinder");
+  EXPECT_TRUE(s.axisymmetric.has_value());
+  EXPECT_TRUE(s.mirror_y0);
+  EXPECT_TRUE(s.mirror_x0);
+}
+
+TEST_F(DesignSource, ABevelIsSymmetricAboutItsYZeroPlaneOnly) {
+  const auto bevel = mneedle::needle_from_plugin(registry_, "sharp_bevel", {});
+  const auto s = mneedle::needle_symmetry(registry_, bevel, "sharp_bevel");
+  EXPECT_FALSE(s.axisymmetric.has_value());
+  EXPECT_TRUE(s.mirror_y0);
+  EXPECT_FALSE(s.mirror_x0);
+}
+
+TEST_F(DesignSource, ACylinderStlHasBothMirrorPlanesButNoProfile) {
+  // An STL carries no profile (the axisymmetric model needs the plugin's exact one), but its
+  // facets are symmetric about both planes, so the 3-D model may solve a quarter.
+  const auto stl = mneedle::needle_from_file(kRoot + "/designs/cylinder.stl", 1e-3);
+  const auto s = mneedle::needle_symmetry(registry_, stl, "cylinder.stl");
+  EXPECT_FALSE(s.axisymmetric.has_value());
+  EXPECT_TRUE(s.mirror_y0);
+  EXPECT_TRUE(s.mirror_x0);
+}
+
+TEST_F(DesignSource, PreparedSceneNeedlesCarryTheSymmetryEveryOtherPathTakes) {
+  // simulate's path (prepare_needles) and screen's (EvaluationOptions) must agree field by field.
+  const mneedle::Scene scene =
+      mneedle::load_scene(kRoot + "/designs/scenes/paper_a_silicone_cylinder.toml");
+  const auto prepared = mneedle::prepare_needles(registry_, scene, 16);
+  ASSERT_EQ(prepared.size(), 1u);
+  const auto source = mneedle::needle_from_scene(registry_, scene.needles.front());
+  mneedle::PreparedNeedle from_options;
+  mneedle::apply_symmetry(mneedle::needle_symmetry(registry_, source, "x"), from_options);
+  EXPECT_EQ(prepared[0].axisymmetric.has_value(), from_options.axisymmetric.has_value());
+  EXPECT_EQ(prepared[0].mirror_symmetric_y0, from_options.mirror_symmetric_y0);
+  EXPECT_EQ(prepared[0].mirror_symmetric_x0, from_options.mirror_symmetric_x0);
+  EXPECT_TRUE(prepared[0].mirror_symmetric_x0);
+}
+
+}  // namespace
