@@ -70,6 +70,11 @@ struct Indentation3d::Impl {
   std::vector<double> reach;         // horizontal reach radius per needle
   std::vector<int> candidates;       // top-surface nodes a needle may capture
   std::vector<int> candidate_index;  // node -> index in candidates or -1
+  // Surface nodes that share a top face with a candidate without being one (nor fixed): their
+  // compliance rows follow the candidates', so that the faces a needle holds, whose area is
+  // reported, are known without a solve over the whole mesh.
+  std::vector<int> ring;
+  std::vector<int> ring_index;  // node -> index in ring or -1
   std::vector<CapturedNode> captured;
   std::vector<int> captured_by;  // node -> needle or -1
   std::vector<char> fixed_dof;
@@ -132,7 +137,25 @@ struct Indentation3d::Impl {
             break;
           }
       }
+    ring_index.assign(mesh.nodes.size(), -1);
+    for (const auto& face : mesh.top_faces) {
+      if (std::none_of(face.begin(), face.end(), [&](int node) {
+            return node >= 0 && candidate_index[static_cast<std::size_t>(node)] >= 0;
+          }))
+        continue;
+      for (int node : face) {
+        const auto i = static_cast<std::size_t>(node);
+        if (node < 0 || candidate_index[i] >= 0 || ring_index[i] >= 0 || mesh.fixed[i]) continue;
+        ring_index[i] = static_cast<int>(ring.size());
+        ring.push_back(node);
+      }
+    }
     captured_by.assign(mesh.nodes.size(), -1);
+  }
+
+  // Rows of the sticking path's compliance: the candidates, then the ring.
+  Eigen::Index surface_rows() const {
+    return 3 * static_cast<Eigen::Index>(candidates.size() + ring.size());
   }
 
   // Candidates whose current position lies inside a needle at `at_depth` are captured onto the
@@ -198,17 +221,17 @@ struct Indentation3d::Impl {
       for (int j = 0; j < 3; ++j)
         unit(3 * found[i].node + j, 3 * static_cast<Eigen::Index>(i) + j) = 1.0;
     const Eigen::MatrixXd columns = solver.solve_many(unit);
-    compliance.conservativeResize(3 * static_cast<Eigen::Index>(candidates.size()),
-                                  old_columns + columns.cols());
-    for (std::size_t c = 0; c < candidates.size(); ++c)
+    compliance.conservativeResize(surface_rows(), old_columns + columns.cols());
+    for (std::size_t c = 0; c < candidates.size() + ring.size(); ++c) {
+      const int node = c < candidates.size() ? candidates[c] : ring[c - candidates.size()];
       for (int j = 0; j < 3; ++j)
         compliance.block(3 * static_cast<Eigen::Index>(c) + j, old_columns, 1, columns.cols()) =
-            columns.row(3 * candidates[c] + j);
+            columns.row(3 * node + j);
+    }
   }
 
   Eigen::VectorXd candidate_displacement() const {
-    if (captured.empty())
-      return Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(candidates.size()));
+    if (captured.empty()) return Eigen::VectorXd::Zero(surface_rows());
     return compliance * multipliers;
   }
 
@@ -699,6 +722,21 @@ struct Indentation3d::Impl {
     return result;
   }
 
+  // The linear path's displacement at the corners of the held faces, from the compliance rows
+  // of the candidates and their ring (every corner of a held face is one of them or fixed): a
+  // solve over the whole mesh per step cost as much as the contact itself. Entries of other
+  // nodes are left at zero and are not read.
+  Eigen::VectorXd linear_surface_displacement() const {
+    Eigen::VectorXd field = Eigen::VectorXd::Zero(model.dof_count());
+    const Eigen::VectorXd us = candidate_displacement();
+    for (std::size_t c = 0; c < candidates.size() + ring.size(); ++c) {
+      const int node = c < candidates.size() ? candidates[c] : ring[c - candidates.size()];
+      field.segment<3>(3 * static_cast<Eigen::Index>(node)) =
+          us.segment<3>(3 * static_cast<Eigen::Index>(c));
+    }
+    return field;
+  }
+
   // Projected area of the top faces touched by a needle, each face counted by the fraction of
   // its nodes the needle holds (so the rim faces count in part, not all or nothing).
   double contact_area(int needle, const Eigen::VectorXd& displacement) const {
@@ -797,7 +835,7 @@ struct Indentation3d::Impl {
     const Eigen::VectorXd imposed = prescribed_vector(at_depth);
     result.strain_energy_J =
         whole() * (model.is_linear() ? 0.5 * forces.dot(imposed) : model.strain_energy(u));
-    const Eigen::VectorXd moved = model.is_linear() ? linear_displacement() : u;
+    const Eigen::VectorXd moved = model.is_linear() ? linear_surface_displacement() : u;
     for (std::size_t n = 0; n < needles.size(); ++n) {
       NeedleStep3d needle;
       needle.name = needles[n].name;
