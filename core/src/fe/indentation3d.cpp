@@ -78,7 +78,7 @@ struct Indentation3d::Impl {
   std::vector<CapturedNode> captured;
   std::vector<int> captured_by;  // node -> needle or -1
   std::vector<char> fixed_dof;
-  SparseSolver solver;
+  SparseSolver solver{3};  // x, y, z per node: ordered by node
   Eigen::SparseMatrix<double> stiffness;
   Timing3d timing;
   double depth = 0.0;

@@ -15,7 +15,9 @@ namespace mneedle::fe {
 /// Only the lower triangle of the matrix is read.
 class SparseSolver {
  public:
-  SparseSolver();
+  /// `dofs_per_node` > 1 (a solid model's unknowns, node by node: 3 in 3-D) orders the nodes
+  /// rather than the dofs: the same fill, found in a fraction of the time.
+  explicit SparseSolver(int dofs_per_node = 1);
   ~SparseSolver();
   SparseSolver(SparseSolver&&) noexcept;
   SparseSolver& operator=(SparseSolver&&) noexcept;
@@ -37,9 +39,13 @@ class SparseSolver {
   std::string backend() const;
   /// Number of symbolic analyses performed so far (to check that the pattern is reused).
   int analysis_count() const;
+  /// True when the last analysis ordered nodes (dofs_per_node > 1 and a whole number of nodes).
+  bool ordered_by_node() const;
 
  private:
   struct Impl;
+  // The matrix in the factorised order: `matrix` itself, or P K Pᵀ kept in Impl.
+  const Eigen::SparseMatrix<double>& reordered(const Eigen::SparseMatrix<double>& matrix) const;
   std::unique_ptr<Impl> impl_;
 };
 
