@@ -14,17 +14,7 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 
-mkdir -p "$work/designs"
-for i in $(seq 0 9); do
-  angle=$((15 + 5 * i))
-  printf '[[designs]]\nname = "sharp_%02d"\nplugin = "sharp_bevel"\nbevel_angle = "%d deg"\n\n' "$i" "$angle"
-  printf '[[designs]]\nname = "blunt_%02d"\nplugin = "blunt_bevel"\nbevel_angle = "%d deg"\n\n' "$i" "$angle"
-done > "$work/designs/bevels.toml"
-for i in $(seq 0 9); do
-  d=$((150 + 10 * i))
-  "$mneedle" generate cone --set "diameter=${d}um" --unit um -o "$work/designs/cone_$i.stl" > /dev/null
-  "$mneedle" generate cylinder --set "diameter=${d}um" --unit um -o "$work/designs/cylinder_$i.stl" > /dev/null
-done
+"$root/bench/screen_designs.sh" "$mneedle" "$work/designs"
 
 run() {  # label, evaluating threads, then the command; prints a table row
   local label="$1" threads="$2"; shift 2
