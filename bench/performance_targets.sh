@@ -26,7 +26,10 @@ simulate_row() {
   local label="$1" target="$2" repeats="$3"
   shift 3
   for i in $(seq 1 "$repeats"); do
-    "$mneedle" simulate "$@" --json > "$work/run_$i.json" 2> /dev/null
+    if ! "$mneedle" simulate "$@" --json > "$work/run_$i.json" 2> "$work/err.txt"; then
+      echo "| $label | failed: $(tail -1 "$work/err.txt") | - | - | - | - | - |"
+      return 0
+    fi
   done
   python3 - "$label" "$target" "$repeats" "$work" <<'PY'
 import json, statistics, sys

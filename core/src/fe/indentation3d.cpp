@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -849,6 +850,15 @@ struct Indentation3d::Impl {
       needle.force_N = total.z();
       needle.lateral_force_N = {total.x(), total.y()};
       needle.contact_area_m2 = share(n) * contact_area(static_cast<int>(n), moved);
+#ifndef NDEBUG
+      // The surface displacement read from the compliance rows must be the whole-mesh solve's
+      // (every corner of a held face is a candidate, a ring node or fixed): checked in debug
+      // builds, where it costs the solve it saves. 1e-9: round-off (measured 5e-15).
+      if (model.is_linear()) {
+        const double full = share(n) * contact_area(static_cast<int>(n), linear_displacement());
+        assert(std::abs(needle.contact_area_m2 - full) <= 1e-9 * full);
+      }
+#endif
       needle.contact_pressure_Pa =
           needle.contact_area_m2 > 0.0 ? needle.force_N / needle.contact_area_m2 : 0.0;
       result.needles.push_back(needle);

@@ -30,7 +30,6 @@ struct SparseSolver::Impl {
   // Nodal ordering (dofs_per_node > 1): the matrix is factorised as P K Pᵀ.
   bool permuted = false;
   Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> permutation;
-  Eigen::SparseMatrix<double> reordered;
   Cholesky cholesky;
   Indefinite indefinite;
   bool indefinite_analyzed = false;
@@ -90,13 +89,33 @@ std::vector<int> nodal_ordering(const Eigen::SparseMatrix<double>& matrix, int b
   graph.dtype = CHOLMOD_DOUBLE;
   graph.sorted = 1;
   graph.packed = 1;
-  std::vector<int> order(static_cast<std::size_t>(nodes));
+  std::vector<int> order(static_cast<std::size_t>(nodes), -1);
   if (!cholmod_metis(&graph, nullptr, 0, 0, order.data(), &common) &&
       !cholmod_amd(&graph, nullptr, 0, order.data(), &common))
     return {};
+  // CHOLMOD does not pass on every METIS failure: accept only a permutation of the nodes.
+  std::vector<char> placed(static_cast<std::size_t>(nodes), 0);
+  for (int node : order) {
+    if (node < 0 || node >= nodes || placed[static_cast<std::size_t>(node)]) return {};
+    placed[static_cast<std::size_t>(node)] = 1;
+  }
   return order;
 }
 #endif
+
+// P K Pᵀ, lower triangle: the matrix in the order the factorisation uses. A copy that lives only
+// as long as the analysis or factorisation that needs it.
+Eigen::SparseMatrix<double> permuted(
+    const Eigen::SparseMatrix<double>& matrix,
+    const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>& permutation) {
+  Eigen::SparseMatrix<double> scattered(matrix.rows(), matrix.cols());
+  scattered.selfadjointView<Eigen::Lower>() =
+      matrix.selfadjointView<Eigen::Lower>().twistedBy(permutation);
+  // The permutation leaves each column's row indices unsorted; CHOLMOD is told (by Eigen) and
+  // Eigen's AMD assumes they are sorted. Transposing twice sorts them.
+  const Eigen::SparseMatrix<double> transposed = scattered.transpose();
+  return transposed.transpose();
+}
 
 }  // namespace
 
@@ -127,7 +146,10 @@ void SparseSolver::analyze(const Eigen::SparseMatrix<double>& matrix) {
     common.nmethods = impl_->permuted ? 1 : 0;  // 0: CHOLMOD's own choice (AMD, then METIS)
     common.method[0].ordering = impl_->permuted ? CHOLMOD_NATURAL : CHOLMOD_GIVEN;
 #endif
-    impl_->cholesky.analyzePattern(reordered(matrix));
+    if (impl_->permuted)
+      impl_->cholesky.analyzePattern(permuted(matrix, impl_->permutation));
+    else
+      impl_->cholesky.analyzePattern(matrix);
   }
   impl_->indefinite_analyzed = false;
   impl_->rows = matrix.rows();
@@ -136,18 +158,11 @@ void SparseSolver::analyze(const Eigen::SparseMatrix<double>& matrix) {
   ++impl_->analyses;
 }
 
-const Eigen::SparseMatrix<double>& SparseSolver::reordered(
-    const Eigen::SparseMatrix<double>& matrix) const {
-  if (!impl_->permuted) return matrix;
-  impl_->reordered.resize(matrix.rows(), matrix.cols());
-  impl_->reordered.selfadjointView<Eigen::Lower>() =
-      matrix.selfadjointView<Eigen::Lower>().twistedBy(impl_->permutation);
-  return impl_->reordered;
-}
-
 void SparseSolver::factorize(const Eigen::SparseMatrix<double>& input) {
   if (input.rows() != impl_->rows || input.nonZeros() != impl_->nonzeros) analyze(input);
-  const Eigen::SparseMatrix<double>& matrix = reordered(input);
+  Eigen::SparseMatrix<double> reordered;
+  if (impl_->permuted) reordered = permuted(input, impl_->permutation);
+  const Eigen::SparseMatrix<double>& matrix = impl_->permuted ? reordered : input;
   impl_->cholesky.factorize(matrix);
   if (impl_->cholesky.info() == Eigen::Success) {
     impl_->active = Active::Cholesky;
@@ -171,15 +186,24 @@ namespace {
 template <typename Matrix, typename Impl>
 Matrix solve_with(const Impl& impl, const Matrix& rhs) {
   if (impl.permuted) {
-    const Matrix reordered_rhs = impl.permutation * rhs;
-    switch (impl.active) {
-      case Active::Cholesky:
-        return impl.permutation.transpose() * Matrix(impl.cholesky.solve(reordered_rhs));
-      case Active::Indefinite:
-        return impl.permutation.transpose() * Matrix(impl.indefinite.solve(reordered_rhs));
-      case Active::None:
-        break;
+    // One copy of the right-hand side's size at a time beside the caller's (a block of
+    // compliance columns is dofs x 3 captured nodes): permuted, solved, permuted back in place.
+    Matrix x;
+    {
+      const Matrix reordered_rhs = impl.permutation * rhs;
+      switch (impl.active) {
+        case Active::Cholesky:
+          x = impl.cholesky.solve(reordered_rhs);
+          break;
+        case Active::Indefinite:
+          x = impl.indefinite.solve(reordered_rhs);
+          break;
+        case Active::None:
+          throw SolverError("sparse solver: no valid factorisation (singular matrix)");
+      }
     }
+    x = impl.permutation.transpose() * x;
+    return x;
   } else {
     switch (impl.active) {
       case Active::Cholesky:
@@ -221,6 +245,13 @@ std::string SparseSolver::backend() const {
 
 bool SparseSolver::ordered_by_node() const {
   return impl_->permuted;
+}
+
+double SparseSolver::factor_nonzeros() const {
+#ifdef MNEEDLE_HAVE_CHOLMOD
+  if (impl_->active == Active::Cholesky) return impl_->cholesky.cholmod().lnz;
+#endif
+  return 0.0;
 }
 
 int SparseSolver::analysis_count() const {

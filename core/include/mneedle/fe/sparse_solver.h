@@ -16,7 +16,8 @@ namespace mneedle::fe {
 class SparseSolver {
  public:
   /// `dofs_per_node` > 1 (a solid model's unknowns, node by node: 3 in 3-D) orders the nodes
-  /// rather than the dofs: the same fill, found in a fraction of the time.
+  /// rather than the dofs: the same fill, found in a fraction of the time. CHOLMOD only, and only
+  /// when METIS (or AMD) orders the nodal graph; otherwise CHOLMOD orders the dofs itself.
   explicit SparseSolver(int dofs_per_node = 1);
   ~SparseSolver();
   SparseSolver(SparseSolver&&) noexcept;
@@ -39,13 +40,14 @@ class SparseSolver {
   std::string backend() const;
   /// Number of symbolic analyses performed so far (to check that the pattern is reused).
   int analysis_count() const;
-  /// True when the last analysis ordered nodes (dofs_per_node > 1 and a whole number of nodes).
+  /// True when the last analysis ordered nodes (dofs_per_node > 1, a whole number of nodes and
+  /// CHOLMOD's METIS or AMD gave a valid order).
   bool ordered_by_node() const;
+  /// Nonzeros of the last CHOLMOD Cholesky factor (its fill); 0 for the other factorisations.
+  double factor_nonzeros() const;
 
  private:
   struct Impl;
-  // The matrix in the factorised order: `matrix` itself, or P K Pᵀ kept in Impl.
-  const Eigen::SparseMatrix<double>& reordered(const Eigen::SparseMatrix<double>& matrix) const;
   std::unique_ptr<Impl> impl_;
 };
 
