@@ -22,30 +22,27 @@ class DesignSource : public ::testing::Test {
   mneedle::PluginRegistry registry_;
 };
 
+void expect_symmetry(const mneedle::NeedleSymmetry& s, bool profile, bool y0, bool x0) {
+  EXPECT_EQ(s.axisymmetric.has_value(), profile);
+  EXPECT_EQ(s.mirror_y0, y0);
+  EXPECT_EQ(s.mirror_x0, x0);
+}
+
 TEST_F(DesignSource, ABodyOfRevolutionPluginHasItsProfileAndBothMirrorPlanes) {
   const auto cylinder = mneedle::needle_from_plugin(registry_, "cylinder", {});
-  const auto s = mneedle::needle_symmetry(registry_, cylinder, "cylinder");
-  EXPECT_TRUE(s.axisymmetric.has_value());
-  EXPECT_TRUE(s.mirror_y0);
-  EXPECT_TRUE(s.mirror_x0);
+  expect_symmetry(mneedle::needle_symmetry(registry_, cylinder, "cylinder"), true, true, true);
 }
 
 TEST_F(DesignSource, ABevelIsSymmetricAboutItsYZeroPlaneOnly) {
   const auto bevel = mneedle::needle_from_plugin(registry_, "sharp_bevel", {});
-  const auto s = mneedle::needle_symmetry(registry_, bevel, "sharp_bevel");
-  EXPECT_FALSE(s.axisymmetric.has_value());
-  EXPECT_TRUE(s.mirror_y0);
-  EXPECT_FALSE(s.mirror_x0);
+  expect_symmetry(mneedle::needle_symmetry(registry_, bevel, "sharp_bevel"), false, true, false);
 }
 
 TEST_F(DesignSource, ACylinderStlHasBothMirrorPlanesButNoProfile) {
   // An STL carries no profile (the axisymmetric model needs the plugin's exact one), but its
   // facets are symmetric about both planes, so the 3-D model may solve a quarter.
   const auto stl = mneedle::needle_from_file(kRoot + "/designs/cylinder.stl", 1e-3);
-  const auto s = mneedle::needle_symmetry(registry_, stl, "cylinder.stl");
-  EXPECT_FALSE(s.axisymmetric.has_value());
-  EXPECT_TRUE(s.mirror_y0);
-  EXPECT_TRUE(s.mirror_x0);
+  expect_symmetry(mneedle::needle_symmetry(registry_, stl, "cylinder.stl"), false, true, true);
 }
 
 TEST_F(DesignSource, SimulatesPreparedNeedlesCarryTheirSymmetry) {

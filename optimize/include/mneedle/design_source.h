@@ -70,8 +70,8 @@ bool mirror_symmetric_y0(const TriangleMesh& mesh);
 /// The same for the image (-x, y, z): symmetric about its x = 0 plane (bodies of revolution).
 bool mirror_symmetric_x0(const TriangleMesh& mesh);
 
-/// What a needle's shape lets the pre-puncture model reduce (docs/model.md, "Model reductions"):
-/// the body-of-revolution profile and the mirror planes through its axis.
+/// What a needle's shape lets the pre-puncture model reduce (docs/model.md, "Half and quarter
+/// models"): the body-of-revolution profile and the mirror planes through its axis.
 struct NeedleSymmetry {
   std::optional<fe::AxisymmetricNeedle> axisymmetric;  // cylinder and cone plugins
   bool mirror_y0 = false;                              // symmetric about its y = 0 plane
