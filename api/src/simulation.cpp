@@ -42,6 +42,8 @@ nlohmann::json point_json(const RunPoint& p, std::optional<PunctureCriterion> cr
     if (criterion == PunctureCriterion::Stress) j["tip_stress_Pa"] = p.tip_stress_Pa;
     if (criterion == PunctureCriterion::Energy)
       j["energy_release_rate_J_per_m2"] = p.energy_release_rate_J_per_m2;
+    if (criterion == PunctureCriterion::Penetration)
+      j["penetration_force_N"] = p.penetration_force_N;
   } else {
     j["alpha_N"] = p.alpha_N;
     j["beta_N"] = p.beta_N;
@@ -121,7 +123,7 @@ nlohmann::json run_json(const InsertionRun& run, const Scene& scene) {
 void apply_simulate_settings(Scene& scene, const SimulateSettings& s) {
   check_choice("fidelity", s.fidelity, {"fast", "standard", "fine"}, true);
   check_choice("contact", s.contact, {"sticking", "frictionless"}, true);
-  check_choice("criterion", s.criterion, {"pressure", "energy", "stress"}, true);
+  check_choice("criterion", s.criterion, {"pressure", "energy", "stress", "penetration"}, true);
   check_choice("model", s.model, {"auto", "analytic", "axisymmetric", "3d"}, false);
   if (s.max_needles < 1 || s.max_needles > 100000)
     throw InputError("simulate: max_needles " + std::to_string(s.max_needles) +
@@ -143,6 +145,7 @@ InsertionRunOptions simulate_run_options(const Scene& scene, const SimulateSetti
   if (s.criterion == "pressure") r.criterion = PunctureCriterion::Pressure;
   if (s.criterion == "energy") r.criterion = PunctureCriterion::Energy;
   if (s.criterion == "stress") r.criterion = PunctureCriterion::Stress;
+  if (s.criterion == "penetration") r.criterion = PunctureCriterion::Penetration;
   r.model = s.model == "analytic"       ? PreModel::Analytic
             : s.model == "axisymmetric" ? PreModel::Axisymmetric
             : s.model == "3d"           ? PreModel::Full3d

@@ -107,10 +107,12 @@ void print_table(const InsertionRun& run) {
               << " mN\n";
     const bool stress = run.criterion == PunctureCriterion::Stress;
     const bool energy = run.criterion == PunctureCriterion::Energy;
+    const bool penetration = run.criterion == PunctureCriterion::Penetration;
     std::cout << "  depth [um]  stage   force [mN]   F/A_sec [MPa]"
-              << (stress   ? "   tip stress [MPa]"
-                  : energy ? "   G [J/m^2]"
-                           : "")
+              << (stress        ? "   tip stress [MPa]"
+                  : energy      ? "   G [J/m^2]"
+                  : penetration ? "   F_p [mN]"
+                                : "")
               << "\n";
     for (const RunPoint& p : n.curve) {
       std::cout << std::setprecision(2) << std::setw(12) << p.depth_m * 1e6 << "  " << std::setw(5)
@@ -119,6 +121,8 @@ void print_table(const InsertionRun& run) {
       if (stress && p.stage == Stage::Pre) std::cout << std::setw(19) << p.tip_stress_Pa * 1e-6;
       if (energy && p.stage == Stage::Pre)
         std::cout << std::setw(13) << p.energy_release_rate_J_per_m2;
+      if (penetration && p.stage == Stage::Pre)
+        std::cout << std::setw(12) << p.penetration_force_N * 1e3;
       std::cout << "\n";
     }
     std::cout.unsetf(std::ios::fixed);
@@ -216,7 +220,7 @@ void add_simulate_command(CLI::App& app) {
       ->check(CLI::IsMember({"sticking", "frictionless"}));
   cmd->add_option("--criterion", options->settings.criterion,
                   "puncture criterion (default: the scene's)")
-      ->check(CLI::IsMember({"pressure", "energy", "stress"}));
+      ->check(CLI::IsMember({"pressure", "energy", "stress", "penetration"}));
   cmd->add_option("--axis", options->settings.axis,
                   "Axis of the scene's STL needles (overrides their axis key): auto, x, y, z or "
                   "a tip direction a,b,c");

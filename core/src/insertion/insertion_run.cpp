@@ -7,6 +7,8 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <numbers>
+#include <optional>
 
 #include "fe/needle_shape.h"
 #include "insertion/insertion_planner.h"
@@ -18,6 +20,7 @@
 #include "mneedle/fe/tissue_mesh.h"
 #include "mneedle/geometry/cross_section.h"
 #include "mneedle/insertion/analytic_indentation.h"
+#include "mneedle/insertion/penetration_force.h"
 #include "mneedle/insertion/puncture.h"
 #include "mneedle/insertion/surface_loads.h"
 
@@ -37,9 +40,32 @@ class SectionArea {
   double at(double depth) const {
     return depth > 0.0 ? slicer_->slice(depth).outline_area_m2 : 0.0;
   }
+  /// The penetration criterion's tissue: F_p is then available at every depth.
+  void set_penetration_tissue(const TissueMaterial& material, double toughness) {
+    penetration_ = PenetrationTissue{material.youngs_modulus, material.poisson_ratio, toughness};
+  }
+  /// F_p of the section at the surface, as a needle of equal area: the wedge that opens the
+  /// crack at this depth (docs/model.md, "Penetration criterion"); 0 without the criterion.
+  double penetration_force(double depth) const {
+    if (!penetration_) return 0.0;
+    const double radius = std::sqrt(at(depth) / std::numbers::pi);
+    return sharp_penetration_force(penetration_->modulus, penetration_->poisson,
+                                   penetration_->toughness, radius)
+        .force_N;
+  }
+  double penetration_ratio(double force, double depth) const {
+    const double fp = penetration_force(depth);
+    return fp > 0.0 ? force / fp : 0.0;
+  }
 
  private:
+  struct PenetrationTissue {
+    double modulus = 0.0;
+    double poisson = 0.0;
+    double toughness = 0.0;
+  };
   std::shared_ptr<const CrossSectionSlicer> slicer_;
+  std::optional<PenetrationTissue> penetration_;
 };
 
 double pressure_over(double force, double area) {
@@ -100,12 +126,14 @@ CriterionSample sample_of(double depth, const NeedleState& n, const SectionArea&
   s.contact_pressure_Pa = pressure_over(n.force_N, area.at(depth));
   s.tip_stress_Pa = n.tip_stress_Pa;
   s.energy_release_rate_J_per_m2 = n.energy_release_rate_J_per_m2;
+  s.penetration_ratio = area.penetration_ratio(n.force_N, depth);
   return s;
 }
 
 void set_section(RunPoint& p, const SectionArea& area) {
   p.section_area_m2 = area.at(p.depth_m);
   p.section_pressure_Pa = pressure_over(p.force_N, p.section_area_m2);
+  p.penetration_force_N = area.penetration_force(p.depth_m);
 }
 
 double tip_size_3d(const RunPlan& plan, const InsertionRunOptions& options) {
@@ -256,7 +284,8 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
 PreResult run_analytic(const RunPlan& plan, const Scene& scene,
                        const std::vector<PreparedNeedle>& needles,
                        const std::vector<SectionArea>& areas) {
-  if (plan.threshold && plan.threshold->criterion != PunctureCriterion::Pressure)
+  if (plan.threshold && plan.threshold->criterion != PunctureCriterion::Pressure &&
+      plan.threshold->criterion != PunctureCriterion::Penetration)
     throw InputError(
         "simulate: the analytic model gives no stress field or energy release rate; "
         "the " +
@@ -282,15 +311,19 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
       CriterionSample c;
       c.depth_m = st.depth_m;
       c.contact_pressure_Pa = p.section_pressure_Pa;
+      c.penetration_ratio = areas[i].penetration_ratio(p.force_N, p.depth_m);
       series.points.push_back(p);
       series.samples.push_back(c);
       if (!watch.keep_going(0, c)) break;
     }
     const Tissue tissue = scene.tissue;
     const SectionArea area = areas[i];
-    series.resolve = [tissue, profile, area](double depth) {
-      return pressure_over(analytic_indentation(tissue, *profile, {depth}).front().force_N,
-                           area.at(depth));
+    const bool penetration =
+        plan.threshold && plan.threshold->criterion == PunctureCriterion::Penetration;
+    series.resolve = [tissue, profile, area, penetration](double depth) {
+      const double force = analytic_indentation(tissue, *profile, {depth}).front().force_N;
+      return penetration ? area.penetration_ratio(force, depth)
+                         : pressure_over(force, area.at(depth));
     };
     out.needles.push_back(std::move(series));
   }
@@ -454,6 +487,12 @@ NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const R
       const std::vector<RunPoint>& points = pre.points;
       resolve = [&points, &area](double depth) {
         return pressure_over(interpolated_point(points, depth).force_N, area.at(depth));
+      };
+    }
+    if (!resolve && plan.threshold->criterion == PunctureCriterion::Penetration) {
+      const std::vector<RunPoint>& points = pre.points;
+      resolve = [&points, &area](double depth) {
+        return area.penetration_ratio(interpolated_point(points, depth).force_N, depth);
       };
     }
     const double tolerance = plan.horizon_m / std::max(plan.steps, 1) * 1e-6;
@@ -707,6 +746,10 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
   } else {
     std::vector<SectionArea> areas;
     for (const PreparedNeedle& n : needles) areas.emplace_back(n.mesh);
+    if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Penetration) {
+      const TissueLayer& top = scene.tissue.layers.front();
+      for (SectionArea& a : areas) a.set_penetration_tissue(top.material, top.fracture->toughness);
+    }
     PreResult pre;
     // Without a criterion nothing can fire early: the rung covering the depth is the answer.
     for (int rung = plan.threshold ? 0 : last_rung; rung <= last_rung; ++rung) {

@@ -77,6 +77,11 @@ PunctureThreshold puncture_threshold(const Scene& scene, PunctureCriterion crite
         missing(scene, fracture_key + ".toughness", criterion);
       t.threshold = top.fracture->toughness;
       break;
+    case PunctureCriterion::Penetration:
+      if (!top.fracture || !(top.fracture->toughness > 0.0))
+        missing(scene, fracture_key + ".toughness", criterion);
+      t.threshold = 1.0;  // F reaches F_p
+      break;
     case PunctureCriterion::Stress:
       if (!top.strength) missing(scene, "strength", criterion);
       t.threshold = top.strength->strength;
@@ -94,6 +99,8 @@ double criterion_value(PunctureCriterion criterion, const CriterionSample& sampl
       return sample.energy_release_rate_J_per_m2;
     case PunctureCriterion::Stress:
       return sample.tip_stress_Pa;
+    case PunctureCriterion::Penetration:
+      return sample.penetration_ratio;
   }
   return 0.0;
 }

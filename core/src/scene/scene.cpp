@@ -735,10 +735,11 @@ ModelOptions read_model(std::optional<Table> t, const Tissue& tissue) {
                                                          {"fine", Fidelity::Fine}})
                    .value_or(m.fidelity);
   if (t->get("outputs")) m.outputs = read_outputs(*t);
-  const auto criterion =
-      t->optional_choice<PunctureCriterion>("criterion", {{"pressure", PunctureCriterion::Pressure},
-                                                          {"energy", PunctureCriterion::Energy},
-                                                          {"stress", PunctureCriterion::Stress}});
+  const auto criterion = t->optional_choice<PunctureCriterion>(
+      "criterion", {{"pressure", PunctureCriterion::Pressure},
+                    {"energy", PunctureCriterion::Energy},
+                    {"stress", PunctureCriterion::Stress},
+                    {"penetration", PunctureCriterion::Penetration}});
   if (criterion) {
     check_criterion_inputs(*t, *criterion, tissue);
     m.criterion = *criterion;
@@ -961,6 +962,8 @@ std::string_view to_string(PunctureCriterion c) {
       return "energy";
     case PunctureCriterion::Stress:
       return "stress";
+    case PunctureCriterion::Penetration:
+      return "penetration";
   }
   return "?";
 }

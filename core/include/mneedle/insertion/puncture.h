@@ -18,7 +18,7 @@ namespace mneedle {
 /// The threshold one criterion reads from the scene's top layer (the layer the tip enters).
 struct PunctureThreshold {
   PunctureCriterion criterion = PunctureCriterion::Pressure;
-  double threshold = 0.0;         ///< Pa (pressure, stress) or J/m^2 (energy)
+  double threshold = 0.0;  ///< Pa (pressure, stress), J/m^2 (energy) or 1 (penetration: F/F_p)
   double average_length_m = 0.0;  ///< stress: the layer's strength length; else 0
   std::size_t layer = 0;          ///< index of the layer the data comes from
 };
@@ -37,6 +37,9 @@ struct CriterionSample {
   double contact_pressure_Pa = 0.0;           ///< F / A_sec: force over the outline area at z = 0
   double tip_stress_Pa = 0.0;                 ///< averaged max principal stress under the tip
   double energy_release_rate_J_per_m2 = 0.0;  ///< G of a crack under the tip
+  /// F / F_p: the force over the steady mode-I penetration force of the needle's section at
+  /// the surface (penetration_force.h); dimensionless, the criterion fires at 1.
+  double penetration_ratio = 0.0;
 };
 
 /// The sample's value of the quantity the criterion compares with its threshold.

@@ -111,7 +111,7 @@ struct Insertion {
 
 enum class Fidelity { Fast, Standard, Fine };
 enum class Output { Puncture, ForceCurve, Fields };
-enum class PunctureCriterion { Pressure, Energy, Stress };
+enum class PunctureCriterion { Pressure, Energy, Stress, Penetration };
 enum class Contact { Sticking, Frictionless };
 
 struct ModelOptions {
@@ -181,7 +181,7 @@ Scene parse_scene(std::string_view toml, std::string source_name);
 std::string_view to_string(Boundary b);           ///< "fixed"
 std::string_view to_string(Fidelity f);           ///< "fast", "standard", "fine"
 std::string_view to_string(Output o);             ///< "puncture", "force_curve", "fields"
-std::string_view to_string(PunctureCriterion c);  ///< "pressure", "energy", "stress"
+std::string_view to_string(PunctureCriterion c);  ///< "pressure", "energy", "stress", "penetration"
 std::string_view to_string(Contact c);            ///< "sticking", "frictionless"
 std::string_view to_string(FrictionLaw f);        ///< "coulomb", "linear_growth", "none"
 
