@@ -12,6 +12,7 @@
 #include "fe/needle_meshes.h"
 #include "mneedle/base/error.h"
 #include "mneedle/geometry/tip_area.h"
+#include "mneedle/insertion/penetration_force.h"
 #include "mneedle/insertion/puncture.h"
 #include "mneedle/insertion/surface_loads.h"
 
@@ -252,6 +253,61 @@ TEST(InsertionRun, PunctureDepthMovesContinuouslyWithTheBevelAngle) {
   for (std::size_t i = 1; i < depths.size(); ++i) {
     EXPECT_GT(std::abs(depths[i] - depths[i - 1]), 1e-9 * depths[i]) << "tie at " << 15 + 2 * i;
   }
+  for (std::size_t i = 2; i < depths.size(); ++i) {
+    const double change = (depths[i] - depths[i - 1]) - (depths[i - 1] - depths[i - 2]);
+    EXPECT_LT(std::abs(change), 5e-6) << "jump at " << 15 + 2 * i << " deg: " << depths[i - 2]
+                                      << ", " << depths[i - 1] << ", " << depths[i];
+  }
+}
+
+TEST(InsertionRun, PenetrationCriterionFiresWhereTheForceReachesThePenetrationForce) {
+  // Flat punch (axisymmetric FE): its section at the surface is the whole circle from the first
+  // step, so F_p is one number, and F is linear in depth: the bisected crossing has F = F_p to
+  // the bisection's 1e-6 of a step.
+  InsertionRunOptions o = fast();
+  o.criterion = PunctureCriterion::Penetration;
+  const InsertionRun run = run_insertion(punch_scene(), {punch("punch", 115e-6)}, o);
+  ASSERT_TRUE(run.criterion && *run.criterion == PunctureCriterion::Penetration);
+  EXPECT_EQ(*run.threshold, 1.0);
+  const NeedleRun& n = run.needles.front();
+  ASSERT_TRUE(n.puncture.has_value());
+  // The mesh's circle is a 48-gon: F_p is of the radius with its outline's area,
+  // r sqrt(48 sin(2 pi / 48) / (2 pi)).
+  const double radius = std::sqrt(n.curve.front().section_area_m2 / M_PI);
+  EXPECT_NEAR(radius, 115e-6 * std::sqrt(48.0 * std::sin(2.0 * M_PI / 48.0) / (2.0 * M_PI)), 1e-12);
+  const double fp = sharp_penetration_force(0.2e6, 0.45, 19.0, radius).force_N;
+  EXPECT_NEAR(n.puncture->force_N, fp, 1e-5 * fp);
+  for (const RunPoint& p : n.curve) {
+    if (p.stage != Stage::Pre) continue;
+    EXPECT_NEAR(p.penetration_force_N, fp, 1e-12 * fp) << p.depth_m;
+  }
+  EXPECT_FALSE(n.puncture->at_first_contact);
+}
+
+TEST(InsertionRun, PenetrationDepthMovesContinuouslyWithTheBevelAngle) {
+  // As PunctureDepthMovesContinuouslyWithTheBevelAngle, with F_p of the bevel's section: depths
+  // 239 um at 15 deg, 255 um near 33 deg, 237 um at 45 deg on the closed-form model; no ties, and
+  // the increment from one 2 deg step to the next changes by at most 5 um (1.8 um measured).
+  const Scene scene =
+      parse_scene(scene_text("", kFracture, kOnePunch, "[\"puncture\", \"force_curve\"]",
+                             "[\"3000 um\", \"3000 um\", \"2000 um\"]", "400 um"),
+                  "angles.toml");
+  InsertionRunOptions o = fast();
+  o.model = PreModel::Analytic;
+  o.criterion = PunctureCriterion::Penetration;
+  std::vector<double> depths;
+  for (int degrees = 15; degrees <= 45; degrees += 2) {
+    PreparedNeedle bevel;
+    bevel.name = "punch";
+    bevel.mesh = test::bevel_needle(115e-6, degrees * M_PI / 180.0, 1e-3);
+    const InsertionRun run = run_insertion(scene, {bevel}, o);
+    ASSERT_TRUE(run.needles[0].puncture.has_value()) << degrees << " deg";
+    const Puncture& p = *run.needles[0].puncture;
+    EXPECT_FALSE(p.at_first_contact) << degrees << " deg";
+    depths.push_back(p.depth_m);
+  }
+  for (std::size_t i = 1; i < depths.size(); ++i)
+    EXPECT_GT(std::abs(depths[i] - depths[i - 1]), 1e-9 * depths[i]) << "tie at " << 15 + 2 * i;
   for (std::size_t i = 2; i < depths.size(); ++i) {
     const double change = (depths[i] - depths[i - 1]) - (depths[i - 1] - depths[i - 2]);
     EXPECT_LT(std::abs(change), 5e-6) << "jump at " << 15 + 2 * i << " deg: " << depths[i - 2]
