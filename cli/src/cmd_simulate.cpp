@@ -5,10 +5,13 @@
 // where the puncture criterion fires, and continues with the post-puncture surface loads.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -56,6 +59,25 @@ InsertionRunOptions run_options(const Scene& scene, const SimulateOptions& o) {
               << "/\n";
   }
   return r;
+}
+
+// The penetration criterion treats the top layer as a half-space (docs/model.md, "Penetration
+// criterion"): a layer thinner than the needle's diameter is not one, and the user should know.
+void warn_if_penetration_layer_is_thin(const InsertionRun& run, const Scene& scene,
+                                       const std::string& file) {
+  if (run.criterion != PunctureCriterion::Penetration || scene.tissue.layers.size() < 2) return;
+  double widest_m2 = 0.0;
+  for (const NeedleRun& n : run.needles)
+    for (const RunPoint& p : n.curve) widest_m2 = std::max(widest_m2, p.section_area_m2);
+  const double diameter = 2.0 * std::sqrt(widest_m2 / std::numbers::pi);
+  const TissueLayer& top = scene.tissue.layers.front();
+  if (!(top.thickness < diameter)) return;
+  std::cerr << "mneedle: warning: " << file << ": tissue.layers[0] '" << top.name << "' is "
+            << format_quantity(top.thickness, Dimension::Length)
+            << " thick, less than the needle's diameter ("
+            << format_quantity(diameter, Dimension::Length)
+            << "): the penetration criterion takes it for a half-space, so its F_p does not hold "
+               "(docs/model.md, \"Penetration criterion\")\n";
 }
 
 void print_csv(const InsertionRun& run) {
@@ -194,6 +216,7 @@ void run(const SimulateOptions& o) {
               << 100.0 * kEnergyCheckTolerance
               << " % apart: the contact or the mesh is not resolved; docs/model.md, \"Energy "
                  "check\")\n";
+  warn_if_penetration_layer_is_thin(result, scene, o.scene.string());
   if (!o.plot.empty())
     plot::write_svg(o.plot, simulate_figure(result, "simulate: " + o.scene.filename().string()));
   if (!o.report.empty()) write_report_folder(o.report, tree, o.plugin_dirs);

@@ -364,3 +364,53 @@ TEST(CmdSimulate, PlotDrawsTheCurveWithItsAxesAndUnits) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(CmdSimulate, PenetrationCriterionReportsItsForceAtEveryStepAndFiresWhereTheForceReachesIt) {
+  // A 200 um cone in one gel (axisymmetric, fast): the criterion is F / F_p, threshold 1, and at
+  // the bisected crossing F equals F_p of the section there to the bisection's 1e-6 of a step.
+  const fs::path dir =
+      fs::temp_directory_path() / ("mneedle_penetration_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path file = dir / "gel.toml";
+  std::ofstream(file) << gel_scene(gel_layer("gel", "", "0.2 MPa"));
+  const CommandRun run =
+      run_mneedle("simulate '" + file.string() + "' --criterion penetration --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err.find("warning"), std::string::npos) << run.err;  // one thick layer
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["criterion"]["name"], "penetration");
+  EXPECT_EQ(j["criterion"]["threshold"].get<double>(), 1.0);
+  const auto& needle = j["needles"][0];
+  ASSERT_FALSE(needle["puncture"].is_null()) << run.out;
+  const auto& puncture = needle["puncture"];
+  EXPECT_FALSE(puncture["at_first_contact"].get<bool>());
+  double previous_fp = 0.0;
+  const nlohmann::json* at_puncture = nullptr;
+  for (const auto& p : needle["curve"]) {
+    if (p["stage"] != "pre") continue;
+    ASSERT_TRUE(p.contains("penetration_force_N")) << p.dump();
+    // The cone's section widens with depth up to its shaft, so F_p never falls.
+    EXPECT_GE(p["penetration_force_N"].get<double>(), previous_fp);
+    previous_fp = p["penetration_force_N"].get<double>();
+    at_puncture = &p;
+  }
+  ASSERT_NE(at_puncture, nullptr);
+  EXPECT_EQ((*at_puncture)["depth_m"].get<double>(), puncture["depth_m"].get<double>());
+  const double force = puncture["force_N"].get<double>();
+  EXPECT_NEAR(force, (*at_puncture)["penetration_force_N"].get<double>(), 1e-5 * force);
+
+  // A top layer thinner than the needle is no half-space: the run says so on stderr.
+  std::ofstream(file) << gel_scene(gel_layer("film", "50 um", "0.2 MPa") +
+                                   gel_layer("gel", "", "0.2 MPa"));
+  const CommandRun thin = run_mneedle("simulate '" + file.string() + "' --criterion penetration");
+  ASSERT_EQ(thin.exit_code, 0) << thin.err;
+  EXPECT_NE(thin.err.find("warning"), std::string::npos) << thin.err;
+  EXPECT_NE(thin.err.find("'film' is 50 um thick"), std::string::npos) << thin.err;
+  EXPECT_NE(thin.err.find("takes it for a half-space"), std::string::npos) << thin.err;
+  EXPECT_NE(thin.out.find("F_p [mN]"), std::string::npos) << thin.out;
+  fs::remove_all(dir);
+}
+
+}  // namespace
