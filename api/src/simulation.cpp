@@ -73,12 +73,15 @@ nlohmann::json run_json(const InsertionRun& run, const Scene& scene) {
   nlohmann::json needles = nlohmann::json::array();
   for (const NeedleRun& n : run.needles) {
     nlohmann::json puncture = nullptr;
-    if (n.puncture)
+    if (n.puncture) {
       puncture = {{"depth_m", n.puncture->depth_m},
                   {"force_N", n.puncture->force_N},
                   {"criterion", to_string(n.puncture->criterion)},
                   {"post_force_N", n.puncture->post_force_N},
                   {"at_first_contact", n.puncture->at_first_contact}};
+      if (n.puncture->criterion == PunctureCriterion::Penetration)
+        puncture["flat_tip"] = n.puncture->flat_tip;
+    }
     needles.push_back({{"name", n.name},
                        {"curve", curve_json(n.curve, run.criterion)},
                        {"puncture", puncture},

@@ -120,6 +120,10 @@ void print_table(const InsertionRun& run) {
                 << (n.puncture->at_first_contact
                         ? " [at first contact: the criterion is above its threshold at the first "
                           "depth step, so this depth is the step's, not the tissue's]"
+                        : "")
+                << (n.puncture->flat_tip
+                        ? " [flat tip: F_p is a sharp tip's, a flat end needs more, so this "
+                          "depth is a lower bound]"
                         : "");
     else if (run.criterion)
       std::cout << "no puncture within the insertion depth";

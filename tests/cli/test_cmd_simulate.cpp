@@ -386,6 +386,7 @@ TEST(CmdSimulate, PenetrationCriterionReportsItsForceAtEveryStepAndFiresWhereThe
   ASSERT_FALSE(needle["puncture"].is_null()) << run.out;
   const auto& puncture = needle["puncture"];
   EXPECT_FALSE(puncture["at_first_contact"].get<bool>());
+  EXPECT_FALSE(puncture["flat_tip"].get<bool>());  // a cone ends in a point
   double previous_fp = 0.0;
   const nlohmann::json* at_puncture = nullptr;
   for (const auto& p : needle["curve"]) {

@@ -33,6 +33,8 @@ using detail::RunPlan;
 // The area inside a needle's outer outline at the undeformed surface when its tip is `depth`
 // below it: the pressure criterion's area (docs/model.md, "Criteria"). The slicer is shared so
 // that bisection closures can keep it.
+constexpr double kFlatProbeDepth = 1e-9;  // m
+
 class SectionArea {
  public:
   explicit SectionArea(const TriangleMesh& mesh)
@@ -53,6 +55,9 @@ class SectionArea {
                                    penetration_->toughness, radius)
         .force_N;
   }
+  /// The outline 1 nm above the tip is wider than a 0.5 um circle: a flat end, not a point (a
+  /// cone gives 0 there, a 5 um spherical cap 0.1 um, a 50 um flat 25 um).
+  bool ends_flat() const { return std::sqrt(at(kFlatProbeDepth) / std::numbers::pi) > 0.5e-6; }
   double penetration_ratio(double force, double depth) const {
     const double fp = penetration_force(depth);
     return fp > 0.0 ? force / fp : 0.0;
@@ -527,6 +532,8 @@ NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const R
     puncture.force_N = at.force_N;
     puncture.criterion = plan.threshold->criterion;
     puncture.at_first_contact = crossing->step == 0;
+    puncture.flat_tip =
+        plan.threshold->criterion == PunctureCriterion::Penetration && area.ends_flat();
     if (post != nullptr) {
       puncture.post_force_N = post->at(crossing->depth_m).force_N;
       if (plan.post_stage) {

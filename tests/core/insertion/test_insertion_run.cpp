@@ -76,6 +76,7 @@ TEST(InsertionRun, FlatPunchPuncturesWhereItsLinearPressureReachesTheThreshold) 
   const double slope = last_pre->section_pressure_Pa / last_pre->depth_m;
   EXPECT_NEAR(slope * n.puncture->depth_m, 0.3e6, 0.3e6 * 1e-5);
   EXPECT_FALSE(n.puncture->at_first_contact);
+  EXPECT_FALSE(n.puncture->flat_tip);  // only the penetration criterion flags a flat end
   // Boussinesq with the bonded layer: P = 2 E* d / (pi a) (1 + ~10 %) -> d_p ~ 200 um.
   EXPECT_GT(n.puncture->depth_m, 150e-6);
   EXPECT_LT(n.puncture->depth_m, 260e-6);
@@ -282,6 +283,8 @@ TEST(InsertionRun, PenetrationCriterionFiresWhereTheForceReachesThePenetrationFo
     EXPECT_NEAR(p.penetration_force_N, fp, 1e-12 * fp) << p.depth_m;
   }
   EXPECT_FALSE(n.puncture->at_first_contact);
+  // A flat end: F_p is the sharp mechanism's, and the depth is flagged as a lower bound.
+  EXPECT_TRUE(n.puncture->flat_tip);
 }
 
 TEST(InsertionRun, PenetrationDepthMovesContinuouslyWithTheBevelAngle) {
@@ -304,6 +307,7 @@ TEST(InsertionRun, PenetrationDepthMovesContinuouslyWithTheBevelAngle) {
     ASSERT_TRUE(run.needles[0].puncture.has_value()) << degrees << " deg";
     const Puncture& p = *run.needles[0].puncture;
     EXPECT_FALSE(p.at_first_contact) << degrees << " deg";
+    EXPECT_FALSE(p.flat_tip) << degrees << " deg";  // a bevel ends in a point
     depths.push_back(p.depth_m);
   }
   for (std::size_t i = 1; i < depths.size(); ++i)

@@ -104,6 +104,11 @@ struct Puncture {
   /// contact for this tip and tissue (a pressure singular at the tip), so the depth reflects
   /// the step, not the tissue. Never rank or optimise on such a depth.
   bool at_first_contact = false;
+  /// Penetration criterion only: the needle ends in a flat (its outline 1 nm above the tip is a
+  /// circle of radius above 0.5 um). F_p is the sharp tip's mode-I force; a flat end needs a
+  /// ring crack at a higher force, so this depth is a lower bound (docs/model.md, "Penetration
+  /// criterion").
+  bool flat_tip = false;
 };
 
 struct NeedleRun {
