@@ -107,6 +107,10 @@ void add_insertion(DesignEvaluation& e, const TriangleMesh& mesh, const Scene& s
     } else {
       e.puncture_objective_m = n.puncture->depth_m;
     }
+    if (n.puncture->flat_tip)
+      e.notes.push_back(
+          "the needle ends in a flat: the penetration criterion's force is a sharp tip's, so "
+          "this puncture depth is a lower bound (docs/model.md, \"Penetration criterion\")");
   } else {
     e.puncture_objective_m = e.depth_m * (2.0 - criterion_ratio(run, n));
     e.notes.push_back(run.criterion ? "no puncture up to the target depth " +

@@ -411,6 +411,15 @@ TEST(CmdSimulate, PenetrationCriterionReportsItsForceAtEveryStepAndFiresWhereThe
   EXPECT_NE(thin.err.find("'film' is 50 um thick"), std::string::npos) << thin.err;
   EXPECT_NE(thin.err.find("takes it for a half-space"), std::string::npos) << thin.err;
   EXPECT_NE(thin.out.find("F_p [mN]"), std::string::npos) << thin.out;
+
+  // A brittle gel (toughness / (E r) = 5e-5): the crack would run wider than the table, F_p is
+  // an upper bound, and the run says so.
+  std::string brittle = gel_scene(gel_layer("gel", "", "0.2 MPa"));
+  brittle.replace(brittle.find("19 J/m^2"), 8, "0.001 J/m^2");
+  std::ofstream(file) << brittle;
+  const CommandRun weak = run_mneedle("simulate '" + file.string() + "' --criterion penetration");
+  ASSERT_EQ(weak.exit_code, 0) << weak.err;
+  EXPECT_NE(weak.err.find("F_p is an upper bound"), std::string::npos) << weak.err;
   fs::remove_all(dir);
 }
 

@@ -81,4 +81,22 @@ TEST(DesignEvaluation, EveryPluginsDefaultsAndTheDocumentedBoxCornersEvaluateInS
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 60.0);
 }
 
+TEST(DesignEvaluation, FlatEndedNeedleSaysItsPenetrationDepthIsALowerBound) {
+  // A flat end punctures by a ring crack at a higher force than the sharp mechanism of the
+  // penetration criterion: the row a screen or an optimisation reports must say so.
+  const auto registry = PluginRegistry::discover({MNEEDLE_PLUGIN_BUILD_DIR});
+  auto scene =
+      mneedle::load_scene(std::string(MNEEDLE_TEST_ASSETS) + "/scenes/puncture_punch.toml");
+  scene.model.criterion = mneedle::PunctureCriterion::Penetration;
+  const mneedle::NeedleSource n = mneedle::needle_from_plugin(registry, "cylinder", {});
+  mneedle::EvaluationOptions o;
+  o.symmetry = mneedle::needle_symmetry(registry, n, "cylinder");
+  const auto e = mneedle::evaluate_design(n.mesh, scene, "silicon", o);
+  ASSERT_TRUE(e.puncture.has_value());
+  EXPECT_EQ(e.puncture->criterion, "penetration");
+  bool said = false;
+  for (const std::string& note : e.notes) said = said || note.find("lower bound") != note.npos;
+  EXPECT_TRUE(said);
+}
+
 }  // namespace

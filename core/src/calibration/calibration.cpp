@@ -146,6 +146,13 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     fail("a criterion constant cannot be fitted when the puncture is given (--puncture-at)");
   }
   const PunctureCriterion criterion = options.run.criterion;
+  // The criterion is read off one pre-puncture run whose thresholds never fire; F_p would need
+  // the tissue's own toughness, which that run replaces. Not supported rather than wrong.
+  if (criterion == PunctureCriterion::Penetration && !options.puncture_travel_m) {
+    fail(
+        "the penetration criterion is not supported (use the pressure or energy criterion, or "
+        "give the puncture with --puncture-at)");
+  }
   if (fits_pc && criterion != PunctureCriterion::Pressure) {
     fail("critical_pressure is the pressure criterion's; the run uses another criterion");
   }

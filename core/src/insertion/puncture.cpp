@@ -80,6 +80,11 @@ PunctureThreshold puncture_threshold(const Scene& scene, PunctureCriterion crite
     case PunctureCriterion::Penetration:
       if (!top.fracture || !(top.fracture->toughness > 0.0))
         missing(scene, fracture_key + ".toughness", criterion);
+      // The plane-strain crack model under F_p takes 0 <= nu < 0.5 (the scene allows nu < 0).
+      if (top.material.poisson_ratio < 0.0)
+        throw InputError(layer_where(scene, 0) +
+                         ": material.nu: " + std::to_string(top.material.poisson_ratio) +
+                         " is negative; the penetration criterion needs 0 <= nu < 0.5");
       t.threshold = 1.0;  // F reaches F_p
       break;
     case PunctureCriterion::Stress:

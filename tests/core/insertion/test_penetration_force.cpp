@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iostream>
 #include <limits>
 
 #include "mneedle/base/error.h"
@@ -61,9 +60,9 @@ double direct_force(double width_ratio, double gamma) {
 
 TEST(PenetrationForce, TabulatedMinimumIsCloseToTheMinimumBetweenTheTabulatedWidths) {
   // Γ/(E r) = 0.07 puts the minimum inside the table (near w̄ = 3.5 r). The model run directly at
-  // widths halfway between the tabulated ones around it may find a lower total; the table's
-  // minimum must stay within 0.5 % of the lowest of them (GRID_ERROR measured; the width grid
-  // is the only approximation the table adds to the plane-strain model).
+  // widths halfway between the tabulated ones around it may find a lower total; neither may beat
+  // the table's minimum by more than 0.1 % (measured: both are 0.06 % and 0.2 % above it; the
+  // width grid is the only approximation the table adds to the plane-strain model).
   const double gamma = 0.07 * kE * kRadius;
   const PenetrationForce f = sharp_penetration_force(kE, kNu, gamma, kRadius);
   ASSERT_FALSE(f.at_narrowest_crack);
@@ -73,8 +72,7 @@ TEST(PenetrationForce, TabulatedMinimumIsCloseToTheMinimumBetweenTheTabulatedWid
   const double below = direct_force(0.5 * (kWedgeWidthRatios[k - 1] + kWedgeWidthRatios[k]), gamma);
   const double above = direct_force(0.5 * (kWedgeWidthRatios[k] + kWedgeWidthRatios[k + 1]), gamma);
   const double lowest = std::min({below, above, f.force_N});
-  std::cerr << "GRID " << k << " " << f.force_N << " " << below << " " << above << "\n";
-  EXPECT_LE(f.force_N, lowest * 1.005);
+  EXPECT_LE(f.force_N, lowest * 1.001);
 }
 
 TEST(PenetrationForce, WiderCracksStoreLessStrainEnergy) {

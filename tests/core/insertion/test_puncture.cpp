@@ -45,6 +45,33 @@ TEST(PunctureThreshold, ReadsEachCriterionFromTheTopLayer) {
   const PunctureThreshold stress = puncture_threshold(s, PunctureCriterion::Stress);
   EXPECT_DOUBLE_EQ(stress.threshold, 2e6);
   EXPECT_DOUBLE_EQ(stress.average_length_m, 15e-6);
+  // The penetration criterion compares F with F_p: dimensionless, fires at 1.
+  EXPECT_DOUBLE_EQ(puncture_threshold(s, PunctureCriterion::Penetration).threshold, 1.0);
+}
+
+TEST(PunctureThreshold, PenetrationNeedsToughnessAndANonNegativePoissonRatio) {
+  // Only a strength on the top layer: no fracture data, so no toughness.
+  const Scene without = scene_with("strength = \"2 MPa\"\nstrength_length = \"15 um\"\n", "");
+  try {
+    puncture_threshold(without, PunctureCriterion::Penetration);
+    FAIL() << "no toughness must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("toughness: missing (the penetration criterion"),
+              std::string::npos)
+        << e.what();
+  }
+  Scene auxetic = scene_with("",
+                             "[tissue.fracture]\ntoughness = \"19 J/m^2\"\n"
+                             "critical_pressure = \"0.663 MPa\"\n");
+  auxetic.tissue.layers.front().material.poisson_ratio = -0.2;
+  try {
+    puncture_threshold(auxetic, PunctureCriterion::Penetration);
+    FAIL() << "nu < 0 must be refused";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("test.toml:"), std::string::npos) << m;
+    EXPECT_NE(m.find("material.nu"), std::string::npos) << m;
+  }
 }
 
 TEST(PunctureThreshold, MissingValueNamesFileLineLayerAndKey) {
@@ -134,6 +161,8 @@ TEST(CriterionValue, PicksTheCriterionsQuantity) {
   s.contact_pressure_Pa = 1.0;
   s.tip_stress_Pa = 2.0;
   s.energy_release_rate_J_per_m2 = 3.0;
+  s.penetration_ratio = 4.0;
+  EXPECT_EQ(criterion_value(PunctureCriterion::Penetration, s), 4.0);
   EXPECT_EQ(criterion_value(PunctureCriterion::Pressure, s), 1.0);
   EXPECT_EQ(criterion_value(PunctureCriterion::Stress, s), 2.0);
   EXPECT_EQ(criterion_value(PunctureCriterion::Energy, s), 3.0);

@@ -20,7 +20,8 @@ inline constexpr std::array<double, 12> kWedgeWidthRatios = {1.01, 1.05, 1.1, 1.
 /// U_ε / (E r²) at each of kWedgeWidthRatios for Poisson's ratio ν (dimensionless). U_ε scales
 /// exactly as E r² (linear elasticity, a mesh and block similar to the crack), so one table per
 /// ν serves every modulus and radius: it is computed once per ν and process (12 plane-strain
-/// solves, about 3 s) and kept. Thread-safe. Throws InputError for ν outside [0, 0.5).
+/// solves, about 4 s) and kept. Thread-safe: the solves run outside the lock, so a thread asking
+/// for a table already made never waits. Throws InputError for ν outside [0, 0.5).
 const std::vector<double>& wedged_crack_energy_table(double poisson_ratio);
 
 struct PenetrationForce {
@@ -39,7 +40,8 @@ struct PenetrationForce {
 /// F_p for a needle of radius r [m] in a tissue of Young's modulus E [Pa], Poisson's ratio ν and
 /// toughness Γ [J/m², energy per unit crack area]. Minimised over the tabulated widths (U_ε
 /// linear between them, so the minimum is at a tabulated width); continuous in every argument.
-/// r = 0 gives 0. Throws InputError for E ≤ 0, Γ ≤ 0, r < 0 or a non-finite value.
+/// r = 0 gives 0 (without the table). Throws InputError for E ≤ 0, Γ ≤ 0, r < 0 or a non-finite
+/// value.
 PenetrationForce sharp_penetration_force(double youngs_modulus_Pa, double poisson_ratio,
                                          double toughness_J_per_m2, double radius_m);
 
