@@ -1,6 +1,9 @@
 #include "mneedle/api/simulation.h"
 
+#include <algorithm>
+#include <cmath>
 #include <initializer_list>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <variant>
@@ -8,8 +11,10 @@
 #include "mneedle/api/finite_json.h"
 #include "mneedle/api/loads_json.h"
 #include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
 #include "mneedle/fe/tissue_mesh.h"
 #include "mneedle/insertion/energy_check.h"
+#include "mneedle/insertion/penetration_force.h"
 #include "mneedle/needle/mesh.h"
 #include "mneedle/needle/needle_frame.h"
 
@@ -158,6 +163,32 @@ InsertionRunOptions simulate_run_options(const Scene& scene, const SimulateSetti
   return r;
 }
 
+std::vector<std::string> penetration_warnings(const InsertionRun& run, const Scene& scene) {
+  std::vector<std::string> out;
+  if (run.criterion != PunctureCriterion::Penetration || scene.tissue.layers.empty()) return out;
+  double widest_m2 = 0.0;
+  for (const NeedleRun& n : run.needles)
+    for (const RunPoint& p : n.curve) widest_m2 = std::max(widest_m2, p.section_area_m2);
+  const double diameter = 2.0 * std::sqrt(widest_m2 / std::numbers::pi);
+  const TissueLayer& top = scene.tissue.layers.front();
+  const std::string layer = scene.source_name + ": tissue.layers[0] '" + top.name + "'";
+  if (top.fracture && diameter > 0.0 &&
+      sharp_penetration_force(top.material.youngs_modulus, top.material.poisson_ratio,
+                              top.fracture->toughness, diameter / 2.0)
+          .at_widest_crack)
+    out.push_back(layer +
+                  " is brittle against the needle (toughness / (E r) below about 0.013): its "
+                  "crack would run wider than 12 needle radii, so F_p is an upper bound "
+                  "(docs/model.md, \"Penetration criterion\")");
+  if (scene.tissue.layers.size() > 1 && top.thickness < diameter)
+    out.push_back(layer + " is " + format_quantity(top.thickness, Dimension::Length) +
+                  " thick, less than the needle's diameter (" +
+                  format_quantity(diameter, Dimension::Length) +
+                  "): the penetration criterion takes it for a half-space, so its F_p does not "
+                  "hold (docs/model.md, \"Penetration criterion\")");
+  return out;
+}
+
 nlohmann::json simulation_json(const InsertionRun& run, const Scene& scene,
                                const std::vector<PreparedNeedle>& needles,
                                const SimulateSettings& settings) {
@@ -166,6 +197,7 @@ nlohmann::json simulation_json(const InsertionRun& run, const Scene& scene,
   for (std::size_t i = 0; i < needles.size() && i < tree["needles"].size(); ++i)
     tree["needles"][i]["mesh_sha256"] = mesh_sha256(needles[i].mesh);
   if (!settings.axis.empty()) tree["axis"] = settings.axis;
+  tree["warnings"] = penetration_warnings(run, scene);
   require_finite_json(tree, scene.source_name);
   return tree;
 }

@@ -61,7 +61,8 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
       "before the target depth come last. pass = punctures before the target depth and "
       "margin (capacity / peak force) >= safety factor. A depth marked * is where the "
       "criterion already fires at the first depth step: not resolved, ranked after the "
-      "resolved ones (docs/model.md, \"Criteria\").\n\n",
+      "resolved ones (docs/model.md, \"Criteria\"). A depth marked + is a lower bound (a flat "
+      "end under the penetration criterion), ranked after the resolved ones too.\n\n",
       std::string(to_string(scene.model.criterion)).c_str());
   bool sampled = false;
   for (const auto& row : ranked) sampled = sampled || row.pass_probability.has_value();
@@ -86,10 +87,12 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
     std::string models;
     for (const auto& m : j["models_run"])
       models += (models.empty() ? "" : "+") + m.get<std::string>();
-    const std::string depth = row.puncture_depth_m
-                                  ? cell(*row.puncture_depth_m, Dimension::Length) +
-                                        (row.puncture_at_first_contact ? "*" : "")
-                                  : "none";
+    const std::string depth =
+        row.puncture_depth_m
+            ? cell(*row.puncture_depth_m, Dimension::Length) + (row.puncture_at_first_contact ? "*"
+                                                                : row.puncture_lower_bound    ? "+"
+                                                                                              : "")
+            : "none";
     const std::string force =
         row.puncture_depth_m ? cell(row.puncture_force_n, Dimension::Force) : "-";
     std::printf("%-4d %-24s %-6s %-11s %-11s %-11s %-11s %-9s %-8s %s\n", ++rank,

@@ -25,7 +25,6 @@
 #include "mneedle/fe/tissue_mesh.h"
 #include "mneedle/insertion/energy_check.h"
 #include "mneedle/insertion/insertion_run.h"
-#include "mneedle/insertion/penetration_force.h"
 #include "mneedle/needle/mesh.h"
 #include "mneedle/needle/needle_frame.h"
 #include "mneedle/plot/figure.h"
@@ -60,34 +59,6 @@ InsertionRunOptions run_options(const Scene& scene, const SimulateOptions& o) {
               << "/\n";
   }
   return r;
-}
-
-// Where the penetration criterion's F_p does not hold (docs/model.md, "Penetration criterion"),
-// the user should know: a top layer thinner than the needle's diameter is no half-space, and a
-// brittle layer's crack would run wider than the widest tabulated one (F_p an upper bound).
-void warn_about_penetration_limits(const InsertionRun& run, const Scene& scene,
-                                   const std::string& file) {
-  if (run.criterion != PunctureCriterion::Penetration) return;
-  double widest_m2 = 0.0;
-  for (const NeedleRun& n : run.needles)
-    for (const RunPoint& p : n.curve) widest_m2 = std::max(widest_m2, p.section_area_m2);
-  const double diameter = 2.0 * std::sqrt(widest_m2 / std::numbers::pi);
-  const TissueLayer& top = scene.tissue.layers.front();
-  if (top.fracture && diameter > 0.0 &&
-      sharp_penetration_force(top.material.youngs_modulus, top.material.poisson_ratio,
-                              top.fracture->toughness, diameter / 2.0)
-          .at_widest_crack)
-    std::cerr << "mneedle: warning: " << file << ": tissue.layers[0] '" << top.name
-              << "' is brittle against the needle (toughness / (E r) below 0.013): its crack would "
-                 "run wider than 12 needle radii, so F_p is an upper bound (docs/model.md, "
-                 "\"Penetration criterion\")\n";
-  if (scene.tissue.layers.size() < 2 || !(top.thickness < diameter)) return;
-  std::cerr << "mneedle: warning: " << file << ": tissue.layers[0] '" << top.name << "' is "
-            << format_quantity(top.thickness, Dimension::Length)
-            << " thick, less than the needle's diameter ("
-            << format_quantity(diameter, Dimension::Length)
-            << "): the penetration criterion takes it for a half-space, so its F_p does not hold "
-               "(docs/model.md, \"Penetration criterion\")\n";
 }
 
 void print_csv(const InsertionRun& run) {
@@ -230,7 +201,8 @@ void run(const SimulateOptions& o) {
               << 100.0 * kEnergyCheckTolerance
               << " % apart: the contact or the mesh is not resolved; docs/model.md, \"Energy "
                  "check\")\n";
-  warn_about_penetration_limits(result, scene, o.scene.string());
+  for (const std::string& w : penetration_warnings(result, scene))
+    std::cerr << "mneedle: warning: " << w << "\n";
   if (!o.plot.empty())
     plot::write_svg(o.plot, simulate_figure(result, "simulate: " + o.scene.filename().string()));
   if (!o.report.empty()) write_report_folder(o.report, tree, o.plugin_dirs);

@@ -93,9 +93,10 @@ void add_insertion(DesignEvaluation& e, const TriangleMesh& mesh, const Scene& s
     }
   if (!n.curve.empty()) e.force_at_depth_n = n.curve.back().force_N;
   if (n.puncture && n.puncture->depth_m <= e.depth_m * (1.0 + 1e-9)) {
-    e.puncture = PunctureSummary{n.puncture->depth_m, n.puncture->force_N, n.puncture->post_force_N,
-                                 std::string(to_string(n.puncture->criterion)),
-                                 n.puncture->at_first_contact};
+    e.puncture =
+        PunctureSummary{n.puncture->depth_m,          n.puncture->force_N,
+                        n.puncture->post_force_N,     std::string(to_string(n.puncture->criterion)),
+                        n.puncture->at_first_contact, n.puncture->flat_tip};
     e.reaches_target = true;
     if (n.puncture->at_first_contact) {
       // No depth to optimise: the objective is the flat "no information" value, 2 x the depth.

@@ -193,10 +193,12 @@ json evaluation_json(const DesignEvaluation& e) {
                                          {"force_N", e.puncture->force_N},
                                          {"post_force_N", e.puncture->post_force_N},
                                          {"criterion", e.puncture->criterion},
-                                         {"at_first_contact", e.puncture->at_first_contact}}
+                                         {"at_first_contact", e.puncture->at_first_contact},
+                                         {"lower_bound", e.puncture->lower_bound}}
                                   : json(nullptr)},
           {"punctured", e.puncture.has_value()},
           {"puncture_at_first_contact", e.puncture && e.puncture->at_first_contact},
+          {"puncture_lower_bound", e.puncture && e.puncture->lower_bound},
           {"puncture_depth_m",
            optional_number(e.puncture ? std::optional(e.puncture->depth_m) : std::nullopt)},
           {"puncture_force_N",
@@ -224,9 +226,9 @@ json evaluation_json(const DesignEvaluation& e) {
 std::string row_hash(const DesignInput& d, const std::string& scene_hash,
                      const std::string& fidelity, const std::string& material) {
   // Version 3 rows hash the design's name and full-precision values and carry
-  // puncture_at_first_contact; version 4 rows carry the force curve (the report plots it); older
-  // rows are redone.
-  constexpr const char* kRowVersion = "4";
+  // puncture_at_first_contact; version 4 rows carry the force curve (the report plots it);
+  // version 5 rows carry puncture_lower_bound; older rows are redone.
+  constexpr const char* kRowVersion = "5";
   std::string fingerprint;
   try {
     fingerprint = design_fingerprint(d);
@@ -305,6 +307,7 @@ ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::s
       row.puncture_depth_m = e.puncture->depth_m;
       row.puncture_force_n = e.puncture->force_N;
       row.puncture_at_first_contact = e.puncture->at_first_contact;
+      row.puncture_lower_bound = e.puncture->lower_bound;
     }
     row.margin = e.margin;
     row.passes = e.passes;
@@ -358,6 +361,7 @@ ScreeningRow row_from_json(const std::string& line) {
       row.puncture_depth_m = j.at("puncture_depth_m").get<double>();
       row.puncture_force_n = j.at("puncture_force_N").get<double>();
       row.puncture_at_first_contact = j.value("puncture_at_first_contact", false);
+      row.puncture_lower_bound = j.value("puncture_lower_bound", false);
     }
     row.margin = j.at("margin").is_null() ? INFINITY : j.at("margin").get<double>();
     row.passes = j.at("passes").get<bool>();
@@ -677,6 +681,9 @@ std::vector<ScreeningRow> rank_rows(std::vector<ScreeningRow> rows) {
     // A depth that is only the first step's says nothing about the tip: after resolved ones.
     if (a.puncture_at_first_contact != b.puncture_at_first_contact)
       return !a.puncture_at_first_contact;
+    // A depth that is only a lower bound (a flat end under the penetration criterion) after the
+    // resolved ones too.
+    if (a.puncture_lower_bound != b.puncture_lower_bound) return !a.puncture_lower_bound;
     if (a.puncture_depth_m && *a.puncture_depth_m != *b.puncture_depth_m)
       return *a.puncture_depth_m < *b.puncture_depth_m;
     if (a.puncture_force_n != b.puncture_force_n) return a.puncture_force_n < b.puncture_force_n;

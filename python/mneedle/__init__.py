@@ -121,6 +121,9 @@ def simulate(
             f"of the work the needle did on it up to {check['depth_m']:.3g} m (more than "
             f"{100 * check['tolerance']:.3g} % apart: the contact or the mesh is not resolved)",
             RuntimeWarning, stacklevel=2)
+    for text in result.get("warnings", []):
+        # Where the penetration criterion does not hold, as the CLI says on stderr.
+        warnings.warn(text, RuntimeWarning, stacklevel=2)
     return result
 
 

@@ -321,7 +321,9 @@ TEST(CmdSimulate, OneMaterialSplitIntoLayersPuncturesWhereTheUnsplitOneDoes) {
     EXPECT_TRUE(j["energy_check"]["passes"].get<bool>());
     EXPECT_NEAR(j["energy_check"]["depth_m"].get<double>(), whole, 1e-12);
     EXPECT_GT(j["peak_memory_bytes"].get<double>(), 1e6);
-    EXPECT_EQ(run.err, "");  // no energy warning
+    // No energy warning (a run slower than 2 s also prints progress lines there, so look for
+    // the warning, not for an empty stderr: under load this run once took 21 s).
+    EXPECT_EQ(run.err.find("warning"), std::string::npos) << run.err;
   }
   ASSERT_GT(whole, 100e-6);  // 639 um: well below every split
   for (const std::string thickness : {"50 um", "150 um", "300 um"}) {

@@ -94,6 +94,7 @@ TEST(DesignEvaluation, FlatEndedNeedleSaysItsPenetrationDepthIsALowerBound) {
   const auto e = mneedle::evaluate_design(n.mesh, scene, "silicon", o);
   ASSERT_TRUE(e.puncture.has_value());
   EXPECT_EQ(e.puncture->criterion, "penetration");
+  EXPECT_TRUE(e.puncture->lower_bound);
   bool said = false;
   for (const std::string& note : e.notes) said = said || note.find("lower bound") != note.npos;
   EXPECT_TRUE(said);

@@ -387,4 +387,23 @@ TEST(ScreeningRanking, ResolvedPuncturesComeBeforeOnesAtFirstContact) {
   EXPECT_EQ(ranked[2].design, "none");
 }
 
+TEST(ScreeningRanking, LowerBoundDepthsComeAfterResolvedOnesAndBeforeFirstContact) {
+  // A flat end under the penetration criterion fires early, but its depth is only a lower bound:
+  // a sharp tip with a resolved, deeper puncture still ranks first.
+  std::vector<mneedle::ScreeningRow> rows(3);
+  for (auto& r : rows) r.ok = true;
+  rows[0].design = "flat";
+  rows[0].puncture_depth_m = 100e-6;
+  rows[0].puncture_lower_bound = true;
+  rows[1].design = "at_contact";
+  rows[1].puncture_depth_m = 5e-6;
+  rows[1].puncture_at_first_contact = true;
+  rows[2].design = "sharp";
+  rows[2].puncture_depth_m = 180e-6;
+  const auto ranked = mneedle::rank_rows(rows);
+  EXPECT_EQ(ranked[0].design, "sharp");
+  EXPECT_EQ(ranked[1].design, "flat");
+  EXPECT_EQ(ranked[2].design, "at_contact");
+}
+
 }  // namespace

@@ -133,3 +133,16 @@ def test_an_energy_check_that_passes_gives_no_warning(source, recwarn):
     result = mneedle.simulate(source / PUNCH)
     assert result["energy_check"] is not None and result["energy_check"]["passes"]
     assert len(recwarn) == 0
+
+
+def test_where_the_penetration_criterion_does_not_hold_python_warns_as_the_cli_does(cli, source):
+    # A gel so brittle against the 230 um punch (toughness / (E r) = 4e-5) that the crack would
+    # run wider than the table: F_p is an upper bound, the JSON and a RuntimeWarning say so.
+    values = mneedle.read_scene(source / PUNCH)
+    values["tissue"]["fracture"]["toughness"] = "0.001 J/m^2"
+    with pytest.warns(RuntimeWarning, match="F_p is an upper bound"):
+        result = mneedle.simulate(values, criterion="penetration", source="brittle gel")
+    assert len(result["warnings"]) == 1
+    assert result["warnings"][0].startswith("brittle gel: tissue.layers[0] 'silicone'")
+    # Paper A's toughness: no warning, and an empty list.
+    assert mneedle.simulate(source / PUNCH, criterion="penetration")["warnings"] == []

@@ -39,6 +39,9 @@ struct PunctureSummary {
   /// The criterion fired at the first depth step (docs/model.md, "Criteria"): the depth is the
   /// step's, not the tissue's; ranked after every resolved puncture, never an objective.
   bool at_first_contact = false;
+  /// Penetration criterion on a flat-ended needle (Puncture::flat_tip): the depth is a lower
+  /// bound; ranked after every resolved puncture, before those at first contact.
+  bool lower_bound = false;
 };
 
 /// One point of the two-stage force curve as screening and optimisation report it (the full

@@ -65,6 +65,7 @@ struct ScreeningRow {
   std::optional<double> puncture_depth_m;  // empty: no puncture up to the target depth
   double puncture_force_n = 0.0;
   bool puncture_at_first_contact = false;  // the depth is unresolved: ranked after the others
+  bool puncture_lower_bound = false;       // the depth is a lower bound: ranked after resolved ones
   double peak_force_n = 0.0;
   double margin = 0.0;
   bool passes = false;
