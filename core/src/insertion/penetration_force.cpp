@@ -17,8 +17,8 @@ namespace {
 
 // The table is made for a unit needle in a unit-modulus block: U_ε / (E r²) is then U_ε itself.
 // The block is 40 crack widths: the free edges' effect falls as 1/L² and is −0.05 % at 43 w̄
-// (docs/validation.md "The plane-strain model"), so about −0.06 % here. Cells of w̄/150 along the slit:
-// +0.06 % against w̄/1200 on paper C's case, at a quarter of the default mesh's time. Mesh and
+// (docs/validation.md "The plane-strain model"), so about −0.06 % here. Cells of w̄/150 along the
+// slit: +0.06 % against w̄/1200 on paper C's case, at a quarter of the default mesh's time. Mesh and
 // block are similar for every width, so the table is exact in E and r.
 constexpr double kBlockWidths = 40.0;
 constexpr double kCellsAlongSlit = 150.0;

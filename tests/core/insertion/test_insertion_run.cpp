@@ -226,6 +226,31 @@ TEST(InsertionRun, OverlappingNeedlesAreAnInputError) {
   EXPECT_NE(message.find("needle 'twin': overlaps needle 'punch'"), std::string::npos) << message;
 }
 
+// Puncture depth of a bevel at 15..45 deg in 2 deg steps: each resolved (not at first contact,
+// not a flat end), no two adjacent angles tied, and the increment from one step to the next
+// changing by at most 5 um (a quarter of the smallest step a jump to the grid would show).
+void expect_continuous_over_bevel_angles(const Scene& scene, const InsertionRunOptions& o) {
+  std::vector<double> depths;
+  for (int degrees = 15; degrees <= 45; degrees += 2) {
+    PreparedNeedle bevel;
+    bevel.name = "punch";
+    bevel.mesh = test::bevel_needle(115e-6, degrees * M_PI / 180.0, 1e-3);
+    const InsertionRun run = run_insertion(scene, {bevel}, o);
+    ASSERT_TRUE(run.needles[0].puncture.has_value()) << degrees << " deg";
+    const Puncture& p = *run.needles[0].puncture;
+    EXPECT_FALSE(p.at_first_contact) << degrees << " deg";
+    EXPECT_FALSE(p.flat_tip) << degrees << " deg";  // a bevel ends in a point
+    depths.push_back(p.depth_m);
+  }
+  for (std::size_t i = 1; i < depths.size(); ++i)
+    EXPECT_GT(std::abs(depths[i] - depths[i - 1]), 1e-9 * depths[i]) << "tie at " << 15 + 2 * i;
+  for (std::size_t i = 2; i < depths.size(); ++i) {
+    const double change = (depths[i] - depths[i - 1]) - (depths[i - 1] - depths[i - 2]);
+    EXPECT_LT(std::abs(change), 5e-6) << "jump at " << 15 + 2 * i << " deg: " << depths[i - 2]
+                                      << ", " << depths[i - 1] << ", " << depths[i];
+  }
+}
+
 TEST(InsertionRun, PunctureDepthMovesContinuouslyWithTheBevelAngle) {
   // Bevel angle 15..45 deg in 2 deg steps on the closed-form model in silicone (P_c 0.15 MPa,
   // crossed on the rising branch of F / A_sec; the depths run 29 -> 230 um, crossing the 100 and
@@ -241,24 +266,7 @@ TEST(InsertionRun, PunctureDepthMovesContinuouslyWithTheBevelAngle) {
                   "angles.toml");
   InsertionRunOptions o = fast();
   o.model = PreModel::Analytic;
-  std::vector<double> depths;
-  for (int degrees = 15; degrees <= 45; degrees += 2) {
-    PreparedNeedle bevel;
-    bevel.name = "punch";
-    bevel.mesh = test::bevel_needle(115e-6, degrees * M_PI / 180.0, 1e-3);
-    const InsertionRun run = run_insertion(scene, {bevel}, o);
-    ASSERT_TRUE(run.needles[0].puncture.has_value()) << degrees << " deg";
-    EXPECT_FALSE(run.needles[0].puncture->at_first_contact) << degrees << " deg";
-    depths.push_back(run.needles[0].puncture->depth_m);
-  }
-  for (std::size_t i = 1; i < depths.size(); ++i) {
-    EXPECT_GT(std::abs(depths[i] - depths[i - 1]), 1e-9 * depths[i]) << "tie at " << 15 + 2 * i;
-  }
-  for (std::size_t i = 2; i < depths.size(); ++i) {
-    const double change = (depths[i] - depths[i - 1]) - (depths[i - 1] - depths[i - 2]);
-    EXPECT_LT(std::abs(change), 5e-6) << "jump at " << 15 + 2 * i << " deg: " << depths[i - 2]
-                                      << ", " << depths[i - 1] << ", " << depths[i];
-  }
+  expect_continuous_over_bevel_angles(scene, o);
 }
 
 TEST(InsertionRun, PenetrationCriterionFiresWhereTheForceReachesThePenetrationForce) {
@@ -298,25 +306,7 @@ TEST(InsertionRun, PenetrationDepthMovesContinuouslyWithTheBevelAngle) {
   InsertionRunOptions o = fast();
   o.model = PreModel::Analytic;
   o.criterion = PunctureCriterion::Penetration;
-  std::vector<double> depths;
-  for (int degrees = 15; degrees <= 45; degrees += 2) {
-    PreparedNeedle bevel;
-    bevel.name = "punch";
-    bevel.mesh = test::bevel_needle(115e-6, degrees * M_PI / 180.0, 1e-3);
-    const InsertionRun run = run_insertion(scene, {bevel}, o);
-    ASSERT_TRUE(run.needles[0].puncture.has_value()) << degrees << " deg";
-    const Puncture& p = *run.needles[0].puncture;
-    EXPECT_FALSE(p.at_first_contact) << degrees << " deg";
-    EXPECT_FALSE(p.flat_tip) << degrees << " deg";  // a bevel ends in a point
-    depths.push_back(p.depth_m);
-  }
-  for (std::size_t i = 1; i < depths.size(); ++i)
-    EXPECT_GT(std::abs(depths[i] - depths[i - 1]), 1e-9 * depths[i]) << "tie at " << 15 + 2 * i;
-  for (std::size_t i = 2; i < depths.size(); ++i) {
-    const double change = (depths[i] - depths[i - 1]) - (depths[i - 1] - depths[i - 2]);
-    EXPECT_LT(std::abs(change), 5e-6) << "jump at " << 15 + 2 * i << " deg: " << depths[i - 2]
-                                      << ", " << depths[i - 1] << ", " << depths[i];
-  }
+  expect_continuous_over_bevel_angles(scene, o);
 }
 
 TEST(InsertionRun, ExplicitCriterionWithoutItsDataIsAnInputError) {
