@@ -1,0 +1,266 @@
+// Mesh convergence of the puncture depth and of the criterion's value at fixed depths
+// (docs/validation.md, "The penetration criterion"; docs/performance.md, "Puncture-depth
+// convergence"). Paper A's silicone scenes through run_insertion, the same call `simulate` makes,
+// at fast, standard, fine and one further refinement ("finer": fine with 7.5 instead of 5.5
+// node spacings per needle radius at the tip and a growth of 1.25 instead of 1.35).
+// Run on demand, never from ctest (finer: several minutes and several GB per needle):
+//   bench_puncture_convergence [--criterion penetration|pressure|energy] [--no-finer]
+//   [--frictionless]
+//                              [sharp_bevel] [blunt_bevel] [cylinder]   (none: sharp_bevel)
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mneedle/base/memory.h"
+#include "mneedle/design_source.h"
+#include "mneedle/fe/tissue_mesh.h"
+#include "mneedle/insertion/insertion_run.h"
+#include "mneedle/plugin_host.h"
+#include "mneedle/scene/scene.h"
+
+namespace {
+
+using namespace mneedle;
+namespace fs = std::filesystem;
+
+// Depths where every level is still before its puncture (the sharp bevel fires at 170-190 um
+// with the penetration criterion): the criterion's value is compared there.
+constexpr double kProbeDepths_m[] = {50e-6, 100e-6, 150e-6};
+
+struct Options {
+  PunctureCriterion criterion = PunctureCriterion::Penetration;
+  bool finer = true;
+  std::optional<Contact> contact;  // empty: the scene's
+  std::vector<std::string> needles;
+};
+
+struct Level {
+  std::string label;
+  InsertionRunOptions run;
+};
+
+struct Outcome {
+  std::string label;
+  std::optional<double> depth_m, force_N;
+  bool at_first_contact = false;
+  std::vector<std::optional<double>> probe_force_N;  // pre-puncture force at kProbeDepths_m
+  std::vector<std::optional<double>> probe_value;    // criterion value there
+  std::vector<RunPoint> curve;                       // pre-puncture points
+  std::size_t nodes = 0;
+  double seconds = 0.0;
+  double peak_gb = 0.0;
+  std::string error;
+};
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--no-finer") {
+      o.finer = false;
+    } else if (a == "--frictionless") {
+      o.contact = Contact::Frictionless;
+    } else if (a == "--criterion" && i + 1 < argc) {
+      const std::string c = argv[++i];
+      if (c == "penetration")
+        o.criterion = PunctureCriterion::Penetration;
+      else if (c == "pressure")
+        o.criterion = PunctureCriterion::Pressure;
+      else if (c == "energy")
+        o.criterion = PunctureCriterion::Energy;
+      else if (c == "stress")
+        o.criterion = PunctureCriterion::Stress;
+      else {
+        std::cerr << "bench_puncture_convergence: unknown criterion '" << c << "'\n";
+        std::exit(2);
+      }
+    } else if (a == "sharp_bevel" || a == "blunt_bevel" || a == "cylinder") {
+      o.needles.push_back(a);
+    } else {
+      std::cerr << "usage: bench_puncture_convergence [--criterion C] [--no-finer] "
+                   "[--frictionless] [sharp_bevel] "
+                   "[blunt_bevel] [cylinder]\n";
+      std::exit(a == "--help" || a == "-h" ? 0 : 2);
+    }
+  }
+  if (o.needles.empty()) o.needles = {"sharp_bevel"};
+  return o;
+}
+
+// Largest distance of the needle's surface from its axis (m): the radius the mesh is sized by.
+double needle_radius(const PreparedNeedle& n) {
+  double r = 0.0;
+  for (const auto& v : n.mesh.vertices) r = std::max(r, std::hypot(v[0], v[1]));
+  return r;
+}
+
+std::vector<Level> levels(const Scene& scene, const PreparedNeedle& needle, const Options& o) {
+  std::vector<Level> out;
+  auto base = [&](fe::Fidelity f) {
+    InsertionRunOptions r;
+    r.fidelity = f;
+    r.contact = o.contact.value_or(scene.model.contact);
+    r.criterion = o.criterion;
+    return r;
+  };
+  out.push_back({"fast", base(fe::Fidelity::Fast)});
+  out.push_back({"standard", base(fe::Fidelity::Standard)});
+  out.push_back({"fine", base(fe::Fidelity::Fine)});
+  if (o.finer) {
+    // One refinement beyond fine, in the same proportions as standard -> fine.
+    Level finer{"finer", base(fe::Fidelity::Fine)};
+    const double block = std::max(scene.tissue.size[0], scene.tissue.size[1]);
+    const double fine_size =
+        fe::mesh_sizing(fe::Fidelity::Fine, 2, needle_radius(needle), block).fine_size;
+    finer.run.overrides.tip_size_m = fine_size * 5.5 / 7.5;
+    finer.run.overrides.growth = 1.25;
+    out.push_back(finer);
+  }
+  return out;
+}
+
+// Linear interpolation on the pre-puncture points of the curve; empty past the last one.
+template <class Get>
+std::optional<double> at_depth(const std::vector<RunPoint>& curve, double depth, Get get) {
+  const RunPoint* prev = nullptr;
+  for (const RunPoint& p : curve) {
+    if (p.stage != Stage::Pre) break;
+    if (p.depth_m >= depth) {
+      if (prev == nullptr) return get(p);
+      const double t = (depth - prev->depth_m) / (p.depth_m - prev->depth_m);
+      return get(*prev) + t * (get(p) - get(*prev));
+    }
+    prev = &p;
+  }
+  return std::nullopt;
+}
+
+double criterion_value(const RunPoint& p, PunctureCriterion c) {
+  switch (c) {
+    case PunctureCriterion::Penetration:
+      return p.penetration_force_N > 0.0 ? p.force_N / p.penetration_force_N : 0.0;
+    case PunctureCriterion::Pressure:
+      return p.section_pressure_Pa;
+    case PunctureCriterion::Energy:
+      return p.energy_release_rate_J_per_m2;
+    case PunctureCriterion::Stress:
+      return p.tip_stress_Pa;
+  }
+  return 0.0;
+}
+
+Outcome run_level(const Scene& scene, const std::vector<PreparedNeedle>& needles, const Level& l,
+                  PunctureCriterion c) {
+  Outcome o;
+  o.label = l.label;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    const InsertionRun run = run_insertion(scene, needles, l.run);
+    const NeedleRun& n = run.needles.front();
+    if (n.puncture) {
+      o.depth_m = n.puncture->depth_m;
+      o.force_N = n.puncture->force_N;
+      o.at_first_contact = n.puncture->at_first_contact;
+    }
+    for (double d : kProbeDepths_m) {
+      o.probe_force_N.push_back(at_depth(n.curve, d, [](const RunPoint& p) { return p.force_N; }));
+      o.probe_value.push_back(
+          at_depth(n.curve, d, [c](const RunPoint& p) { return criterion_value(p, c); }));
+    }
+    for (const RunPoint& p : n.curve)
+      if (p.stage == Stage::Pre) o.curve.push_back(p);
+    o.nodes = static_cast<std::size_t>(run.nodes);
+  } catch (const std::exception& e) {
+    o.error = e.what();
+  }
+  o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  o.peak_gb = static_cast<double>(peak_memory_bytes()) / 1e9;
+  return o;
+}
+
+std::string percent_against(std::optional<double> v, std::optional<double> ref) {
+  if (!v || !ref || *ref == 0.0) return "-";
+  char b[32];
+  std::snprintf(b, sizeof b, "%+.1f %%", 100.0 * (*v / *ref - 1.0));
+  return b;
+}
+
+std::string number(std::optional<double> v, double scale, const char* format) {
+  if (!v) return "-";
+  char b[32];
+  std::snprintf(b, sizeof b, format, *v * scale);
+  return b;
+}
+
+void print_table(const std::string& needle, const std::vector<Outcome>& runs) {
+  const Outcome& ref = runs.back();  // the finest level run
+  std::printf("\n### %s (errors against %s)\n\n", needle.c_str(), ref.label.c_str());
+  std::printf("| level | nodes | time [s] | peak [GB] | puncture depth [um] | force [mN] |");
+  for (double d : kProbeDepths_m) std::printf(" value at %.0f um |", d * 1e6);
+  std::printf("\n|---|--:|--:|--:|--:|--:|");
+  for (std::size_t i = 0; i < std::size(kProbeDepths_m); ++i) std::printf("--:|");
+  std::printf("\n");
+  for (const Outcome& r : runs) {
+    if (!r.error.empty()) {
+      std::printf("| %s | failed: %s |\n", r.label.c_str(), r.error.c_str());
+      continue;
+    }
+    std::printf("| %s | %zu | %.1f | %.2f | %s (%s)%s | %s |", r.label.c_str(), r.nodes, r.seconds,
+                r.peak_gb, number(r.depth_m, 1e6, "%.1f").c_str(),
+                percent_against(r.depth_m, ref.depth_m).c_str(),
+                r.at_first_contact ? " first contact" : "", number(r.force_N, 1e3, "%.3f").c_str());
+    for (std::size_t i = 0; i < r.probe_value.size(); ++i)
+      std::printf(" %s (%s) |", number(r.probe_value[i], 1.0, "%.4g").c_str(),
+                  percent_against(r.probe_value[i], ref.probe_value[i]).c_str());
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+}
+
+// F/d² of every pre-puncture step: constant for a self-similar tip (a cone, a bevel before its
+// heel) in a linear half-space, so its scatter from step to step shows the mesh's own noise.
+void print_curves(const std::vector<Outcome>& runs) {
+  std::printf("\nF / d^2 [N/m^2] at each step (depth in um):\n\n");
+  for (const Outcome& r : runs) {
+    std::printf("%s:", r.label.c_str());
+    for (const RunPoint& p : r.curve)
+      std::printf(" %.0f:%.4g", p.depth_m * 1e6, p.force_N / (p.depth_m * p.depth_m));
+    std::printf("\n");
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options options = parse(argc, argv);
+  try {
+    const PluginRegistry registry = PluginRegistry::discover();
+    for (const std::string& needle : options.needles) {
+      const fs::path file = fs::path(MNEEDLE_SOURCE_ROOT) / "designs" / "scenes" /
+                            ("paper_a_silicone_" + needle + ".toml");
+      const Scene scene = load_scene(file);
+      const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene);
+      std::vector<Outcome> runs;
+      for (const Level& l : levels(scene, needles.front(), options)) {
+        runs.push_back(run_level(scene, needles, l, options.criterion));
+        std::fprintf(stderr, "%s %s: %.1f s %s\n", needle.c_str(), l.label.c_str(),
+                     runs.back().seconds, runs.back().error.c_str());
+      }
+      print_table(needle + ", criterion " + std::string(to_string(options.criterion)) +
+                      (options.contact ? ", frictionless contact" : ", the scene's contact"),
+                  runs);
+      print_curves(runs);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_puncture_convergence: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
