@@ -403,11 +403,25 @@ void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
         .points.back()
         .force_N;
   };
-  const double f_full = reference_on(plan.full_block_x_m, plan.full_block_y_m);
-  const double f_cut = plan.pre == PreKind::Axisymmetric
-                           ? reduced.needles[0].points.back().force_N
-                           : reference_on(plan.block_x_m, plan.block_y_m);
-  if (keep_reduction(*cut, f_cut, f_full, options, "the full block was used")) return;
+  // A proxy that cannot be solved (e.g. Newton stalling on a bevel's body of revolution in a
+  // neo-Hookean tissue) leaves the cut unmeasured: the safe choice is the full block, not an
+  // error that ends a run whose own model solves.
+  std::optional<std::string> unmeasured;
+  double f_full = 0.0, f_cut = 0.0;
+  try {
+    f_full = reference_on(plan.full_block_x_m, plan.full_block_y_m);
+    f_cut = plan.pre == PreKind::Axisymmetric ? reduced.needles[0].points.back().force_N
+                                              : reference_on(plan.block_x_m, plan.block_y_m);
+  } catch (const SolverError& e) {
+    unmeasured = e.what();
+  }
+  if (unmeasured) {
+    cut->name += "_rejected";
+    cut->detail += "; its effect could not be measured (the axisymmetric proxy: " + *unmeasured +
+                   "): the full block was used";
+  } else if (keep_reduction(*cut, f_cut, f_full, options, "the full block was used")) {
+    return;
+  }
   plan.block_x_m = plan.full_block_x_m;
   plan.block_y_m = plan.full_block_y_m;
   plan.axisymmetric_radius_m = fe::equal_area_radius(std::sqrt(plan.block_x_m * plan.block_y_m));
