@@ -403,17 +403,23 @@ void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
         .points.back()
         .force_N;
   };
-  // A proxy that cannot be solved (e.g. Newton stalling on a bevel's body of revolution in a
-  // neo-Hookean tissue) leaves the cut unmeasured: the safe choice is the full block, not an
-  // error that ends a run whose own model solves.
+  // For the 3-D model a proxy that cannot be solved (e.g. Newton stalling on a bevel's body of
+  // revolution in a neo-Hookean tissue) leaves the cut unmeasured: the safe choice is the full
+  // block, not an error that ends a run whose own model solves (docs/model.md, "Scene
+  // planner", domain_cut). For the axisymmetric model the proxy is the run's own model on the full block,
+  // so its failure is the run's.
   std::optional<std::string> unmeasured;
   double f_full = 0.0, f_cut = 0.0;
-  try {
+  if (plan.pre == PreKind::Axisymmetric) {
     f_full = reference_on(plan.full_block_x_m, plan.full_block_y_m);
-    f_cut = plan.pre == PreKind::Axisymmetric ? reduced.needles[0].points.back().force_N
-                                              : reference_on(plan.block_x_m, plan.block_y_m);
-  } catch (const SolverError& e) {
-    unmeasured = e.what();
+    f_cut = reduced.needles[0].points.back().force_N;
+  } else {
+    try {
+      f_full = reference_on(plan.full_block_x_m, plan.full_block_y_m);
+      f_cut = reference_on(plan.block_x_m, plan.block_y_m);
+    } catch (const SolverError& e) {
+      unmeasured = e.what();
+    }
   }
   if (unmeasured) {
     cut->name += "_rejected";
