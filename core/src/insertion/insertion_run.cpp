@@ -406,8 +406,8 @@ void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
   // For the 3-D model a proxy that cannot be solved (e.g. Newton stalling on a bevel's body of
   // revolution in a neo-Hookean tissue) leaves the cut unmeasured: the safe choice is the full
   // block, not an error that ends a run whose own model solves (docs/model.md, "Scene
-  // planner", domain_cut). For the axisymmetric model the proxy is the run's own model on the full block,
-  // so its failure is the run's.
+  // planner", domain_cut). For the axisymmetric model the proxy is the run's own model on the full
+  // block, so its failure is the run's.
   std::optional<std::string> unmeasured;
   double f_full = 0.0, f_cut = 0.0;
   if (plan.pre == PreKind::Axisymmetric) {
