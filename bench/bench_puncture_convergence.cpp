@@ -39,6 +39,8 @@ constexpr double kProbeDepths_m[] = {40e-6, 100e-6, 160e-6};
 struct Options {
   PunctureCriterion criterion = PunctureCriterion::Penetration;
   bool finer = true;
+  int refine = 0;  // refinement_levels of every level (0: the tensor grid)
+  bool finest = false;
   std::optional<Contact> contact;  // empty: the scene's
   std::vector<std::string> needles;
 };
@@ -66,6 +68,10 @@ Options parse(int argc, char** argv) {
     const std::string a = argv[i];
     if (a == "--no-finer") {
       o.finer = false;
+    } else if (a == "--refine" && i + 1 < argc) {
+      o.refine = std::atoi(argv[++i]);
+    } else if (a == "--finest") {
+      o.finest = true;
     } else if (a == "--frictionless") {
       o.contact = Contact::Frictionless;
     } else if (a == "--criterion" && i + 1 < argc) {
@@ -109,6 +115,7 @@ std::vector<Level> levels(const Scene& scene, const PreparedNeedle& needle, cons
     r.fidelity = f;
     r.contact = o.contact.value_or(scene.model.contact);
     r.criterion = o.criterion;
+    if (o.refine > 0) r.overrides.refinement_levels = o.refine;
     return r;
   };
   out.push_back({"fast", base(fe::Fidelity::Fast)});
@@ -123,6 +130,15 @@ std::vector<Level> levels(const Scene& scene, const PreparedNeedle& needle, cons
     finer.run.overrides.tip_size_m = fine_size * 5.5 / 7.5;
     finer.run.overrides.growth = 1.25;
     out.push_back(finer);
+  }
+  if (o.finest) {
+    // Two steps beyond fine: 10.5 spacings per radius, growth 1.2 (a graded mesh's level).
+    Level finest{"finest", base(fe::Fidelity::Fine)};
+    const double block = std::max(scene.tissue.size[0], scene.tissue.size[1]);
+    finest.run.overrides.tip_size_m =
+        fe::mesh_sizing(fe::Fidelity::Fine, 2, needle_radius(needle), block).fine_size * 5.5 / 10.5;
+    finest.run.overrides.growth = 1.2;
+    out.push_back(finest);
   }
   return out;
 }

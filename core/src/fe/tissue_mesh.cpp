@@ -9,6 +9,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "fe/tet_bisection.h"
 #include "mneedle/base/error.h"
 
 namespace mneedle::fe {
@@ -16,6 +17,12 @@ namespace mneedle::fe {
 namespace {
 
 constexpr int kEdgeNodes[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+
+// Bounds on local refinement: each level halves the element size along the needle's path, and
+// 2^6 = 64 is far beyond any useful grading; the tetrahedron cap bounds the work and memory of a
+// bad override (a TET10 mesh of 4 million tetrahedra is about 5.5 million nodes).
+constexpr int kMaxRefinementLevels = 6;
+constexpr std::size_t kMaxRefinedTets = 4'000'000;
 
 [[noreturn]] void bad_spec(const std::string& field, const std::string& problem) {
   throw InputError("tissue block: " + field + ": " + problem);
@@ -31,6 +38,10 @@ void validate(const TissueBlockSpec& spec) {
       bad_spec("layers." + layer.name + ".thickness", "must be positive and finite");
   if (spec.order != 1 && spec.order != 2) bad_spec("order", "must be 1 or 2");
   if (!(spec.insertion_depth >= 0.0)) bad_spec("insertion_depth", "must be >= 0");
+  if (spec.overrides.refinement_levels &&
+      (*spec.overrides.refinement_levels < 0 ||
+       *spec.overrides.refinement_levels > kMaxRefinementLevels))
+    bad_spec("overrides.refinement_levels", "must be 0 to " + std::to_string(kMaxRefinementLevels));
   for (const NeedleSite& site : spec.sites) {
     if (!(site.radius > 0.0)) bad_spec("needle radius", "must be positive");
     if (std::abs(site.x) >= spec.size_x / 2 || std::abs(site.y) >= spec.size_y / 2)
@@ -43,6 +54,22 @@ void validate(const TissueBlockSpec& spec) {
 double graded_size(double distance_outside, const MeshSizing& sizing) {
   const double size = sizing.fine_size + (sizing.growth - 1.0) * std::max(0.0, distance_outside);
   return std::min(size, sizing.max_size);
+}
+
+// Element size wanted at p (m) when the grid is refined along the needles' paths: the fine size
+// within fine_half_width of a needle's axis and above the insertion depth, growing by `growth`
+// per element with the distance from that cylinder (the tensor grid's grading, made radial).
+double refinement_target(const Eigen::Vector3d& p, const std::vector<NeedleSite>& sites,
+                         const MeshSizing& sizing, double insertion_depth) {
+  const double below = -p.z() - insertion_depth;
+  auto from_axis = [&](double x, double y) {
+    const double lateral = std::hypot(p.x() - x, p.y() - y) - sizing.fine_half_width;
+    return graded_size(std::max(lateral, below), sizing);
+  };
+  if (sites.empty()) return from_axis(0.0, 0.0);
+  double size = sizing.max_size;
+  for (const NeedleSite& site : sites) size = std::min(size, from_axis(site.x, site.y));
+  return size;
 }
 
 // Places nodes on [lo, hi] so that each interval spans about one local element size, by
@@ -170,14 +197,13 @@ std::vector<double> tips_clear_of(const std::vector<double>& sites, const std::v
 // the half >= 0 is then exactly a half model's axis.
 std::vector<double> lateral_coordinates(double half, const std::vector<double>& centres,
                                         const std::vector<double>& tips, const MeshSizing& sizing,
-                                        bool* symmetric) {
+                                        double clearance, bool* symmetric) {
   auto size_at = [&](double x) {
     double size = sizing.max_size;
     for (double c : centres)
       size = std::min(size, graded_size(std::abs(x - c) - sizing.fine_half_width, sizing));
     return size;
   };
-  const double clearance = 0.25 * sizing.fine_size;
   std::vector<double> sorted = centres;
   std::sort(sorted.begin(), sorted.end());
   const std::vector<double> clear = tips_clear_of(sorted, tips, half, clearance);
@@ -269,10 +295,12 @@ std::vector<char> mirrored_cells(const std::vector<double>& axis,
 
 // Six tetrahedra per hexahedron, all sharing one main diagonal of the cell (Kuhn/Freudenthal).
 // The diagonal may be mirrored in x per column and in y per row: a face between two cells then
-// still gets the same diagonal from both sides, so the mesh stays conforming.
-void split_cells(TetMesh& mesh, const std::array<std::vector<double>, 3>& axes,
-                 const std::vector<int>& cell_layer, const std::vector<char>& mirror_x,
-                 const std::vector<char>& mirror_y) {
+// still gets the same diagonal from both sides, so the mesh stays conforming. Each tetrahedron
+// goes to emit(path, layer) with its corners along the path corner 0 -> corner 7 (the order
+// bisection needs, docs/model.md "Tissue block and mesh").
+template <typename Emit>
+void split_cells(const std::array<std::vector<double>, 3>& axes, const std::vector<int>& cell_layer,
+                 const std::vector<char>& mirror_x, const std::vector<char>& mirror_y, Emit emit) {
   const int nx = static_cast<int>(axes[0].size()) - 1;
   const int ny = static_cast<int>(axes[1].size()) - 1;
   const int nz = static_cast<int>(axes[2].size()) - 1;
@@ -292,19 +320,23 @@ void split_cells(TetMesh& mesh, const std::array<std::vector<double>, 3>& axes,
         for (const auto& perm : kPermutations) {
           const int v1 = 1 << perm[0];
           const int v2 = v1 | (1 << perm[1]);
-          std::array<int, 10> tet{};
-          tet.fill(-1);
-          tet[0] = corner[0];
-          tet[1] = corner[static_cast<std::size_t>(v1)];
-          tet[2] = corner[static_cast<std::size_t>(v2)];
-          tet[3] = corner[7];
-          const auto& x = mesh.nodes;
-          if (signed_tet_volume(x[tet[0]], x[tet[1]], x[tet[2]], x[tet[3]]) < 0.0)
-            std::swap(tet[1], tet[2]);
-          mesh.elements.push_back(tet);
-          mesh.element_layer.push_back(cell_layer[static_cast<std::size_t>(k)]);
+          emit(std::array<int, 4>{corner[0], corner[static_cast<std::size_t>(v1)],
+                                  corner[static_cast<std::size_t>(v2)], corner[7]},
+               cell_layer[static_cast<std::size_t>(k)]);
         }
       }
+}
+
+// Appends a tetrahedron to the mesh, positively oriented.
+void add_element(TetMesh& mesh, const std::array<int, 4>& corners, int layer) {
+  std::array<int, 10> tet{};
+  tet.fill(-1);
+  std::copy(corners.begin(), corners.end(), tet.begin());
+  const auto& x = mesh.nodes;
+  if (signed_tet_volume(x[tet[0]], x[tet[1]], x[tet[2]], x[tet[3]]) < 0.0)
+    std::swap(tet[1], tet[2]);
+  mesh.elements.push_back(tet);
+  mesh.element_layer.push_back(layer);
 }
 
 void add_midside_nodes(TetMesh& mesh) {
@@ -382,10 +414,12 @@ void mark_fixed_nodes(TetMesh& mesh, const Eigen::Vector3d& lo, const Eigen::Vec
 // (which is symmetric about 0 by construction when its sites and tips are), so a reduced model
 // meshes exactly its share of the full mesh.
 std::vector<double> half_axis(double half_size, const std::vector<double>& sites,
-                              const std::vector<double>& tips, const MeshSizing& sizing, bool half,
-                              const std::string& name, std::vector<char>* mirrored) {
+                              const std::vector<double>& tips, const MeshSizing& sizing,
+                              double clearance, bool half, const std::string& name,
+                              std::vector<char>* mirrored) {
   bool symmetric = false;
-  std::vector<double> axis = lateral_coordinates(half_size, sites, tips, sizing, &symmetric);
+  std::vector<double> axis =
+      lateral_coordinates(half_size, sites, tips, sizing, clearance, &symmetric);
   *mirrored = mirrored_cells(axis, sites);
   if (!half) return axis;
   if (!symmetric)
@@ -481,18 +515,26 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
     }
   }
   if (spec.sites.empty()) cx = cy = {0.0};
-  std::vector<double> z = vertical_coordinates(spec.layers, sizing, spec.insertion_depth);
+  // With refinement levels the grid is built 2^levels coarser at the sites and bisected back
+  // down to the fine size along the needles' paths only.
+  const int levels = spec.overrides.refinement_levels.value_or(0);
+  MeshSizing base = sizing;
+  base.fine_size = std::min(sizing.max_size, std::ldexp(sizing.fine_size, levels));
+  std::vector<double> z = vertical_coordinates(spec.layers, base, spec.insertion_depth);
   // A tensor grid carries the thinnest layer's cell height everywhere in x and y: cap the
   // lateral size so those cells stay within kMaxCellAspect (the quality floor rests on it).
   double thinnest = z.back() - z.front();
   for (std::size_t k = 0; k + 1 < z.size(); ++k) thinnest = std::min(thinnest, z[k + 1] - z[k]);
-  MeshSizing lateral = sizing;
-  lateral.max_size =
-      std::max(sizing.fine_size, std::min(sizing.max_size, kMaxCellAspect * thinnest));
+  MeshSizing lateral = base;
+  lateral.max_size = std::max(base.fine_size, std::min(base.max_size, kMaxCellAspect * thinnest));
+  // A tip closer than this to a site or another line gets no line of its own (the fine size's,
+  // also when the grid starts coarser: refinement does not add lines).
+  const double clearance = 0.25 * sizing.fine_size;
   std::array<std::vector<char>, 2> mirrored;
   std::array<std::vector<double>, 3> axes = {
-      half_axis(spec.size_x / 2, cx, tip_x, lateral, spec.half_x, "x", &mirrored[0]),
-      half_axis(spec.size_y / 2, cy, tip_y, lateral, spec.half_y, "y", &mirrored[1]), std::move(z)};
+      half_axis(spec.size_x / 2, cx, tip_x, lateral, clearance, spec.half_x, "x", &mirrored[0]),
+      half_axis(spec.size_y / 2, cy, tip_y, lateral, clearance, spec.half_y, "y", &mirrored[1]),
+      std::move(z)};
   TetMesh mesh;
   mesh.order = spec.order;
   mesh.layers = spec.layers;
@@ -515,7 +557,23 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
     }
     cell_layer.push_back(layer);
   }
-  split_cells(mesh, axes, cell_layer, mirrored[0], mirrored[1]);
+  if (levels == 0) {
+    split_cells(axes, cell_layer, mirrored[0], mirrored[1],
+                [&](const std::array<int, 4>& path, int layer) { add_element(mesh, path, layer); });
+  } else {
+    TetBisection bisection(std::move(mesh.nodes));
+    split_cells(
+        axes, cell_layer, mirrored[0], mirrored[1],
+        [&](const std::array<int, 4>& path, int layer) { bisection.add_kuhn_tet(path, layer); });
+    bisection.refine(
+        [&](const Eigen::Vector3d& p) {
+          return refinement_target(p, spec.sites, sizing, spec.insertion_depth);
+        },
+        kMaxRefinedTets);
+    mesh.nodes = bisection.nodes();
+    for (std::size_t t = 0; t < bisection.tets().size(); ++t)
+      add_element(mesh, bisection.tets()[t], bisection.layers()[t]);
+  }
   if (mesh.order == 2) add_midside_nodes(mesh);
   link_neighbours_and_top(mesh);
   mark_fixed_nodes(mesh, {axes[0].front(), axes[1].front(), axes[2].front()},

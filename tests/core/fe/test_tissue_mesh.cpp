@@ -38,6 +38,17 @@ double tet_volume(const TetMesh& mesh, const std::array<int, 10>& t) {
   return (p[t[1]] - p[t[0]]).dot((p[t[2]] - p[t[0]]).cross(p[t[3]] - p[t[0]])) / 6.0;
 }
 
+// Each element's midside node lies at the middle of its edge (VTK_QUADRATIC_TETRA order).
+void expect_midside_nodes_at_edge_middles(const TetMesh& mesh) {
+  for (const auto& t : mesh.elements)
+    for (int e = 0; e < 6; ++e) {
+      constexpr int kEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+      const auto& p = mesh.nodes;
+      const Eigen::Vector3d mid = 0.5 * (p[t[kEdge[e][0]]] + p[t[kEdge[e][1]]]);
+      EXPECT_LT((p[t[static_cast<std::size_t>(4 + e)]] - mid).norm(), 1e-15);
+    }
+}
+
 TEST(TissueMesh, VolumesArePositiveAndFillTheBlock) {
   const TetMesh mesh = generate_tissue_mesh(paper_a_skin(Fidelity::Fast, 1));
   double total = 0.0;
@@ -93,13 +104,7 @@ TEST(TissueMesh, QuadraticMeshSharesEveryMidsideNode) {
   const long body_diagonals = nx * ny * nz;
   EXPECT_EQ(static_cast<long>(mesh.nodes.size()),
             corners + grid_edges + face_diagonals + body_diagonals);
-  for (const auto& t : mesh.elements)
-    for (int e = 0; e < 6; ++e) {
-      constexpr int kEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
-      const auto& p = mesh.nodes;
-      const Eigen::Vector3d mid = 0.5 * (p[t[kEdge[e][0]]] + p[t[kEdge[e][1]]]);
-      EXPECT_LT((p[t[static_cast<std::size_t>(4 + e)]] - mid).norm(), 1e-15);
-    }
+  expect_midside_nodes_at_edge_middles(mesh);
 }
 
 TEST(TissueMesh, ElementsAreFinestAtTheNeedleSite) {
@@ -236,6 +241,102 @@ TEST(TissueMesh, RejectsBadSpecsWithInputError) {
   EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
   EXPECT_THROW(parse_fidelity("ultra"), mneedle::InputError);
   EXPECT_EQ(parse_fidelity("fine"), Fidelity::Fine);
+}
+
+// Local refinement (docs/model.md, "Tissue block and mesh"): the grid built 2^levels coarser and
+// bisected back to the tip size along the needle's path.
+TissueBlockSpec refined_skin(int levels) {
+  TissueBlockSpec spec = paper_a_skin(Fidelity::Standard, 2);
+  spec.overrides.refinement_levels = levels;
+  return spec;
+}
+
+// The block's outer surface: a face every one of whose corners lies on one side of the box.
+bool on_box_surface(const TetMesh& mesh, const std::array<int, 10>& t, int opposite) {
+  for (int d = 0; d < 3; ++d)
+    for (double side : {-1500e-6, 1500e-6, -1150e-6, 0.0}) {
+      bool all = true;
+      for (int i = 0; i < 4; ++i)
+        if (i != opposite)
+          all = all &&
+                mesh.nodes[static_cast<std::size_t>(t[static_cast<std::size_t>(i)])][d] == side;
+      if (all) return true;
+    }
+  return false;
+}
+
+TEST(TissueMesh, RefinedMeshIsConformingAndOpenOnlyOnTheBoxSurface) {
+  const TetMesh mesh = generate_tissue_mesh(refined_skin(2));
+  double total = 0.0;
+  for (const auto& t : mesh.elements) {
+    EXPECT_GT(tet_volume(mesh, t), 0.0);
+    total += tet_volume(mesh, t);
+  }
+  EXPECT_NEAR(total, 3000e-6 * 3000e-6 * 1150e-6, 1e-9 * total);
+  // A hanging node would leave a face without a neighbour inside the block.
+  for (std::size_t t = 0; t < mesh.elements.size(); ++t)
+    for (int f = 0; f < 4; ++f)
+      if (mesh.neighbours[t][static_cast<std::size_t>(f)] < 0) {
+        ASSERT_TRUE(on_box_surface(mesh, mesh.elements[t], f)) << "element " << t;
+      }
+  // Midside nodes: shared between neighbours and at the middle of their edge.
+  expect_midside_nodes_at_edge_middles(mesh);
+}
+
+TEST(TissueMesh, RefinementReachesTheTipSizeAtTheSiteWithFewerNodes) {
+  const TetMesh plain = generate_tissue_mesh(paper_a_skin(Fidelity::Standard, 2));
+  const TetMesh refined = generate_tissue_mesh(refined_skin(2));
+  // The shortest lateral corner-to-corner spacing on the top surface at the axis is the tip
+  // size in both (the refined grid halves twice from four times it).
+  auto spacing_at_axis = [](const TetMesh& m) {
+    double spacing = 1.0;
+    for (const auto& t : m.elements)
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b) {
+          const Eigen::Vector3d& p =
+              m.nodes[static_cast<std::size_t>(t[static_cast<std::size_t>(a)])];
+          const Eigen::Vector3d& q =
+              m.nodes[static_cast<std::size_t>(t[static_cast<std::size_t>(b)])];
+          if (p.z() == 0.0 && q.z() == 0.0 && p.y() == 0.0 && q.y() == 0.0 &&
+              std::min(std::abs(p.x()), std::abs(q.x())) == 0.0)
+            spacing = std::min(spacing, (p - q).norm());
+        }
+    return spacing;
+  };
+  const double tip = mesh_sizing(Fidelity::Standard, 2, 115e-6, 3000e-6).fine_size;
+  EXPECT_NEAR(spacing_at_axis(plain), tip, 1e-12);
+  EXPECT_NEAR(spacing_at_axis(refined), tip, 1e-12);
+  EXPECT_LT(refined.nodes.size(), plain.nodes.size());
+}
+
+TEST(TissueMesh, RefinedMeshIsMirrorSymmetricAndItsQuarterIsThePositivePart) {
+  TissueBlockSpec spec = refined_skin(2);
+  const TetMesh full = generate_tissue_mesh(spec);
+  auto key = [](const Eigen::Vector3d& p) { return std::array<double, 3>{p.x(), p.y(), p.z()}; };
+  std::set<std::array<double, 3>> nodes;
+  for (const Eigen::Vector3d& p : full.nodes) nodes.insert(key(p));
+  for (const Eigen::Vector3d& p : full.nodes) {
+    EXPECT_EQ(nodes.count({-p.x(), p.y(), p.z()}), 1U) << p.transpose();
+    EXPECT_EQ(nodes.count({p.x(), -p.y(), p.z()}), 1U) << p.transpose();
+  }
+  spec.half_x = spec.half_y = true;
+  const TetMesh quarter = generate_tissue_mesh(spec);
+  std::set<std::array<double, 3>> kept, meshed;
+  for (const Eigen::Vector3d& p : full.nodes)
+    if (p.x() >= 0.0 && p.y() >= 0.0) kept.insert(key(p));
+  for (const Eigen::Vector3d& p : quarter.nodes) meshed.insert(key(p));
+  EXPECT_EQ(meshed, kept);
+}
+
+TEST(TissueMesh, RefinedMeshKeepsTheQualityFloor) {
+  const MeshQuality q = mesh_quality(generate_tissue_mesh(refined_skin(3)));
+  EXPECT_GE(q.min_dihedral_deg, kMinDihedralFloorDeg);
+  EXPECT_LE(q.max_aspect_ratio, kMaxAspectRatioCeiling);
+}
+
+TEST(TissueMesh, RefinementLevelsOutOfRangeAreAnInputError) {
+  EXPECT_THROW(generate_tissue_mesh(refined_skin(-1)), mneedle::InputError);
+  EXPECT_THROW(generate_tissue_mesh(refined_skin(7)), mneedle::InputError);
 }
 
 }  // namespace

@@ -17,6 +17,9 @@ struct FidelityOverrides {
   std::optional<double> tolerance;          ///< Newton residual tolerance (relative)
   std::optional<int> steps;                 ///< depth steps of the insertion
   std::optional<int> elements_through_top;  ///< elements through the top layer's thickness
+  /// 3-D tissue only: the grid is built 2^n coarser at the needle and bisected back to the tip
+  /// size along the needle's path (0: the plain tensor grid, the default; at most 6).
+  std::optional<int> refinement_levels;
 };
 
 /// Contact between the rigid needle and the tissue surface.
