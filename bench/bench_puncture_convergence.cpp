@@ -5,7 +5,10 @@
 // radius at the tip and a growth of 1.25 instead of 1.35).
 // Run on demand, never from ctest (finer: several minutes and several GB per needle):
 //   bench_puncture_convergence [--criterion penetration|pressure|energy|stress]
-//       [--no-finer] [--frictionless] [sharp_bevel] [blunt_bevel] [cylinder]   (none: sharp_bevel)
+//       [--no-finer] [--finest] [--refine N] [--tissue silicone|skin] [--frictionless]
+//       [sharp_bevel] [blunt_bevel] [cylinder]   (none: sharp_bevel)
+// --refine N: every level's grid built 2^N coarser and bisected back along the needle's path
+// (refinement_levels); --finest: a level beyond finer (10.5 spacings per radius, growth 1.2).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -41,7 +44,8 @@ struct Options {
   bool finer = true;
   int refine = 0;  // refinement_levels of every level (0: the tensor grid)
   bool finest = false;
-  std::optional<Contact> contact;  // empty: the scene's
+  std::string tissue = "silicone";  // paper_a_<tissue>_<needle>.toml
+  std::optional<Contact> contact;   // empty: the scene's
   std::vector<std::string> needles;
 };
 
@@ -60,6 +64,7 @@ struct Outcome {
   double seconds = 0.0;
   double peak_gb = 0.0;  // the process's peak so far: the levels run in order, finest last
   std::string error;
+  std::string reductions;  // the planner's, as run
 };
 
 Options parse(int argc, char** argv) {
@@ -70,6 +75,8 @@ Options parse(int argc, char** argv) {
       o.finer = false;
     } else if (a == "--refine" && i + 1 < argc) {
       o.refine = std::atoi(argv[++i]);
+    } else if (a == "--tissue" && i + 1 < argc) {
+      o.tissue = argv[++i];
     } else if (a == "--finest") {
       o.finest = true;
     } else if (a == "--frictionless") {
@@ -91,8 +98,8 @@ Options parse(int argc, char** argv) {
     } else if (a == "sharp_bevel" || a == "blunt_bevel" || a == "cylinder") {
       o.needles.push_back(a);
     } else {
-      std::cerr << "usage: bench_puncture_convergence [--criterion C] [--no-finer] "
-                   "[--frictionless] [sharp_bevel] "
+      std::cerr << "usage: bench_puncture_convergence [--criterion C] [--no-finer] [--finest] "
+                   "[--refine N] [--tissue silicone|skin] [--frictionless] [sharp_bevel] "
                    "[blunt_bevel] [cylinder]\n";
       std::exit(a == "--help" || a == "-h" ? 0 : 2);
     }
@@ -177,6 +184,7 @@ Outcome run_level(const Scene& scene, const std::vector<PreparedNeedle>& needles
     for (const RunPoint& p : n.curve)
       if (p.stage == Stage::Pre) o.curve.push_back(p);
     o.nodes = static_cast<std::size_t>(run.nodes);
+    for (const Reduction& r : run.reductions) o.reductions += " " + r.name + ": " + r.detail + ";";
   } catch (const std::exception& e) {
     o.error = e.what();
   }
@@ -251,7 +259,7 @@ int main(int argc, char** argv) {
     const PluginRegistry registry = PluginRegistry::discover();
     for (const std::string& needle : options.needles) {
       const fs::path file = fs::path(MNEEDLE_SOURCE_ROOT) / "designs" / "scenes" /
-                            ("paper_a_silicone_" + needle + ".toml");
+                            ("paper_a_" + options.tissue + "_" + needle + ".toml");
       const Scene scene = load_scene(file);
       const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene);
       std::vector<Outcome> runs;
@@ -264,6 +272,8 @@ int main(int argc, char** argv) {
                       (options.contact ? ", frictionless contact" : ", the scene's contact"),
                   runs);
       print_curves(runs);
+      std::printf("\nReductions of the scene planner:\n\n");
+      for (const Outcome& r : runs) std::printf("- %s:%s\n", r.label.c_str(), r.reductions.c_str());
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_puncture_convergence: %s\n", e.what());

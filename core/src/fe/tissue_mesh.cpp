@@ -454,6 +454,10 @@ std::string to_string(Fidelity fidelity) {
   return "fine";
 }
 
+int default_refinement_levels(Fidelity fidelity, int order) {
+  return order == 2 && fidelity != Fidelity::Fast ? 2 : 0;
+}
+
 MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, double block_size,
                        const FidelityOverrides& overrides) {
   // Node spacings per needle radius at the site (a TET10 element spans two, a TET4 one), growth
@@ -517,7 +521,8 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   if (spec.sites.empty()) cx = cy = {0.0};
   // With refinement levels the grid is built 2^levels coarser at the sites and bisected back
   // down to the fine size along the needles' paths only.
-  const int levels = spec.overrides.refinement_levels.value_or(0);
+  const int levels =
+      spec.overrides.refinement_levels.value_or(default_refinement_levels(spec.fidelity, spec.order));
   MeshSizing base = sizing;
   base.fine_size = std::min(sizing.max_size, std::ldexp(sizing.fine_size, levels));
   std::vector<double> z = vertical_coordinates(spec.layers, base, spec.insertion_depth);

@@ -284,7 +284,7 @@ TEST(TissueMesh, RefinedMeshIsConformingAndOpenOnlyOnTheBoxSurface) {
 }
 
 TEST(TissueMesh, RefinementReachesTheTipSizeAtTheSiteWithFewerNodes) {
-  const TetMesh plain = generate_tissue_mesh(paper_a_skin(Fidelity::Standard, 2));
+  const TetMesh plain = generate_tissue_mesh(refined_skin(0));
   const TetMesh refined = generate_tissue_mesh(refined_skin(2));
   // The shortest lateral corner-to-corner spacing on the top surface at the axis is the tip
   // size in both (the refined grid halves twice from four times it).

@@ -68,6 +68,10 @@ struct MeshSizing {
   double max_size = 0.0;         ///< coarsest element size
   int elements_through_top = 1;  ///< elements through the (thin, stiff) top layer
 };
+/// Halvings of the grid along the needle's path by local bisection when overrides leave
+/// refinement_levels unset (docs/model.md, "Tissue block and mesh").
+int default_refinement_levels(Fidelity fidelity, int order);
+
 /// Overrides honoured here: tip_size_m (fine_size), growth, elements_through_top.
 MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, double block_size,
                        const FidelityOverrides& overrides = {});
