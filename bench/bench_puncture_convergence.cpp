@@ -8,7 +8,8 @@
 //       [--no-finer] [--finest] [--refine N] [--tissue silicone|skin] [--frictionless]
 //       [sharp_bevel] [blunt_bevel] [cylinder]   (none: sharp_bevel)
 // --refine N: every level's grid built 2^N coarser and bisected back along the needle's path
-// (refinement_levels); --finest: a level beyond finer (10.5 spacings per radius, growth 1.2).
+// (refinement_levels; 0 is the plain tensor grid; default: 0 at fast, 2 at standard and finer);
+// --finest: a level beyond finer (10.5 spacings per radius, growth 1.2).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -42,7 +43,7 @@ constexpr double kProbeDepths_m[] = {40e-6, 100e-6, 160e-6};
 struct Options {
   PunctureCriterion criterion = PunctureCriterion::Penetration;
   bool finer = true;
-  int refine = 0;  // refinement_levels of every level (0: the tensor grid)
+  std::optional<int> refine;  // refinement_levels of every level; empty: each level's default
   bool finest = false;
   std::string tissue = "silicone";  // paper_a_<tissue>_<needle>.toml
   std::optional<Contact> contact;   // empty: the scene's
@@ -122,7 +123,7 @@ std::vector<Level> levels(const Scene& scene, const PreparedNeedle& needle, cons
     r.fidelity = f;
     r.contact = o.contact.value_or(scene.model.contact);
     r.criterion = o.criterion;
-    if (o.refine > 0) r.overrides.refinement_levels = o.refine;
+    r.overrides.refinement_levels = o.refine;
     return r;
   };
   out.push_back({"fast", base(fe::Fidelity::Fast)});
