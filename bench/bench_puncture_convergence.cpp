@@ -8,7 +8,7 @@
 //       [--no-finer] [--finest] [--refine N] [--tissue silicone|skin] [--frictionless]
 //       [sharp_bevel] [blunt_bevel] [cylinder]   (none: sharp_bevel)
 // --refine N: every level's grid built 2^N coarser and bisected back along the needle's path
-// (refinement_levels; 0 is the plain tensor grid; default: 0 at fast, 2 at standard and finer);
+// (refinement_levels; 0 is the plain tensor grid; default: 2 at fine and beyond, 0 below);
 // --finest: a level beyond finer (10.5 spacings per radius, growth 1.2).
 #include <algorithm>
 #include <chrono>

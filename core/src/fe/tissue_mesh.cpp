@@ -455,7 +455,7 @@ std::string to_string(Fidelity fidelity) {
 }
 
 int default_refinement_levels(Fidelity fidelity, int order) {
-  return order == 2 && fidelity != Fidelity::Fast ? 2 : 0;
+  return order == 2 && fidelity == Fidelity::Fine ? 2 : 0;
 }
 
 MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, double block_size,

@@ -42,10 +42,9 @@ TetMesh punch_mesh(const TissueBlockSpec& base, double radius, double depth, int
 constexpr double kHayesNu045Ratio04 = 1.599;
 // Frictionless punch, docs/validation.md, "Frictionless flat punch vs Hayes": a displacement
 // finite element solution is stiffer than the exact one, so F >= F_Hayes; the standard mesh
-// (67 um elements at the site) reads 1.21 x Hayes (the rim singularity; 1.25 on the plain tensor
-// grid, before local refinement), falling under refinement
-// (ExtremePoisson.Tet10FrictionlessPunchApproachesHayesFromAboveUnderRefinement). The upper
-// bound is the tensor grid's reading plus 4 %: a change of the contact resolution moves it more.
+// (67 um elements at the site) reads 1.25 x Hayes (the rim singularity), falling under
+// refinement (ExtremePoisson.Tet10FrictionlessPunchApproachesHayesFromAboveUnderRefinement).
+// The upper bound is that reading plus 4 %: a change of the contact resolution moves it more.
 constexpr double kFrictionlessPunchLowest = 1.0;
 constexpr double kFrictionlessPunchHighest = 1.30;
 
@@ -76,9 +75,7 @@ void check_bonded_punch(int order, double tolerance) {
 }
 
 TEST(Indentation3d, BondedFlatPunchOnQuadraticTetsMatchesHayesLayerSolution) {
-  // Measured 0.958 on the standard mesh refined along the punch's path (0.983 on the plain
-  // tensor grid; docs/validation.md).
-  check_bonded_punch(2, 0.05);
+  check_bonded_punch(2, 0.05);  // measured 0.983 (docs/validation.md)
 }
 
 TEST(Indentation3d, BondedFlatPunchOnLinearTetsMatchesHayesLayerSolution) {
