@@ -18,10 +18,8 @@ namespace {
 
 constexpr int kEdgeNodes[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
 
-// Bounds on local refinement: each level halves the element size along the needle's path, and
-// 2^6 = 64 is far beyond any useful grading; the tetrahedron cap bounds the work and memory of a
-// bad override (a TET10 mesh of 4 million tetrahedra is about 5.5 million nodes).
-constexpr int kMaxRefinementLevels = 6;
+// The tetrahedron cap bounds the work and memory of a bad override (a TET10 mesh of 4 million
+// tetrahedra is about 5.5 million nodes).
 constexpr std::size_t kMaxRefinedTets = 4'000'000;
 
 [[noreturn]] void bad_spec(const std::string& field, const std::string& problem) {
@@ -521,8 +519,8 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   if (spec.sites.empty()) cx = cy = {0.0};
   // With refinement levels the grid is built 2^levels coarser at the sites and bisected back
   // down to the fine size along the needles' paths only.
-  const int levels =
-      spec.overrides.refinement_levels.value_or(default_refinement_levels(spec.fidelity, spec.order));
+  const int levels = spec.overrides.refinement_levels.value_or(
+      default_refinement_levels(spec.fidelity, spec.order));
   MeshSizing base = sizing;
   base.fine_size = std::min(sizing.max_size, std::ldexp(sizing.fine_size, levels));
   std::vector<double> z = vertical_coordinates(spec.layers, base, spec.insertion_depth);

@@ -734,9 +734,16 @@ InsertionRunOptions scene_run_options(const Scene& scene) {
   return r;
 }
 
+static_assert(kMaxMeshRefinement == fe::kMaxRefinementLevels,
+              "the scene's mesh_refinement bound is the mesh generator's");
+
 InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>& needles,
-                           const InsertionRunOptions& options) {
+                           const InsertionRunOptions& requested) {
   const auto start = std::chrono::steady_clock::now();
+  // The scene's mesh refinement reaches every command the same way (an explicit override wins).
+  InsertionRunOptions options = requested;
+  if (!options.overrides.refinement_levels)
+    options.overrides.refinement_levels = scene.model.mesh_refinement;
   check_needle_placement(scene, needles);
   // The pre-puncture model climbs the horizon ladder (docs/model.md, "Pre-puncture horizon"):
   // rung k is built for 100 um x 2^k whatever depth was asked, and the first rung on which every

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <initializer_list>
 #include <numbers>
@@ -135,6 +136,20 @@ class Table {
 
   void require_positive(std::string_view key, double v, Dimension d) {
     if (!(v > 0.0)) fail_key(key, "must be positive, got " + format_quantity(v, d));
+  }
+
+  // A whole number in [lo, hi] (a count: dimensionless, so no unit).
+  std::optional<int> optional_count(std::string_view key, int lo, int hi) {
+    const toml::node* node = get(key);
+    if (!node) return std::nullopt;
+    const auto* integer = node->as_integer();
+    if (!integer) fail(key_path(key), line_of(*node), "expected a whole number");
+    const std::int64_t v = integer->get();
+    if (v < lo || v > hi)
+      fail(key_path(key), line_of(*node),
+           "must be " + std::to_string(lo) + " to " + std::to_string(hi) + ", got " +
+               std::to_string(v));
+    return static_cast<int>(v);
   }
 
   std::optional<std::string> optional_string(std::string_view key) {
@@ -747,6 +762,7 @@ ModelOptions read_model(std::optional<Table> t, const Tissue& tissue) {
   m.contact = t->optional_choice<Contact>("contact", {{"sticking", Contact::Sticking},
                                                       {"frictionless", Contact::Frictionless}})
                   .value_or(m.contact);
+  m.mesh_refinement = t->optional_count("mesh_refinement", 0, kMaxMeshRefinement);
   t->finish();
   return m;
 }

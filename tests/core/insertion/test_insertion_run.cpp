@@ -500,6 +500,28 @@ TEST(ScenePlanner, HalfModelOfABevelMatchesTheFullModel) {
   EXPECT_NEAR(a.contact_area_m2, b.contact_area_m2, 1e-9 * b.contact_area_m2);
 }
 
+// [model] mesh_refinement reaches the 3-D mesh through run_insertion (so every command); an
+// explicit override in the options wins over it.
+TEST(ScenePlanner, SceneMeshRefinementReachesThe3dMeshAndAnOverrideWins) {
+  PreparedNeedle bevel;
+  bevel.name = "bevel";
+  bevel.mesh = test::bevel_needle(115e-6, M_PI / 6, 1e-3);
+  bevel.mirror_symmetric_y0 = true;
+  const std::string text = scene_text("", "", kOnePunch, "[\"puncture\", \"force_curve\"]",
+                                      "[\"1500 um\", \"1500 um\", \"600 um\"]", "100 um");
+  const Scene plain = parse_scene(text, "bevel.toml");
+  const Scene refined = parse_scene(text + "mesh_refinement = 2\n", "bevel.toml");
+  ASSERT_EQ(refined.model.mesh_refinement, 2);
+  const InsertionRun a = run_insertion(plain, {bevel}, fast());
+  const InsertionRun b = run_insertion(refined, {bevel}, fast());
+  InsertionRunOptions grid = fast();
+  grid.overrides.refinement_levels = 0;
+  const InsertionRun c = run_insertion(refined, {bevel}, grid);
+  EXPECT_NE(a.nodes, b.nodes);  // fast's default is the plain grid (0)
+  EXPECT_EQ(c.nodes, a.nodes);
+  ASSERT_GT(b.needles.front().curve.back().force_N, 0.0);
+}
+
 // The domain cut of a 3-D run is measured on the needle's body of revolution; for a bevel in
 // neo-Hookean silicone that proxy's Newton stalls at 14 um (relative residual 1.4e-5 against the
 // 1e-5 floor; docs/validation.md, "Is the linear tissue why our forces are ≈ 3× below paper

@@ -129,6 +129,13 @@ TEST(Scene, OptionalTablesTakeTheirDefaults) {
   EXPECT_FALSE(s.requirements.target_depth);
   EXPECT_DOUBLE_EQ(s.requirements.safety_factor, 1.5);
   EXPECT_TRUE(s.materials.empty());
+  EXPECT_FALSE(s.model.mesh_refinement);  // the fidelity's default
+}
+
+TEST(Scene, MeshRefinementIsAWholeNumberOfHalvings) {
+  const Scene s =
+      parse(with("fidelity = \"standard\"", "fidelity = \"standard\"\nmesh_refinement = 3"));
+  EXPECT_EQ(s.model.mesh_refinement, 3);
 }
 
 TEST(Scene, PlainNumbersAreSi) {
@@ -338,6 +345,15 @@ TEST(Scene, ShippedSiliconePhantomRoundTrips) {
 TEST(SceneErrors, UnknownUnit) {
   expect_error(with("\"20 um\"", "\"20 uf\""),
                {"test.toml:7:", "tissue.layers[0].thickness", "unknown unit 'uf'"});
+}
+
+TEST(SceneErrors, MeshRefinementOutsideZeroToSixOrNotAWholeNumber) {
+  expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\nmesh_refinement = 7"),
+               {"test.toml:", "model.mesh_refinement", "must be 0 to 6, got 7"});
+  expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\nmesh_refinement = 1.5"),
+               {"test.toml:", "model.mesh_refinement", "expected a whole number"});
+  expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\nmesh_refinement = \"2\""),
+               {"test.toml:", "model.mesh_refinement", "expected a whole number"});
 }
 
 TEST(SceneErrors, WrongDimension) {

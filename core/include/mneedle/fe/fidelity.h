@@ -22,6 +22,10 @@ struct FidelityOverrides {
   std::optional<int> refinement_levels;
 };
 
+/// Largest refinement_levels: each level halves the element size along the needle's path, and
+/// 2^6 = 64 is far beyond any useful grading.
+inline constexpr int kMaxRefinementLevels = 6;
+
 /// Contact between the rigid needle and the tissue surface.
 enum class ContactMode { Sticking, Frictionless };
 

@@ -114,11 +114,17 @@ enum class Output { Puncture, ForceCurve, Fields };
 enum class PunctureCriterion { Pressure, Energy, Stress, Penetration };
 enum class Contact { Sticking, Frictionless };
 
+/// Largest `[model] mesh_refinement` (each level halves the element size along the path).
+inline constexpr int kMaxMeshRefinement = 6;
+
 struct ModelOptions {
   Fidelity fidelity = Fidelity::Standard;
   std::vector<Output> outputs{Output::Puncture, Output::ForceCurve};
   PunctureCriterion criterion = PunctureCriterion::Pressure;
   Contact contact = Contact::Sticking;
+  /// 3-D TET10 tissue mesh: halvings of its grid along the needles' paths (docs/model.md,
+  /// "Tissue block and mesh"); empty: the fidelity's default (2 at fine, 0 below).
+  std::optional<int> mesh_refinement;
 
   bool wants(Output o) const;
 };
