@@ -73,8 +73,9 @@ bool TetBisection::has_refinement_edge(int t, int a, int b) const {
 void TetBisection::bisect_conforming(int t, int depth) {
   if (depth > kMaxClosureDepth)
     throw std::logic_error("tet bisection: conforming closure did not terminate");
-  const auto& v = tets_[static_cast<std::size_t>(t)];
-  const int a = v[0], b = v[static_cast<std::size_t>(tag_[static_cast<std::size_t>(t)])];
+  // Copies, not a reference into tets_: the recursion below grows the vector.
+  const auto ti = static_cast<std::size_t>(t);
+  const int a = tets_[ti][0], b = tets_[ti][static_cast<std::size_t>(tag_[ti])];
   while (true) {
     const std::vector<int> around = tets_around(a, b);
     if (around.empty()) return;  // the edge was bisected by the closure of a neighbour
@@ -137,8 +138,9 @@ void TetBisection::refine(const std::function<double(const Eigen::Vector3d&)>& t
       if (!(extent(t) > kMargin * target(centroid(t)))) continue;
       bisect_conforming(t, 0);
       if (tets_.size() > max_tets)
-        throw InputError("tissue block: mesh refinement: more than " + std::to_string(max_tets) +
-                         " tetrahedra; coarsen tip_size_m or lower refinement_levels");
+        throw InputError(
+            "tissue block: mesh refinement: more than " + std::to_string(max_tets) +
+            " tetrahedra; lower [model] mesh_refinement (or coarsen the tip size override)");
     }
   }
 }

@@ -522,7 +522,15 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   const int levels = spec.overrides.refinement_levels.value_or(
       default_refinement_levels(spec.fidelity, spec.order));
   MeshSizing base = sizing;
-  base.fine_size = std::min(sizing.max_size, std::ldexp(sizing.fine_size, levels));
+  if (levels > 0) {
+    const std::vector<double> z_fine =
+        vertical_coordinates(spec.layers, sizing, spec.insertion_depth);
+    double thinnest_fine = z_fine.back() - z_fine.front();
+    for (std::size_t k = 0; k + 1 < z_fine.size(); ++k)
+      thinnest_fine = std::min(thinnest_fine, z_fine[k + 1] - z_fine[k]);
+    base.fine_size = std::min({sizing.max_size, std::ldexp(sizing.fine_size, levels),
+                               std::max(sizing.fine_size, kMaxRefinedCellAspect * thinnest_fine)});
+  }
   std::vector<double> z = vertical_coordinates(spec.layers, base, spec.insertion_depth);
   // A tensor grid carries the thinnest layer's cell height everywhere in x and y: cap the
   // lateral size so those cells stay within kMaxCellAspect (the quality floor rests on it).
@@ -530,9 +538,10 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   for (std::size_t k = 0; k + 1 < z.size(); ++k) thinnest = std::min(thinnest, z[k + 1] - z[k]);
   MeshSizing lateral = base;
   lateral.max_size = std::max(base.fine_size, std::min(base.max_size, kMaxCellAspect * thinnest));
-  // A tip closer than this to a site or another line gets no line of its own (the fine size's,
-  // also when the grid starts coarser: refinement does not add lines).
-  const double clearance = 0.25 * sizing.fine_size;
+  // A tip closer than this to a site or another line gets no line of its own. It scales with
+  // the grid actually built: on a coarser base grid a tip line a quarter of the fine size from
+  // a site line would leave a sliver cell that bisection cannot improve.
+  const double clearance = 0.25 * base.fine_size;
   std::array<std::vector<char>, 2> mirrored;
   std::array<std::vector<double>, 3> axes = {
       half_axis(spec.size_x / 2, cx, tip_x, lateral, clearance, spec.half_x, "x", &mirrored[0]),

@@ -98,7 +98,21 @@ TEST(TetBisection, ThreeGenerationsGiveTheKuhnTetrahedraOfHalfSizeBoxes) {
   // 2^3 cells of size 0.5 become 4^3 of size 0.25: eight times the tetrahedra, each of the
   // same volume (1/6 of its cell), so the shapes of the start repeat.
   ASSERT_EQ(mesh.tets().size(), 6U * 64U);
-  for (const auto& t : mesh.tets()) EXPECT_NEAR(volume(mesh, t), 0.25 * 0.25 * 0.25 / 6.0, 1e-15);
+  for (const auto& t : mesh.tets()) {
+    EXPECT_NEAR(volume(mesh, t), 0.25 * 0.25 * 0.25 / 6.0, 1e-15);
+    // A Kuhn tetrahedron of a cube of side h: three edges h, two h sqrt 2, one h sqrt 3.
+    std::array<double, 6> edges{};
+    std::size_t e = 0;
+    for (std::size_t a = 0; a < 4; ++a)
+      for (std::size_t b = a + 1; b < 4; ++b)
+        edges[e++] = (mesh.nodes()[static_cast<std::size_t>(t[a])] -
+                      mesh.nodes()[static_cast<std::size_t>(t[b])])
+                         .norm();
+    std::sort(edges.begin(), edges.end());
+    const std::array<double, 6> kuhn = {
+        0.25, 0.25, 0.25, 0.25 * std::sqrt(2.0), 0.25 * std::sqrt(2.0), 0.25 * std::sqrt(3.0)};
+    for (std::size_t i = 0; i < 6; ++i) EXPECT_NEAR(edges[i], kuhn[i], 1e-15);
+  }
   expect_conforming(mesh, 1.0);
 }
 

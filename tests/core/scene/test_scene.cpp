@@ -349,11 +349,11 @@ TEST(SceneErrors, UnknownUnit) {
 
 TEST(SceneErrors, MeshRefinementOutsideZeroToSixOrNotAWholeNumber) {
   expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\nmesh_refinement = 7"),
-               {"test.toml:", "model.mesh_refinement", "must be 0 to 6, got 7"});
+               {"test.toml:31:", "model.mesh_refinement", "must be 0 to 6, got 7"});
   expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\nmesh_refinement = 1.5"),
-               {"test.toml:", "model.mesh_refinement", "expected a whole number"});
+               {"test.toml:31:", "model.mesh_refinement", "expected a whole number"});
   expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\nmesh_refinement = \"2\""),
-               {"test.toml:", "model.mesh_refinement", "expected a whole number"});
+               {"test.toml:31:", "model.mesh_refinement", "expected a whole number"});
 }
 
 TEST(SceneErrors, WrongDimension) {

@@ -117,6 +117,12 @@ MeshQuality mesh_quality(const TetMesh& mesh);
 /// top layer forces flat cells all across the block, and this cap bounds how flat.
 inline constexpr double kMaxCellAspect = 20.0;
 
+/// Largest ratio of the refined grid's starting lateral size at a site to the unrefined grid's
+/// thinnest cell height. Bisection keeps the shapes of the cells it starts from, so a base grid
+/// many levels coarser over a thin layer would start (and stay) flatter than the floor below
+/// allows; beyond this ratio the grid starts finer and fewer levels are actually used.
+inline constexpr double kMaxRefinedCellAspect = 40.0;
+
 /// Documented quality floor of the generator (docs/model.md, "Tissue block and mesh"): with the
 /// aspect cap every mesh it makes keeps min dihedral >= kMinDihedralFloorDeg and aspect ratio <=
 /// kMaxAspectRatioCeiling (longest edge over 2 sqrt(6) inradius).
