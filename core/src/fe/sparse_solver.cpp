@@ -2,12 +2,17 @@
 
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <cstdlib>
+#include <cstring>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #include "mneedle/base/error.h"
 
 #ifdef MNEEDLE_HAVE_CHOLMOD
+#include <sys/mman.h>
+
 #include <Eigen/CholmodSupport>
 #endif
 
@@ -15,8 +20,104 @@ namespace mneedle::fe {
 
 namespace {
 #ifdef MNEEDLE_HAVE_CHOLMOD
-using Cholesky = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
 constexpr const char* kCholeskyName = "cholmod-supernodal-llt";
+
+// Large CHOLMOD blocks (above all the factor: 100 MB for the skin half model) on transparent huge
+// pages where the kernel gives them on request (THP "madvise", Debian's default). The first touch
+// of each 4 KiB page is a page fault, and on the 2-core VMs we run on those faults were a quarter
+// of a skin run (docs/performance.md, "Where the time goes"). The advice is only advice: where
+// huge pages are off the memory is ordinary. Blocks come from posix_memalign, so CHOLMOD's
+// free() and realloc() stay valid for them.
+constexpr std::size_t kHugePage = std::size_t{2} << 20;
+constexpr std::size_t kHugeBlock = 4 * kHugePage;
+
+void* huge_page_malloc(std::size_t bytes) {
+  if (bytes < kHugeBlock) return std::malloc(bytes);
+  void* block = nullptr;
+  if (posix_memalign(&block, kHugePage, bytes) != 0) return nullptr;
+  madvise(block, bytes / kHugePage * kHugePage, MADV_HUGEPAGE);
+  return block;
+}
+
+void* huge_page_calloc(std::size_t count, std::size_t size) {
+  if (size != 0 && count > SIZE_MAX / size) return nullptr;
+  if (count * size < kHugeBlock) return std::calloc(count, size);
+  void* block = huge_page_malloc(count * size);
+  if (block != nullptr) std::memset(block, 0, count * size);
+  return block;
+}
+
+// CHOLMOD's supernodal Cholesky called directly, not through Eigen's wrapper: the nodal ordering
+// goes to cholmod_analyze_p as a given permutation, and CHOLMOD applies it in the transpose it
+// makes anyway. The wrapper takes no permutation, so each analysis and factorisation needed a
+// permuted copy of K (13 % of a skin run). Only the lower triangle is read (stype -1).
+class Cholesky {
+ public:
+  Cholesky() {
+    static std::once_flag hooked;
+    std::call_once(hooked, [] {
+      SuiteSparse_config.malloc_func = huge_page_malloc;
+      SuiteSparse_config.calloc_func = huge_page_calloc;
+    });
+    cholmod_start(&common_);
+    common_.supernodal = CHOLMOD_SUPERNODAL;
+    common_.final_asis = 1;
+    // A failed Cholesky is expected (the LDLT fallback handles it): keep CHOLMOD quiet on stderr.
+    common_.print = 0;
+  }
+  ~Cholesky() {
+    release();
+    cholmod_finish(&common_);
+  }
+  Cholesky(const Cholesky&) = delete;
+  Cholesky& operator=(const Cholesky&) = delete;
+
+  cholmod_common& common() { return common_; }
+
+  // `order` (the dof eliminated k-th, for k = 0, 1, ...) or, when empty, CHOLMOD's own choice.
+  void analyze(const Eigen::SparseMatrix<double>& matrix, std::vector<int> order) {
+    release();
+    common_.nmethods = order.empty() ? 0 : 1;  // 0: CHOLMOD's own choice (AMD, then METIS)
+    common_.method[0].ordering = CHOLMOD_GIVEN;
+    cholmod_sparse a = Eigen::viewAsCholmod(matrix.selfadjointView<Eigen::Lower>());
+    factor_ = cholmod_analyze_p(&a, order.empty() ? nullptr : order.data(), nullptr, 0, &common_);
+    if (factor_ == nullptr)
+      throw SolverError("sparse solver: CHOLMOD analysis failed (status " +
+                        std::to_string(common_.status) + ")");
+  }
+
+  // False when the matrix is not positive definite (or CHOLMOD ran out of memory).
+  bool factorize(const Eigen::SparseMatrix<double>& matrix) {
+    cholmod_sparse a = Eigen::viewAsCholmod(matrix.selfadjointView<Eigen::Lower>());
+    return cholmod_factorize(&a, factor_, &common_) != 0 && factor_->minor == factor_->n;
+  }
+
+  template <typename Matrix>  // Eigen::VectorXd or Eigen::MatrixXd: column-major, no stride
+  Matrix solve(const Matrix& rhs) const {
+    cholmod_dense b{};
+    b.nrow = static_cast<std::size_t>(rhs.rows());
+    b.ncol = static_cast<std::size_t>(rhs.cols());
+    b.nzmax = b.nrow * b.ncol;
+    b.d = b.nrow;
+    b.x = const_cast<double*>(rhs.data());  // read only: CHOLMOD writes its result elsewhere
+    b.xtype = CHOLMOD_REAL;
+    b.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense* x = cholmod_solve(CHOLMOD_A, factor_, &b, &common_);
+    if (x == nullptr) throw SolverError("sparse solver: CHOLMOD solve failed (out of memory?)");
+    Matrix result =
+        Eigen::Map<const Matrix>(static_cast<const double*>(x->x), rhs.rows(), rhs.cols());
+    cholmod_free_dense(&x, &common_);
+    return result;
+  }
+
+ private:
+  void release() {
+    if (factor_ != nullptr) cholmod_free_factor(&factor_, &common_);
+  }
+  // cholmod_solve updates its statistics: a solve is logically const.
+  mutable cholmod_common common_{};
+  cholmod_factor* factor_ = nullptr;
+};
 #else
 using Cholesky = Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
 constexpr const char* kCholeskyName = "eigen-simplicial-llt";
@@ -27,7 +128,8 @@ enum class Active { None, Cholesky, Indefinite };
 
 struct SparseSolver::Impl {
   int dofs_per_node = 1;
-  // Nodal ordering (dofs_per_node > 1): the matrix is factorised as P K Pᵀ.
+  // Nodal ordering (dofs_per_node > 1): CHOLMOD factorises P K Pᵀ with this permutation given;
+  // the LDLT fallback is handed P K Pᵀ itself.
   bool permuted = false;
   Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> permutation;
   Cholesky cholesky;
@@ -42,10 +144,6 @@ struct SparseSolver::Impl {
 SparseSolver::SparseSolver(int dofs_per_node) : impl_(std::make_unique<Impl>()) {
   if (dofs_per_node < 1) throw SolverError("sparse solver: dofs_per_node must be >= 1");
   impl_->dofs_per_node = dofs_per_node;
-#ifdef MNEEDLE_HAVE_CHOLMOD
-  // A failed Cholesky is expected (the LDLT fallback handles it): keep CHOLMOD quiet on stderr.
-  impl_->cholesky.cholmod().print = 0;
-#endif
 }
 SparseSolver::~SparseSolver() = default;
 SparseSolver::SparseSolver(SparseSolver&&) noexcept = default;
@@ -130,26 +228,28 @@ void SparseSolver::analyze(const Eigen::SparseMatrix<double>& matrix) {
     static std::mutex ordering;
     std::lock_guard<std::mutex> lock(ordering);
 #ifdef MNEEDLE_HAVE_CHOLMOD
+    std::vector<int> dof_order;
     const int b = impl_->dofs_per_node;
     if (b > 1 && matrix.rows() % b == 0 && matrix.rows() > 0) {
-      const std::vector<int> order = nodal_ordering(matrix, b, impl_->cholesky.cholmod());
+      const std::vector<int> order = nodal_ordering(matrix, b, impl_->cholesky.common());
       if (!order.empty()) {
-        // order[k] is the node eliminated k-th; the permutation maps old dof to new.
+        // order[k] is the node eliminated k-th: its dofs are the k-th block of P K Pᵀ. The
+        // permutation maps old dof to new (for the LDLT fallback).
+        dof_order.resize(static_cast<std::size_t>(matrix.rows()));
         impl_->permutation.resize(matrix.rows());
         for (std::size_t k = 0; k < order.size(); ++k)
-          for (int d = 0; d < b; ++d)
+          for (int d = 0; d < b; ++d) {
+            dof_order[static_cast<std::size_t>(b) * k + static_cast<std::size_t>(d)] =
+                b * order[k] + d;
             impl_->permutation.indices()[b * order[k] + d] = b * static_cast<int>(k) + d;
+          }
         impl_->permuted = true;
       }
     }
-    cholmod_common& common = impl_->cholesky.cholmod();
-    common.nmethods = impl_->permuted ? 1 : 0;  // 0: CHOLMOD's own choice (AMD, then METIS)
-    common.method[0].ordering = impl_->permuted ? CHOLMOD_NATURAL : CHOLMOD_GIVEN;
+    impl_->cholesky.analyze(matrix, std::move(dof_order));
+#else
+    impl_->cholesky.analyzePattern(matrix);
 #endif
-    if (impl_->permuted)
-      impl_->cholesky.analyzePattern(permuted(matrix, impl_->permutation));
-    else
-      impl_->cholesky.analyzePattern(matrix);
   }
   impl_->indefinite_analyzed = false;
   impl_->rows = matrix.rows();
@@ -160,16 +260,22 @@ void SparseSolver::analyze(const Eigen::SparseMatrix<double>& matrix) {
 
 void SparseSolver::factorize(const Eigen::SparseMatrix<double>& input) {
   if (input.rows() != impl_->rows || input.nonZeros() != impl_->nonzeros) analyze(input);
-  Eigen::SparseMatrix<double> reordered;
-  if (impl_->permuted) reordered = permuted(input, impl_->permutation);
-  const Eigen::SparseMatrix<double>& matrix = impl_->permuted ? reordered : input;
-  impl_->cholesky.factorize(matrix);
-  if (impl_->cholesky.info() == Eigen::Success) {
+#ifdef MNEEDLE_HAVE_CHOLMOD
+  const bool factorized = impl_->cholesky.factorize(input);
+#else
+  impl_->cholesky.factorize(input);
+  const bool factorized = impl_->cholesky.info() == Eigen::Success;
+#endif
+  if (factorized) {
     impl_->active = Active::Cholesky;
     return;
   }
   // Not positive definite (e.g. a hyperelastic tangent past a limit point): LDLT still
-  // factorises symmetric indefinite matrices with a nonsingular leading-minor sequence.
+  // factorises symmetric indefinite matrices with a nonsingular leading-minor sequence. It gets
+  // P K Pᵀ, the Cholesky's fill-reducing order.
+  Eigen::SparseMatrix<double> reordered;
+  if (impl_->permuted) reordered = permuted(input, impl_->permutation);
+  const Eigen::SparseMatrix<double>& matrix = impl_->permuted ? reordered : input;
   if (!impl_->indefinite_analyzed) {
     impl_->indefinite.analyzePattern(matrix);
     impl_->indefinite_analyzed = true;
@@ -182,37 +288,28 @@ void SparseSolver::factorize(const Eigen::SparseMatrix<double>& input) {
 
 namespace {
 
-// Solves with the active factorisation of P K Pᵀ (P = identity when not permuted).
+// Solves with the active factorisation. CHOLMOD applies its own permutation; the LDLT fallback
+// factorised P K Pᵀ (P = identity when not permuted).
 template <typename Matrix, typename Impl>
 Matrix solve_with(const Impl& impl, const Matrix& rhs) {
-  if (impl.permuted) {
-    // One copy of the right-hand side's size at a time beside the caller's (a block of
-    // compliance columns is dofs x 3 captured nodes): permuted, solved, permuted back in place.
-    Matrix x;
-    {
-      const Matrix reordered_rhs = impl.permutation * rhs;
-      switch (impl.active) {
-        case Active::Cholesky:
-          x = impl.cholesky.solve(reordered_rhs);
-          break;
-        case Active::Indefinite:
+  switch (impl.active) {
+    case Active::Cholesky:
+      return impl.cholesky.solve(rhs);
+    case Active::Indefinite:
+      if (impl.permuted) {
+        // One copy of the right-hand side's size at a time beside the caller's (a block of
+        // compliance columns is dofs x 3 captured nodes): permuted, solved, permuted back.
+        Matrix x;
+        {
+          const Matrix reordered_rhs = impl.permutation * rhs;
           x = impl.indefinite.solve(reordered_rhs);
-          break;
-        case Active::None:
-          throw SolverError("sparse solver: no valid factorisation (singular matrix)");
+        }
+        x = impl.permutation.transpose() * x;
+        return x;
       }
-    }
-    x = impl.permutation.transpose() * x;
-    return x;
-  } else {
-    switch (impl.active) {
-      case Active::Cholesky:
-        return impl.cholesky.solve(rhs);
-      case Active::Indefinite:
-        return impl.indefinite.solve(rhs);
-      case Active::None:
-        break;
-    }
+      return impl.indefinite.solve(rhs);
+    case Active::None:
+      break;
   }
   throw SolverError("sparse solver: no valid factorisation (singular matrix)");
 }
@@ -249,7 +346,7 @@ bool SparseSolver::ordered_by_node() const {
 
 double SparseSolver::factor_nonzeros() const {
 #ifdef MNEEDLE_HAVE_CHOLMOD
-  if (impl_->active == Active::Cholesky) return impl_->cholesky.cholmod().lnz;
+  if (impl_->active == Active::Cholesky) return impl_->cholesky.common().lnz;
 #endif
   return 0.0;
 }

@@ -134,6 +134,24 @@ TEST(SparseSolver, OrderingByNodeSolvesWhatOrderingByDofSolves) {
   EXPECT_LT((one - x.col(0)).norm(), 1e-14 * one.norm());
 }
 
+// CHOLMOD's blocks of 8 MB and more come from the huge-page allocator (sparse_solver.cpp): a
+// factor of several million entries must solve as a small one does, and factorise again.
+TEST(SparseSolver, AFactorLargeEnoughForHugePagesSolvesToRoundoff) {
+  const SpMat matrix = nodal_system(14, 0.05);
+  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(matrix.rows(), -1.0, 1.0);
+  mneedle::fe::SparseSolver solver(3);
+  for (int round = 0; round < 2; ++round) {
+    solver.factorize(matrix);
+    ASSERT_TRUE(solver.ok());
+    if (with_cholmod()) {
+      EXPECT_GT(solver.factor_nonzeros(), 1.0e6) << solver.factor_nonzeros();  // 8 MB at least
+    }
+    const Eigen::VectorXd x = solver.solve(rhs);
+    // Condition number about 1e3, as above.
+    EXPECT_LT((matrix * x - rhs).norm(), 1e-11 * rhs.norm());
+  }
+}
+
 TEST(SparseSolver, OrderingByNodeFindsTheFillOfOrderingByDof) {
   // The point of the nodal order is its cost, not a different factor: the fill must stay that of
   // CHOLMOD's own choice (AMD or METIS on the dofs).
