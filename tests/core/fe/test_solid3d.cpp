@@ -4,6 +4,8 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <set>
+#include <utility>
 
 #include "mneedle/base/error.h"
 #include "mneedle/fe/sparse_solver.h"
@@ -204,6 +206,43 @@ TEST(Solid3d, AssembledLinearStiffnessTimesDisplacementIsTheInternalForce) {
   const Eigen::VectorXd product = k.selfadjointView<Eigen::Lower>() * u;
   EXPECT_LT((product - force).norm(), 1e-10 * force.norm());
   EXPECT_NEAR(energy, 0.5 * u.dot(force), 1e-10 * energy);
+}
+
+// The pattern every assembly writes into: for each pair of nodes sharing an element, node a at
+// or below node b, the 3 x 3 block (3a + i, 3b + j); compressed, each column's rows sorted.
+TEST(Solid3d, EmptyStiffnessHoldsEachCoupledNodeBlockOnceInTheLowerTriangle) {
+  TissueBlockSpec spec;
+  spec.size_x = spec.size_y = 1e-3;
+  spec.layers = {{"block", 0.5e-3, {MaterialModel::Linear, 1e5, 0.4, 0.0, 0.0}}};
+  spec.fidelity = Fidelity::Fast;
+  spec.order = 2;
+  const TetMesh mesh = generate_tissue_mesh(spec);
+  const SolidModel solid(mesh);
+  std::set<std::pair<int, int>> expected;
+  for (const auto& element : mesh.elements)
+    for (int a = 0; a < mesh.nodes_per_element(); ++a)
+      for (int b = 0; b < mesh.nodes_per_element(); ++b) {
+        const int na = element[static_cast<std::size_t>(a)];
+        const int nb = element[static_cast<std::size_t>(b)];
+        if (na < nb) continue;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) expected.emplace(3 * na + i, 3 * nb + j);
+      }
+  const Eigen::SparseMatrix<double> k = solid.empty_stiffness();
+  ASSERT_TRUE(k.isCompressed());
+  ASSERT_EQ(k.rows(), solid.dof_count());
+  ASSERT_EQ(k.nonZeros(), static_cast<Eigen::Index>(expected.size()));
+  std::set<std::pair<int, int>> found;
+  for (int column = 0; column < k.outerSize(); ++column) {
+    int previous = -1;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(k, column); it; ++it) {
+      EXPECT_GT(it.row(), previous) << "column " << column;
+      previous = static_cast<int>(it.row());
+      EXPECT_EQ(it.value(), 0.0);
+      found.emplace(static_cast<int>(it.row()), column);
+    }
+  }
+  EXPECT_EQ(found, expected);
 }
 
 }  // namespace
