@@ -108,13 +108,24 @@ Sample simulate(const TissueBlockSpec& block, const Needle3d& needle, int order,
 // punch) and the bonded-punch factor beta = (1 - nu) ln(3 - 4 nu) / (1 - 2 nu) = 1.0028
 // (Mossakovskii; Spence 1968), their product taken as the reference. The punch is a 96-gon: the
 // reference uses its equal-area radius.
-void punch_study() {
+struct BondedPunch {
+  double radius = 200e-6;
+  double exact = 0.0;  // N
+  Needle3d punch;
+  TissueBlockSpec block;
+};
+
+BondedPunch bonded_punch() {
   const double a = 200e-6, E = 1e6, nu = 0.45, h = 1e-3;
   const double polygon = std::sqrt(96.0 / (2 * kPi) * std::sin(2 * kPi / 96.0));
   const double beta = (1 - nu) * std::log(3 - 4 * nu) / (1 - 2 * nu);
-  const double exact = 2 * a * polygon * E / (1 - nu * nu) * 1.252 * beta * kDepth;
-  const Needle3d punch{"punch", mneedle::test::cylinder_needle(a, 1000e-6, 96), 0.0, 0.0};
-  const TissueBlockSpec block = homogeneous_block(8e-3, h, E, nu);
+  return {a, 2 * a * polygon * E / (1 - nu * nu) * 1.252 * beta * kDepth,
+          Needle3d{"punch", mneedle::test::cylinder_needle(a, 1000e-6, 96), 0.0, 0.0},
+          homogeneous_block(8e-3, h, E, nu)};
+}
+
+void punch_study() {
+  const auto [a, exact, punch, block] = bonded_punch();
   std::printf("\n# a. flat punch, sticking, Hayes x bonded reference F = %.6g N\n", exact);
   std::printf("order tip_size_um nodes cpu_s wall_s force_N rel_error\n");
   for (int order : {1, 2})
@@ -131,12 +142,7 @@ void punch_study() {
 // the reference, its wall time the median of three runs: our side of the CalculiX comparison
 // (bench/performance_targets.sh, bench/calculix_punch.py).
 void punch_coarsest_study() {
-  const double a = 200e-6, E = 1e6, nu = 0.45, h = 1e-3;
-  const double polygon = std::sqrt(96.0 / (2 * kPi) * std::sin(2 * kPi / 96.0));
-  const double beta = (1 - nu) * std::log(3 - 4 * nu) / (1 - 2 * nu);
-  const double exact = 2 * a * polygon * E / (1 - nu * nu) * 1.252 * beta * kDepth;
-  const Needle3d punch{"punch", mneedle::test::cylinder_needle(a, 1000e-6, 96), 0.0, 0.0};
-  const TissueBlockSpec block = homogeneous_block(8e-3, h, E, nu);
+  const auto [a, exact, punch, block] = bonded_punch();
   std::printf("\n# a, coarsest TET10 within 2 %% of F = %.6g N (median wall time of 3 runs)\n",
               exact);
   std::printf("tip_size_um nodes wall_s force_N rel_error\n");
