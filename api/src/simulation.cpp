@@ -64,6 +64,17 @@ nlohmann::json curve_json(const std::vector<RunPoint>& curve,
   return c;
 }
 
+nlohmann::json seconds_by_stage_json(const RunSeconds& t) {
+  return {{"fe_3d_s", t.fe_3d_s},
+          {"axisymmetric_fe_s", t.axisymmetric_fe_s},
+          {"meshing_s", t.meshing_s},
+          {"assembly_s", t.assembly_s},
+          {"factorization_s", t.factorization_s},
+          {"contact_s", t.contact_s},
+          {"factorizations", t.factorizations},
+          {"fe_runs", t.fe_runs}};
+}
+
 nlohmann::json energy_check_json(const std::optional<EnergyCheck>& check) {
   if (!check) return nullptr;
   return {{"depth_m", check->depth_m},
@@ -123,6 +134,7 @@ nlohmann::json run_json(const InsertionRun& run, const Scene& scene) {
           {"pre_puncture_step_m", run.first_step_m},
           {"energy_check", energy_check_json(run.energy_check)},
           {"peak_memory_bytes", run.peak_memory_bytes},
+          {"seconds_by_stage", seconds_by_stage_json(run.seconds_by_stage)},
           {"seconds", run.seconds}};
 }
 

@@ -73,5 +73,29 @@ TEST(Simulation, TreeCarriesTheRunsPunctureCurveAndMeshHash) {
   EXPECT_FALSE(tree.contains("axis"));  // only when the settings gave one
 }
 
+// Where the time went: every FE run's wall time, the 3-D phases inside the 3-D runs' time, all of
+// it inside the run's own wall time (clocks nested, so no tolerance).
+TEST(Simulation, SecondsByStageLieWithinTheRunsWallTime) {
+  Scene scene = load_scene(std::string(MNEEDLE_TEST_ASSETS) + "/scenes/bevel_3d_linear.toml");
+  const SimulateSettings s;
+  apply_simulate_settings(scene, s);
+  const PluginRegistry registry = PluginRegistry::discover({});
+  const auto needles = prepare_needles(registry, scene, s.max_needles);
+  const InsertionRun run = run_insertion(scene, needles, simulate_run_options(scene, s));
+  const nlohmann::json tree = simulation_json(run, scene, needles, s);
+  const nlohmann::json& t = tree["seconds_by_stage"];
+  ASSERT_TRUE(t.is_object());
+  EXPECT_GT(t["fe_3d_s"].get<double>(), 0.0);
+  EXPECT_GE(t["fe_runs"].get<int>(), 1);
+  EXPECT_GE(t["factorizations"].get<int>(), 1);
+  const double phases = t["meshing_s"].get<double>() + t["assembly_s"].get<double>() +
+                        t["factorization_s"].get<double>() + t["contact_s"].get<double>();
+  EXPECT_GT(t["factorization_s"].get<double>(), 0.0);
+  EXPECT_LE(phases, t["fe_3d_s"].get<double>());
+  EXPECT_LE(t["fe_3d_s"].get<double>() + t["axisymmetric_fe_s"].get<double>(),
+            tree["seconds"].get<double>());
+  EXPECT_EQ(t["fe_3d_s"].get<double>(), run.seconds_by_stage.fe_3d_s);
+}
+
 }  // namespace
 }  // namespace mneedle

@@ -38,6 +38,8 @@ struct RunPlan {
   double inp_depth_m = 0.0;
   std::vector<std::string> inp_comment;
   std::vector<Reduction> reductions;
+  /// Where every model run of this plan and its copies adds its time (the run's record).
+  RunSeconds* seconds = nullptr;
 };
 
 /// Accuracy the reductions must keep, relative force change, per fidelity (fast 5 %, standard

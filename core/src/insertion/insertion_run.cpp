@@ -84,6 +84,28 @@ struct PreSeries {
   std::function<double(double)> resolve;  ///< criterion at any depth, when cheap (analytic)
 };
 
+// Adds the wall time of its scope to a RunSeconds field (also when the model throws: a failed
+// proxy's time was spent too).
+class StageTimer {
+ public:
+  StageTimer(RunSeconds* seconds, double RunSeconds::*field)
+      : seconds_(seconds), field_(field), start_(std::chrono::steady_clock::now()) {
+    if (seconds_ != nullptr) ++seconds_->fe_runs;
+  }
+  ~StageTimer() {
+    if (seconds_ != nullptr)
+      seconds_->*field_ +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+  StageTimer(const StageTimer&) = delete;
+  StageTimer& operator=(const StageTimer&) = delete;
+
+ private:
+  RunSeconds* seconds_;
+  double RunSeconds::*field_;
+  std::chrono::steady_clock::time_point start_;
+};
+
 struct PreResult {
   std::vector<PreSeries> needles;
   int nodes = 0;
@@ -189,7 +211,18 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
                           force);
     return more;
   };
-  const fe::Simulation3dResult r = fe::simulate_3d(block, fe_needles, o);
+  fe::Simulation3dResult r;
+  {
+    const StageTimer timer(plan.seconds, &RunSeconds::fe_3d_s);
+    r = fe::simulate_3d(block, fe_needles, o);
+  }
+  if (plan.seconds != nullptr) {
+    plan.seconds->meshing_s += r.timing.meshing_s;
+    plan.seconds->assembly_s += r.timing.assembly_s;
+    plan.seconds->factorization_s += r.timing.factorization_s;
+    plan.seconds->contact_s += r.timing.contact_s;
+    plan.seconds->factorizations += r.timing.factorizations;
+  }
   PreResult out;
   out.needles.resize(needles.size());
   for (const fe::Step3d& step : r.steps)
@@ -260,7 +293,11 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
                           p.overrides.steps.value_or(p.output_steps), step.depth_m, step.force_N);
     return watch.keep_going(0, sample_of(step.depth_m, step, area));
   };
-  const fe::InsertionResult r = fe::simulate_axisymmetric(p);
+  fe::InsertionResult r;
+  {
+    const StageTimer timer(plan.seconds, &RunSeconds::axisymmetric_fe_s);
+    r = fe::simulate_axisymmetric(p);
+  }
   PreResult out;
   out.needles.resize(1);
   for (const fe::InsertionStep& st : r.steps) {
@@ -788,6 +825,7 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     // Without a criterion nothing can fire early: the rung covering the depth is the answer.
     for (int rung = plan.threshold ? 0 : last_rung; rung <= last_rung; ++rung) {
       plan = detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(rung));
+      plan.seconds = &run.seconds_by_stage;
       run.reductions = plan.reductions;
       pre = run_pre(plan, scene, needles, areas, options, run);
       if (every_needle_crossed(plan, pre)) break;

@@ -125,6 +125,21 @@ struct Reduction {
   std::optional<double> measured_effect;  ///< relative change of the force it was checked on
 };
 
+/// Where a run's wall time went (s), summed over every model it ran: each rung of the horizon
+/// ladder and the planner's checks (docs/cli.md, "simulate --json"). The 3-D phases are those of
+/// fe::Timing3d; what is left of `seconds` is the planner, the needles and the post-puncture
+/// stage.
+struct RunSeconds {
+  double fe_3d_s = 0.0;            ///< 3-D FE runs, whole
+  double axisymmetric_fe_s = 0.0;  ///< axisymmetric FE runs, the planner's proxies included
+  double meshing_s = 0.0;          ///< of the 3-D runs: the tissue mesh
+  double assembly_s = 0.0;         ///< of the 3-D runs: stiffness assembly
+  double factorization_s = 0.0;    ///< of the 3-D runs: ordering and Cholesky factorisation
+  double contact_s = 0.0;          ///< of the 3-D runs: capture, compliance columns, contact
+  int factorizations = 0;          ///< of the 3-D runs
+  int fe_runs = 0;                 ///< FE runs (3-D and axisymmetric) started
+};
+
 struct InsertionRun {
   std::vector<NeedleRun> needles;
   std::vector<RunPoint> total_curve;    ///< sum over the needles (stage of the first needle)
@@ -151,6 +166,7 @@ struct InsertionRun {
   /// Stored energy against the needle's work over the pre-puncture curve (empty for analytic
   /// runs); docs/model.md, "Energy check".
   std::optional<EnergyCheck> energy_check;
+  RunSeconds seconds_by_stage;
   /// The process's peak resident memory at the end of the run (bytes; 0 where not measurable).
   std::size_t peak_memory_bytes = 0;
   /// What InsertionRunOptions::inp_path received (3-D model only).
