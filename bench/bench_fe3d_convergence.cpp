@@ -109,8 +109,9 @@ Sample simulate(const TissueBlockSpec& block, const Needle3d& needle, int order,
 // (Mossakovskii; Spence 1968), their product taken as the reference. The punch is a 96-gon: the
 // reference uses its equal-area radius.
 struct BondedPunch {
-  double radius = 200e-6;
-  double exact = 0.0;  // N
+  double radius;  // m
+  double exact;   // N, the bonded reference (Hayes x beta)
+  double beta;    // the bonded-punch factor: exact / beta is Hayes' frictionless force
   Needle3d punch;
   TissueBlockSpec block;
 };
@@ -119,13 +120,13 @@ BondedPunch bonded_punch() {
   const double a = 200e-6, E = 1e6, nu = 0.45, h = 1e-3;
   const double polygon = std::sqrt(96.0 / (2 * kPi) * std::sin(2 * kPi / 96.0));
   const double beta = (1 - nu) * std::log(3 - 4 * nu) / (1 - 2 * nu);
-  return {a, 2 * a * polygon * E / (1 - nu * nu) * 1.252 * beta * kDepth,
+  return {a, 2 * a * polygon * E / (1 - nu * nu) * 1.252 * beta * kDepth, beta,
           Needle3d{"punch", mneedle::test::cylinder_needle(a, 1000e-6, 96), 0.0, 0.0},
           homogeneous_block(8e-3, h, E, nu)};
 }
 
 void punch_study() {
-  const auto [a, exact, punch, block] = bonded_punch();
+  const auto [a, exact, beta, punch, block] = bonded_punch();
   std::printf("\n# a. flat punch, sticking, Hayes x bonded reference F = %.6g N\n", exact);
   std::printf("order tip_size_um nodes cpu_s wall_s force_N rel_error\n");
   for (int order : {1, 2})
@@ -142,7 +143,7 @@ void punch_study() {
 // the reference, its wall time the median of three runs: our side of the CalculiX comparison
 // (bench/performance_targets.sh, bench/calculix_punch.py).
 void punch_coarsest_study() {
-  const auto [a, exact, punch, block] = bonded_punch();
+  const auto [a, exact, beta, punch, block] = bonded_punch();
   std::printf("\n# a, coarsest TET10 within 2 %% of F = %.6g N (median wall time of 3 runs)\n",
               exact);
   std::printf("tip_size_um nodes wall_s force_N rel_error\n");
@@ -166,12 +167,8 @@ void punch_coarsest_study() {
 // straddle the rim holds the tissue a little beyond a (too stiff), captured nodes strictly inside
 // a stop short of it (too soft); both must close on the closed form as the tip size falls.
 void frictionless_punch_study() {
-  const double a = 200e-6, E = 1e6, nu = 0.45, h = 1e-3;
-  const double polygon = std::sqrt(96.0 / (2 * kPi) * std::sin(2 * kPi / 96.0));
-  const double beta = (1 - nu) * std::log(3 - 4 * nu) / (1 - 2 * nu);
-  const double frictionless = 2 * a * polygon * E / (1 - nu * nu) * 1.252 * kDepth;
-  const Needle3d punch{"punch", mneedle::test::cylinder_needle(a, 1000e-6, 96), 0.0, 0.0};
-  const TissueBlockSpec block = homogeneous_block(8e-3, h, E, nu);
+  const auto [a, exact, beta, punch, block] = bonded_punch();
+  const double frictionless = exact / beta;
   std::printf("\n# a'. flat punch, frictionless vs sticking, Hayes F = %.6g N (bonded x%.4f)\n",
               frictionless, beta);
   std::printf("order tip_size_um nodes cpu_s frictionless_rel sticking_rel\n");

@@ -90,7 +90,8 @@ o = [l.split() for l in ours if l and l[0].isdigit()][-1]  # tip_size nodes wall
 c = [l.split() for l in ccx if l and l[0].isdigit()][-1]   # rim nodes gmsh_s ccx_s force error
 ours_s, ccx_s, gmsh_s = float(o[2]), float(c[3]), float(c[2])
 ratio = ccx_s / ours_s
-status = "met" if ratio >= 20 and abs(float(c[5])) <= 0.02 else "missed"
+within = abs(float(o[4])) <= 0.02 and abs(float(c[5])) <= 0.02  # each on a mesh within 2 %
+status = "met" if ratio >= 20 and within else ("missed" if within else "not measured: a tool never reached 2 %")
 print(f"| bonded flat punch against CalculiX, coarsest mesh within 2 % | {ours_s:.2f} s ({o[1]} nodes, "
       f"{float(o[4]):+.1%}) against ccx {ccx_s:.2f} s + gmsh {gmsh_s:.2f} s ({c[1]} nodes, "
       f"{float(c[5]):+.1%}) | >= 20x faster | {ratio:.1f}x (with gmsh {(ccx_s + gmsh_s) / ours_s:.1f}x) "

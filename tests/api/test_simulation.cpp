@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 
 #include "error_message.h"
 #include "mneedle/base/error.h"
@@ -53,14 +54,25 @@ TEST(Simulation, EmptySettingsKeepTheScenesChoicesAndGivenOnesOverrideThem) {
   EXPECT_FALSE(changed.allow_reductions);
 }
 
-TEST(Simulation, TreeCarriesTheRunsPunctureCurveAndMeshHash) {
-  Scene scene = load_scene(kPunch);
+// A scene simulated with default settings, as the CLI does: the run and its JSON tree.
+struct Simulated {
+  InsertionRun run;
+  nlohmann::json tree;
+};
+
+Simulated simulate_scene(const std::string& path) {
+  Scene scene = load_scene(path);
   const SimulateSettings s;
   apply_simulate_settings(scene, s);
   const PluginRegistry registry = PluginRegistry::discover({});
   const auto needles = prepare_needles(registry, scene, s.max_needles);
-  const InsertionRun run = run_insertion(scene, needles, simulate_run_options(scene, s));
-  const nlohmann::json tree = simulation_json(run, scene, needles, s);
+  InsertionRun run = run_insertion(scene, needles, simulate_run_options(scene, s));
+  nlohmann::json tree = simulation_json(run, scene, needles, s);
+  return {std::move(run), std::move(tree)};
+}
+
+TEST(Simulation, TreeCarriesTheRunsPunctureCurveAndMeshHash) {
+  const auto [run, tree] = simulate_scene(kPunch);
   ASSERT_EQ(tree["needles"].size(), 1u);
   const auto& needle = tree["needles"][0];
   ASSERT_TRUE(run.needles[0].puncture.has_value());
@@ -76,13 +88,8 @@ TEST(Simulation, TreeCarriesTheRunsPunctureCurveAndMeshHash) {
 // Where the time went: every FE run's wall time, the 3-D phases inside the 3-D runs' time, all of
 // it inside the run's own wall time (clocks nested, so no tolerance).
 TEST(Simulation, SecondsByStageLieWithinTheRunsWallTime) {
-  Scene scene = load_scene(std::string(MNEEDLE_TEST_ASSETS) + "/scenes/bevel_3d_linear.toml");
-  const SimulateSettings s;
-  apply_simulate_settings(scene, s);
-  const PluginRegistry registry = PluginRegistry::discover({});
-  const auto needles = prepare_needles(registry, scene, s.max_needles);
-  const InsertionRun run = run_insertion(scene, needles, simulate_run_options(scene, s));
-  const nlohmann::json tree = simulation_json(run, scene, needles, s);
+  const auto [run, tree] =
+      simulate_scene(std::string(MNEEDLE_TEST_ASSETS) + "/scenes/bevel_3d_linear.toml");
   const nlohmann::json& t = tree["seconds_by_stage"];
   ASSERT_TRUE(t.is_object());
   EXPECT_GT(t["fe_3d_s"].get<double>(), 0.0);

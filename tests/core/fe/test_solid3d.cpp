@@ -190,13 +190,18 @@ TEST(Solid3d, NonlinearPatchTestIsExactAtFiniteStrain) {
   run_patch_test(1, MaterialModel::NeoHookean, 0.1);
 }
 
-TEST(Solid3d, AssembledLinearStiffnessTimesDisplacementIsTheInternalForce) {
+// A 1 x 1 x 0.5 mm linear block, fast TET10: a few thousand dofs.
+TissueBlockSpec small_linear_block() {
   TissueBlockSpec spec;
   spec.size_x = spec.size_y = 1e-3;
   spec.layers = {{"block", 0.5e-3, {MaterialModel::Linear, 1e5, 0.4, 0.0, 0.0}}};
   spec.fidelity = Fidelity::Fast;
   spec.order = 2;
-  const TetMesh mesh = generate_tissue_mesh(spec);
+  return spec;
+}
+
+TEST(Solid3d, AssembledLinearStiffnessTimesDisplacementIsTheInternalForce) {
+  const TetMesh mesh = generate_tissue_mesh(small_linear_block());
   const SolidModel solid(mesh);
   ASSERT_TRUE(solid.is_linear());
   const Eigen::VectorXd u = 1e-6 * Eigen::VectorXd::Random(solid.dof_count());
@@ -211,12 +216,7 @@ TEST(Solid3d, AssembledLinearStiffnessTimesDisplacementIsTheInternalForce) {
 // The pattern every assembly writes into: for each pair of nodes sharing an element, node a at
 // or below node b, the 3 x 3 block (3a + i, 3b + j); compressed, each column's rows sorted.
 TEST(Solid3d, EmptyStiffnessHoldsEachCoupledNodeBlockOnceInTheLowerTriangle) {
-  TissueBlockSpec spec;
-  spec.size_x = spec.size_y = 1e-3;
-  spec.layers = {{"block", 0.5e-3, {MaterialModel::Linear, 1e5, 0.4, 0.0, 0.0}}};
-  spec.fidelity = Fidelity::Fast;
-  spec.order = 2;
-  const TetMesh mesh = generate_tissue_mesh(spec);
+  const TetMesh mesh = generate_tissue_mesh(small_linear_block());
   const SolidModel solid(mesh);
   std::set<std::pair<int, int>> expected;
   for (const auto& element : mesh.elements)
