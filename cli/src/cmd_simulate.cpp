@@ -201,7 +201,7 @@ void run(const SimulateOptions& o) {
               << 100.0 * kEnergyCheckTolerance
               << " % apart: the contact or the mesh is not resolved; docs/model.md, \"Energy "
                  "check\")\n";
-  for (const std::string& w : penetration_warnings(result, scene))
+  for (const std::string& w : criterion_warnings(result, scene))
     std::cerr << "mneedle: warning: " << w << "\n";
   if (!o.plot.empty())
     plot::write_svg(o.plot, simulate_figure(result, "simulate: " + o.scene.filename().string()));

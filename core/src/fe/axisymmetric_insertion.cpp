@@ -199,9 +199,12 @@ class CondensedSurface {
 
   const std::vector<std::uint32_t>& dofs() const { return dofs_; }
 
-  // Candidate displacements and forces with the captured nodes prescribed and the rest free.
+  // Candidate displacements and forces with the captured nodes prescribed and the rest free;
+  // each pair in `closed` (condensed dof indices {inner u_r, outer u_r}) held at zero gap,
+  // u_r(outer) = u_r(inner), by a Lagrange multiplier.
   void solve(const AxisymmetricMesh& mesh, const ContactState& state, double depth,
-             Eigen::VectorXd& u, Eigen::VectorXd& f) const {
+             Eigen::VectorXd& u, Eigen::VectorXd& f,
+             const std::vector<std::array<int, 2>>& closed = {}) const {
     const auto m = static_cast<Eigen::Index>(dofs_.size());
     std::vector<char> prescribed(static_cast<std::size_t>(m), 0);
     u = Eigen::VectorXd::Zero(m);
@@ -215,7 +218,9 @@ class CondensedSurface {
     }
     std::vector<Eigen::Index> free, fixed;
     for (Eigen::Index j = 0; j < m; ++j) (prescribed[j] ? fixed : free).push_back(j);
-    if (!free.empty()) {
+    if (!free.empty() && !closed.empty()) {
+      solve_closed(free, fixed, closed, u);
+    } else if (!free.empty()) {
       Eigen::MatrixXd S_ff(free.size(), free.size());
       Eigen::VectorXd rhs = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(free.size()));
       for (std::size_t a = 0; a < free.size(); ++a) {
@@ -226,6 +231,38 @@ class CondensedSurface {
       for (std::size_t a = 0; a < free.size(); ++a) u[free[a]] = uf[a];
     }
     f = S_ * u;
+  }
+
+  // The free part of solve() with zero-gap pairs: the saddle-point system
+  // [S_ff G_fᵀ; G_f 0] [u_f; μ] = [-S_fc u_c; -G_c u_c], solved by full-pivoting LU (small and
+  // indefinite).
+  void solve_closed(const std::vector<Eigen::Index>& free, const std::vector<Eigen::Index>& fixed,
+                    const std::vector<std::array<int, 2>>& closed, Eigen::VectorXd& u) const {
+    const auto nf = static_cast<Eigen::Index>(free.size());
+    const auto k = static_cast<Eigen::Index>(closed.size());
+    std::vector<Eigen::Index> position(static_cast<std::size_t>(u.size()), -1);
+    for (Eigen::Index a = 0; a < nf; ++a) position[static_cast<std::size_t>(free[a])] = a;
+    Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(nf + k, nf + k);
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nf + k);
+    for (Eigen::Index a = 0; a < nf; ++a) {
+      for (Eigen::Index b = 0; b < nf; ++b) kkt(a, b) = S_(free[a], free[b]);
+      for (Eigen::Index c : fixed) rhs[a] -= S_(free[a], c) * u[c];
+    }
+    for (Eigen::Index p = 0; p < k; ++p) {
+      const std::array<int, 2>& dofs = closed[static_cast<std::size_t>(p)];
+      const double sign[2] = {-1.0, 1.0};  // gap = u_r(outer) - u_r(inner)
+      for (int side = 0; side < 2; ++side) {
+        const Eigen::Index at = position[static_cast<std::size_t>(dofs[side])];
+        if (at >= 0) {
+          kkt(nf + p, at) = sign[side];
+          kkt(at, nf + p) = sign[side];
+        } else {
+          rhs[nf + p] -= sign[side] * u[dofs[side]];
+        }
+      }
+    }
+    const Eigen::VectorXd x = kkt.fullPivLu().solve(rhs);
+    for (Eigen::Index a = 0; a < nf; ++a) u[free[a]] = x[a];
   }
 
   // Frictionless: each active node's vertical displacement puts it on the needle's lower
@@ -280,13 +317,42 @@ class CondensedSurface {
 };
 
 // One insertion on one model, advanced to a growing sequence of depths.
+// A ring crack's faces: each doubled node {inner, outer}.
+using FacePairs = std::vector<std::array<std::uint32_t, 2>>;
+
+// Active-set rounds of the crack-face contact per solve; a pair closes when its faces overlap by
+// more than kCrackGapTolerance x the insertion depth (round-off of the condensed solve is
+// ~1e-16 of it).
+constexpr int kMaxCrackRounds = 100;
+constexpr double kCrackGapTolerance = 1e-10;
+
 class Stepper {
  public:
   virtual ~Stepper() = default;
   virtual InsertionStep advance_to(double depth) = 0;
   /// Whole displacement field (2 per node) at the last depth.
   virtual Eigen::VectorXd displacement() const = 0;
+  /// Gap u_r(outer) - u_r(inner) of every crack-face pair at the last depth (m).
+  virtual Eigen::VectorXd face_gaps(const FacePairs& pairs) const {
+    const Eigen::VectorXd u = displacement();
+    Eigen::VectorXd gaps(static_cast<Eigen::Index>(pairs.size()));
+    for (std::size_t p = 0; p < pairs.size(); ++p)
+      gaps[static_cast<Eigen::Index>(p)] = u[2 * pairs[p][1]] - u[2 * pairs[p][0]];
+    return gaps;
+  }
+  /// Pairs held closed by crack-face contact at the last depth.
+  virtual int closed_pairs() const { return 0; }
 };
+
+// Candidates followed by the crack-face nodes that are not candidates: the condensed set.
+std::vector<std::uint32_t> with_face_nodes(std::vector<std::uint32_t> nodes,
+                                           const FacePairs& pairs) {
+  std::set<std::uint32_t> seen(nodes.begin(), nodes.end());
+  for (const auto& pair : pairs)
+    for (std::uint32_t node : pair)
+      if (seen.insert(node).second) nodes.push_back(node);
+  return nodes;
+}
 
 // Nonlinear layers: Newton at every sub-step, adaptive step length.
 class NonlinearStepper : public Stepper {
@@ -382,17 +448,33 @@ class NonlinearStepper : public Stepper {
 // the solve itself is exact at any depth.
 class LinearStepper : public Stepper {
  public:
+  // pairs: the ring crack's faces (cracked twin), kept apart when `close_pairs` is set.
   LinearStepper(AxisymmetricModel& model, const AxisymmetricNeedle& needle,
-                const InsertionOptions& options, bool keep_field)
+                const InsertionOptions& options, bool keep_field, FacePairs pairs = {},
+                bool close_pairs = false)
       : mesh_(model.mesh()),
         needle_(needle),
         candidates_(reachable_surface_nodes(mesh_, needle, options.depth_m)),
         n_(model.dof_count()),
-        sub_step_(options.depth_m / (options.output_steps * kSubsteps)) {
+        sub_step_(options.depth_m / (options.output_steps * kSubsteps)),
+        pairs_(std::move(pairs)),
+        close_pairs_(close_pairs),
+        gap_tolerance_(kCrackGapTolerance * options.depth_m) {
     previous_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_));
     if (!candidates_.empty())
-      surface_ = std::make_unique<CondensedSurface>(model, candidates_, keep_field);
+      surface_ = std::make_unique<CondensedSurface>(model, with_face_nodes(candidates_, pairs_),
+                                                    keep_field);
   }
+
+  Eigen::VectorXd face_gaps(const FacePairs& pairs) const override {
+    Eigen::VectorXd gaps = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs.size()));
+    if (!surface_ || u_.size() == 0) return gaps;
+    for (std::size_t p = 0; p < pairs.size(); ++p)
+      gaps[static_cast<Eigen::Index>(p)] =
+          u_[surface_->index_of(pairs[p][1])] - u_[surface_->index_of(pairs[p][0])];
+    return gaps;
+  }
+  int closed_pairs() const override { return static_cast<int>(closed_.size()); }
 
   InsertionStep advance_to(double target) override {
     if (!surface_) return make_step(target, 0, 0, 0, 0, 0);
@@ -400,7 +482,7 @@ class LinearStepper : public Stepper {
     while (depth_ < target * (1.0 - 1e-12)) {
       const double next = std::min(target, depth_ + sub_step_ * (1.0 + 1e-9));
       for (int round = 0; round < 1000; ++round) {
-        surface_->solve(mesh_, state_, next, u_, f_);
+        solve_contact(next);
         ++solves;
         if (capture_new_nodes(needle_, candidates_, mesh_, depth_, previous_, next,
                               surface_->scatter(u_, n_), state_) == 0)
@@ -426,6 +508,43 @@ class LinearStepper : public Stepper {
   }
 
  private:
+  // Crack-face contact by an active set (docs/model.md, "Crack faces in contact"): a closed
+  // pair whose contact force pulls (the outer node's radial force below zero) opens, an open
+  // pair whose faces overlap closes, until nothing changes.
+  void solve_contact(double depth) {
+    if (!close_pairs_ || pairs_.empty()) {
+      surface_->solve(mesh_, state_, depth, u_, f_);
+      return;
+    }
+    for (int round = 0; round < kMaxCrackRounds; ++round) {
+      std::vector<std::array<int, 2>> dofs;
+      for (std::size_t p : closed_)
+        dofs.push_back({surface_->index_of(pairs_[p][0]), surface_->index_of(pairs_[p][1])});
+      surface_->solve(mesh_, state_, depth, u_, f_, dofs);
+      const double force_floor = 1e-12 * f_.norm();
+      std::vector<std::size_t> next;
+      bool changed = false;
+      for (std::size_t p : closed_) {
+        if (f_[surface_->index_of(pairs_[p][1])] < -force_floor)
+          changed = true;
+        else
+          next.push_back(p);
+      }
+      const Eigen::VectorXd gaps = face_gaps(pairs_);
+      for (std::size_t p = 0; p < pairs_.size(); ++p)
+        if (!std::binary_search(closed_.begin(), closed_.end(), p) &&
+            gaps[static_cast<Eigen::Index>(p)] < -gap_tolerance_) {
+          next.push_back(p);
+          changed = true;
+        }
+      if (!changed) return;
+      std::sort(next.begin(), next.end());
+      closed_ = std::move(next);
+    }
+    throw SolverError("axisymmetric insertion: crack-face contact did not settle at depth " +
+                      format_depth(depth));
+  }
+
   static constexpr int kSubsteps = 4;
   const AxisymmetricMesh& mesh_;
   AxisymmetricNeedle needle_;
@@ -436,6 +555,10 @@ class LinearStepper : public Stepper {
   ContactState state_;
   Eigen::VectorXd previous_, u_, f_;
   double depth_ = 0.0;
+  FacePairs pairs_;
+  bool close_pairs_ = false;
+  double gap_tolerance_ = 0.0;
+  std::vector<std::size_t> closed_;  // sorted
 };
 
 // Linear layers, frictionless: active set on the condensed surface; each depth solved
@@ -453,16 +576,31 @@ class LinearStepper : public Stepper {
 constexpr int kMaxActiveSetSolves = 200;
 
 class FrictionlessStepper : public Stepper {
+  FacePairs pairs_;
+
  public:
+  // pairs: the ring crack's faces (cracked twin), measured only (their contact is not modelled
+  // with frictionless needle contact).
   FrictionlessStepper(AxisymmetricModel& model, const AxisymmetricNeedle& needle,
-                      const InsertionOptions& options, bool keep_field)
-      : mesh_(model.mesh()),
+                      const InsertionOptions& options, bool keep_field, FacePairs pairs = {})
+      : pairs_(std::move(pairs)),
+        mesh_(model.mesh()),
         needle_(needle),
         candidates_(reachable_surface_nodes(mesh_, needle, options.depth_m)),
         n_(model.dof_count()),
         depth_scale_(options.depth_m) {
     if (candidates_.empty()) throw InputError("frictionless contact: the needle reaches no node");
-    surface_ = std::make_unique<CondensedSurface>(model, candidates_, keep_field);
+    surface_ =
+        std::make_unique<CondensedSurface>(model, with_face_nodes(candidates_, pairs_), keep_field);
+  }
+
+  Eigen::VectorXd face_gaps(const FacePairs& pairs) const override {
+    Eigen::VectorXd gaps = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs.size()));
+    if (u_.size() == 0) return gaps;
+    for (std::size_t p = 0; p < pairs.size(); ++p)
+      gaps[static_cast<Eigen::Index>(p)] =
+          u_[surface_->index_of(pairs[p][1])] - u_[surface_->index_of(pairs[p][0])];
+    return gaps;
   }
 
   InsertionStep advance_to(double depth) override {
@@ -527,11 +665,15 @@ class FrictionlessStepper : public Stepper {
   Eigen::VectorXd u_, f_;
 };
 
+// pairs: a cracked twin's face pairs (contact per options.crack_face_contact where modelled).
 std::unique_ptr<Stepper> make_stepper(AxisymmetricModel& model, const AxisymmetricNeedle& needle,
-                                      const InsertionOptions& options, bool keep_field) {
+                                      const InsertionOptions& options, bool keep_field,
+                                      const FacePairs& pairs = {}) {
   if (options.contact == ContactMode::Frictionless)
-    return std::make_unique<FrictionlessStepper>(model, needle, options, keep_field);
-  if (model.is_linear()) return std::make_unique<LinearStepper>(model, needle, options, keep_field);
+    return std::make_unique<FrictionlessStepper>(model, needle, options, keep_field, pairs);
+  if (model.is_linear())
+    return std::make_unique<LinearStepper>(model, needle, options, keep_field, pairs,
+                                           options.crack_face_contact);
   return std::make_unique<NonlinearStepper>(model, needle, options);
 }
 
@@ -572,12 +714,14 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
   std::unique_ptr<AxisymmetricModel> cracked_model;
   std::unique_ptr<Stepper> cracked;
   double crack_area = 0.0;
+  FacePairs face_pairs;
   if (options.crack_depth_m > 0.0) {
     const double radius = ring_crack_radius(needle, options.depth_m);
     cracked_model = std::make_unique<AxisymmetricModel>(
-        crack_axisymmetric_mesh(model.mesh(), radius, options.crack_depth_m, &crack_area),
+        crack_axisymmetric_mesh(model.mesh(), radius, options.crack_depth_m, &crack_area,
+                                &face_pairs),
         model.layer_materials());
-    cracked = make_stepper(*cracked_model, needle, options, false);
+    cracked = make_stepper(*cracked_model, needle, options, false, face_pairs);
   }
   std::vector<PvdEntry> collection;
   if (!options.vtu_directory.empty()) {
@@ -593,6 +737,9 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
       step.crack_area_m2 = crack_area;
       step.energy_release_rate_J_per_m2 =
           (step.strain_energy_J - twin.strain_energy_J) / crack_area;
+      const Eigen::VectorXd gaps = cracked->face_gaps(face_pairs);
+      step.crack_face_overlap_m = gaps.size() > 0 ? std::max(0.0, -gaps.minCoeff()) : 0.0;
+      step.crack_face_contacts = cracked->closed_pairs();
     }
     if (keep_field) {
       const Eigen::VectorXd u = intact->displacement();
@@ -740,6 +887,7 @@ InsertionResult simulate_axisymmetric(const AxisymmetricProblem& problem) {
   if (problem.overrides.tolerance) options.newton.residual_tolerance = *problem.overrides.tolerance;
   options.stress_average_length_m = problem.stress_average_length_m;
   options.crack_depth_m = problem.crack_depth_m;
+  options.crack_face_contact = problem.crack_face_contact;
   options.on_step = problem.on_step;
   options.vtu_directory = problem.vtu_directory;
   options.vtu_comment = problem.vtu_comment;

@@ -178,7 +178,8 @@ void AxisymmetricModel::write_vtu(const std::string& path, const Eigen::VectorXd
 }
 
 AxisymmetricMesh crack_axisymmetric_mesh(const AxisymmetricMesh& mesh, double radius_m,
-                                         double depth_m, double* area_m2) {
+                                         double depth_m, double* area_m2,
+                                         std::vector<std::array<std::uint32_t, 2>>* face_pairs) {
   if (!(radius_m > 0.0) || !(depth_m > 0.0))
     throw InputError("ring crack: radius and depth must be > 0 m");
   double extent = 0.0;
@@ -230,6 +231,8 @@ AxisymmetricMesh crack_axisymmetric_mesh(const AxisymmetricMesh& mesh, double ra
   // the ring. (Holding that corner of the outer wedge with the needle would pin one node of a
   // free corner, whose energy vanishes under refinement, and G would not converge.)
   if (area_m2) *area_m2 = 2.0 * kPi * radius_m * depth_m;
+  if (face_pairs)
+    for (const auto& [inner, outer] : copy) face_pairs->push_back({inner, outer});
   return out;
 }
 

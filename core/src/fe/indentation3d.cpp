@@ -56,6 +56,10 @@ constexpr int kMaxStepCuts = 12;
 constexpr int kMaxUzawa = 50;
 constexpr double kUzawaTolerance = 1e-4;
 constexpr int kMaxContactNewton = 60;
+// Crack-face contact: active-set rounds per solve; a pair opens while its gap stays above
+// -kCrackGapTolerance x depth (round-off of the condensed solve is ~1e-16 of it).
+constexpr int kMaxCrackRounds = 100;
+constexpr double kCrackGapTolerance = 1e-10;
 
 }  // namespace
 
@@ -104,6 +108,44 @@ struct Indentation3d::Impl {
   // Cracked twin: the run whose captures this one copies, and each node's node in its mesh.
   const Impl* leader = nullptr;
   std::vector<int> leader_node;
+  // Crack faces in contact (linear sticking path): the node pairs; the gap of every pair under
+  // a unit load at each captured dof (columns follow `compliance`); K⁻¹ columns of the pairs
+  // that have been in contact (their surface rows and the gap of every pair); the pairs in
+  // contact now and their compressive forces (N).
+  std::vector<CrackFacePair> pairs;
+  bool pair_contact = false;
+  Eigen::MatrixXd capture_gaps;
+  std::vector<int> pair_column;  // pair -> column of pair_surface / pair_gaps, or -1
+  Eigen::MatrixXd pair_surface;
+  Eigen::MatrixXd pair_gaps;
+  std::vector<int> active_pairs;
+  Eigen::VectorXd pair_forces;
+
+  bool crack_contact() const {
+    return pair_contact && !pairs.empty() && model.is_linear() && !frictionless();
+  }
+  // Gap of pair p in the displacement field `field` (full length, or any vector indexed by dof).
+  double gap_of(std::size_t p, const Eigen::VectorXd& field) const {
+    const CrackFacePair& pair = pairs[p];
+    return pair.normal.dot(field.segment<3>(3 * pair.positive_node) -
+                           field.segment<3>(3 * pair.negative_node));
+  }
+  // Unit opening load of pair p: +normal on the positive node, -normal on the negative one
+  // (prescribed dofs left out).
+  void put_pair_load(std::size_t p, double scale, Eigen::Ref<Eigen::VectorXd> load) const {
+    const CrackFacePair& pair = pairs[p];
+    for (int j = 0; j < 3; ++j) {
+      const auto plus = static_cast<std::size_t>(3 * pair.positive_node + j);
+      const auto minus = static_cast<std::size_t>(3 * pair.negative_node + j);
+      if (!fixed_dof[plus]) load(static_cast<Eigen::Index>(plus)) += scale * pair.normal(j);
+      if (!fixed_dof[minus]) load(static_cast<Eigen::Index>(minus)) -= scale * pair.normal(j);
+    }
+  }
+  // Both nodes held by a needle: their gap is prescribed (zero), the pair has nothing to add.
+  bool pair_held(std::size_t p) const {
+    return captured_by[static_cast<std::size_t>(pairs[p].positive_node)] >= 0 &&
+           captured_by[static_cast<std::size_t>(pairs[p].negative_node)] >= 0;
+  }
 
   Eigen::Vector3d tip(int needle, double at_depth) const {
     const auto& n = needles[static_cast<std::size_t>(needle)];
@@ -229,28 +271,135 @@ struct Indentation3d::Impl {
         compliance.block(3 * static_cast<Eigen::Index>(c) + j, old_columns, 1, columns.cols()) =
             columns.row(3 * node + j);
     }
+    if (!crack_contact()) return;
+    capture_gaps.conservativeResize(static_cast<Eigen::Index>(pairs.size()), compliance.cols());
+    for (std::size_t p = 0; p < pairs.size(); ++p)
+      for (Eigen::Index k = 0; k < columns.cols(); ++k)
+        capture_gaps(static_cast<Eigen::Index>(p), old_columns + k) = gap_of(p, columns.col(k));
+  }
+
+  // K⁻¹ columns of the opening loads of pairs that have none yet.
+  void add_pair_columns(const std::vector<int>& new_pairs) {
+    if (new_pairs.empty()) return;
+    const auto k = static_cast<Eigen::Index>(new_pairs.size());
+    Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(model.dof_count(), k);
+    for (Eigen::Index i = 0; i < k; ++i)
+      put_pair_load(static_cast<std::size_t>(new_pairs[static_cast<std::size_t>(i)]), 1.0,
+                    unit.col(i));
+    const Eigen::MatrixXd columns = solver.solve_many(unit);
+    const Eigen::Index old_columns = pair_surface.cols();
+    pair_surface.conservativeResize(surface_rows(), old_columns + k);
+    for (std::size_t c = 0; c < candidates.size() + ring.size(); ++c) {
+      const int node = c < candidates.size() ? candidates[c] : ring[c - candidates.size()];
+      for (int j = 0; j < 3; ++j)
+        pair_surface.block(3 * static_cast<Eigen::Index>(c) + j, old_columns, 1, k) =
+            columns.row(3 * node + j);
+    }
+    pair_gaps.conservativeResize(static_cast<Eigen::Index>(pairs.size()), old_columns + k);
+    for (std::size_t p = 0; p < pairs.size(); ++p)
+      for (Eigen::Index i = 0; i < k; ++i)
+        pair_gaps(static_cast<Eigen::Index>(p), old_columns + i) = gap_of(p, columns.col(i));
+    for (Eigen::Index i = 0; i < k; ++i)
+      pair_column[static_cast<std::size_t>(new_pairs[static_cast<std::size_t>(i)])] =
+          static_cast<int>(old_columns + i);
+  }
+
+  // Gap of every pair under the current captured loads and pair forces.
+  Eigen::VectorXd pair_gaps_now() const {
+    Eigen::VectorXd gaps = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs.size()));
+    if (!captured.empty()) gaps += capture_gaps * multipliers;
+    for (std::size_t a = 0; a < active_pairs.size(); ++a)
+      gaps += pair_gaps.col(pair_column[static_cast<std::size_t>(active_pairs[a])]) *
+              pair_forces(static_cast<Eigen::Index>(a));
+    return gaps;
   }
 
   Eigen::VectorXd candidate_displacement() const {
-    if (captured.empty()) return Eigen::VectorXd::Zero(surface_rows());
-    return compliance * multipliers;
+    Eigen::VectorXd us = Eigen::VectorXd::Zero(surface_rows());
+    if (!captured.empty()) us += compliance * multipliers;
+    for (std::size_t a = 0; a < active_pairs.size(); ++a)
+      us += pair_surface.col(pair_column[static_cast<std::size_t>(active_pairs[a])]) *
+            pair_forces(static_cast<Eigen::Index>(a));
+    return us;
   }
 
-  void solve_linear_contact(double at_depth) {
-    if (captured.empty()) {
-      multipliers.resize(0);
-      return;
-    }
+  // The captured nodes' forces for their prescribed displacements, with the pairs in
+  // `active_pairs` closed (gap zero): one symmetric positive definite system
+  // [C_cc C_ca; C_ac C_aa] [f; λ] = [u_prescribed; 0] on the condensed compliance.
+  void solve_with_active_pairs(double at_depth) {
     const Eigen::Index m = 3 * static_cast<Eigen::Index>(captured.size());
-    Eigen::MatrixXd coupling(m, m);
+    const auto k = static_cast<Eigen::Index>(active_pairs.size());
+    Eigen::MatrixXd coupling(m + k, m + k);
     for (std::size_t i = 0; i < captured.size(); ++i)
-      coupling.middleRows(3 * static_cast<Eigen::Index>(i), 3) =
+      coupling.block(3 * static_cast<Eigen::Index>(i), 0, 3, m) =
           compliance.middleRows(3 * candidate_index[static_cast<std::size_t>(captured[i].node)], 3);
-    Eigen::LLT<Eigen::MatrixXd> llt(coupling);
+    for (Eigen::Index a = 0; a < k; ++a) {
+      const auto p = static_cast<std::size_t>(active_pairs[static_cast<std::size_t>(a)]);
+      if (m > 0) {
+        coupling.block(m + a, 0, 1, m) = capture_gaps.row(static_cast<Eigen::Index>(p));
+        coupling.block(0, m + a, m, 1) = capture_gaps.row(static_cast<Eigen::Index>(p)).transpose();
+      }
+      for (Eigen::Index b = 0; b < k; ++b)
+        coupling(m + a, m + b) = pair_gaps(
+            static_cast<Eigen::Index>(p),
+            pair_column[static_cast<std::size_t>(active_pairs[static_cast<std::size_t>(b)])]);
+    }
+    // The gap rows and the pair columns are the same numbers computed twice; average away the
+    // round-off so that the Cholesky factorisation sees an exactly symmetric matrix.
+    const Eigen::MatrixXd symmetric = 0.5 * (coupling + coupling.transpose());
+    Eigen::LLT<Eigen::MatrixXd> llt(symmetric);
     if (llt.info() != Eigen::Success)
       throw SolverError("3-D solve: contact compliance not positive definite at depth " +
                         micrometres(at_depth));
-    multipliers = llt.solve(prescribed_vector(at_depth));
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(m + k);
+    rhs.head(m) = prescribed_vector(at_depth);
+    const Eigen::VectorXd x = llt.solve(rhs);
+    multipliers = x.head(m);
+    pair_forces = x.tail(k);
+  }
+
+  void solve_linear_contact(double at_depth) {
+    if (!crack_contact()) {
+      if (captured.empty()) {
+        multipliers.resize(0);
+        return;
+      }
+      solve_with_active_pairs(at_depth);
+      return;
+    }
+    // Active set (docs/model.md, "Crack faces in contact"): a pair in contact whose force pulls
+    // (λ < 0) opens; an open pair whose faces overlap closes; repeat until nothing changes.
+    const double tolerance = kCrackGapTolerance * std::max(at_depth, 1e-12);
+    for (int round = 0; round < kMaxCrackRounds; ++round) {
+      std::erase_if(active_pairs, [&](int p) { return pair_held(static_cast<std::size_t>(p)); });
+      pair_forces.resize(static_cast<Eigen::Index>(active_pairs.size()));
+      solve_with_active_pairs(at_depth);
+      const Eigen::VectorXd gaps = pair_gaps_now();
+      std::vector<char> in_contact(pairs.size(), 0);
+      for (std::size_t a = 0; a < active_pairs.size(); ++a)
+        in_contact[static_cast<std::size_t>(active_pairs[a])] = 1;
+      std::vector<int> next, missing;
+      bool changed = false;
+      for (std::size_t a = 0; a < active_pairs.size(); ++a) {
+        if (pair_forces(static_cast<Eigen::Index>(a)) >= 0.0)
+          next.push_back(active_pairs[a]);
+        else
+          changed = true;
+      }
+      for (std::size_t p = 0; p < pairs.size(); ++p) {
+        if (in_contact[p] || pair_held(p) || !(gaps(static_cast<Eigen::Index>(p)) < -tolerance))
+          continue;
+        next.push_back(static_cast<int>(p));
+        if (pair_column[p] < 0) missing.push_back(static_cast<int>(p));
+        changed = true;
+      }
+      if (!changed) return;
+      add_pair_columns(missing);
+      std::sort(next.begin(), next.end());
+      active_pairs = std::move(next);
+    }
+    throw SolverError("3-D solve: crack-face contact did not settle at depth " +
+                      micrometres(at_depth));
   }
 
   int advance_linear(double at_depth) {
@@ -279,6 +428,9 @@ struct Indentation3d::Impl {
     for (std::size_t i = 0; i < captured.size(); ++i)
       load.segment<3>(3 * captured[i].node) =
           multipliers.segment<3>(3 * static_cast<Eigen::Index>(i));
+    for (std::size_t a = 0; a < active_pairs.size(); ++a)
+      put_pair_load(static_cast<std::size_t>(active_pairs[a]),
+                    pair_forces(static_cast<Eigen::Index>(a)), load);
     if (captured.empty()) return load;
     return solver.solve(load);
   }
@@ -827,7 +979,29 @@ struct Indentation3d::Impl {
     return result;
   }
 
+  // Largest overlap of the crack faces (m) and the pairs in contact.
+  void report_crack_faces(Step3d* step) const {
+    if (pairs.empty()) return;
+    Eigen::VectorXd gaps;
+    if (crack_contact()) {
+      gaps = pair_gaps_now();
+    } else {
+      const Eigen::VectorXd u_now = field();
+      gaps.resize(static_cast<Eigen::Index>(pairs.size()));
+      for (std::size_t p = 0; p < pairs.size(); ++p)
+        gaps(static_cast<Eigen::Index>(p)) = gap_of(p, u_now);
+    }
+    step->crack_face_overlap_m = std::max(0.0, -gaps.minCoeff());
+    step->crack_face_contacts = static_cast<int>(active_pairs.size());
+  }
+
   Step3d report(double at_depth, int solves) {
+    Step3d step = report_needles(at_depth, solves);
+    report_crack_faces(&step);
+    return step;
+  }
+
+  Step3d report_needles(double at_depth, int solves) {
     if (frictionless()) return report_frictionless(at_depth, solves);
     Step3d result;
     result.depth_m = at_depth;
@@ -939,6 +1113,22 @@ void Indentation3d::hold_contact_of(const Indentation3d& leader, std::vector<int
   impl_->leader_node = std::move(leader_node);
 }
 
+void Indentation3d::set_crack_faces(std::vector<CrackFacePair> pairs, bool contact) {
+  if (impl_->depth > 0.0 || impl_->compliance.cols() > 0)
+    throw InputError("3-D indentation: crack-face contact must be set before the first depth");
+  const auto nodes = static_cast<int>(impl_->mesh.nodes.size());
+  for (const CrackFacePair& pair : pairs) {
+    if (pair.negative_node < 0 || pair.negative_node >= nodes || pair.positive_node < 0 ||
+        pair.positive_node >= nodes || pair.negative_node == pair.positive_node)
+      throw InputError("3-D indentation: crack-face pair: node out of range");
+    if (!pair.normal.allFinite() || std::abs(pair.normal.norm() - 1.0) > 1e-9)
+      throw InputError("3-D indentation: crack-face pair: the normal must be a unit vector");
+  }
+  impl_->pairs = std::move(pairs);
+  impl_->pair_contact = contact;
+  impl_->pair_column.assign(impl_->pairs.size(), -1);
+}
+
 Step3d Indentation3d::advance_to(double depth) {
   if (!(depth >= impl_->depth) || !std::isfinite(depth))
     throw InputError("3-D indentation: depths must grow (asked " + micrometres(depth) + " after " +
@@ -1023,7 +1213,8 @@ namespace {
 // cracked mesh to its node in `mesh`.
 TetMesh cracked_copy(const TetMesh& mesh, const std::vector<Needle3d>& needles,
                      const std::vector<Eigen::Vector2d>& tips, double depth,
-                     std::vector<double>* areas, std::vector<int>* original_node) {
+                     std::vector<double>* areas, std::vector<int>* original_node,
+                     std::vector<CrackFacePair>* pairs) {
   TetMesh cracked = mesh;
   original_node->resize(mesh.nodes.size());
   for (std::size_t n = 0; n < mesh.nodes.size(); ++n) (*original_node)[n] = static_cast<int>(n);
@@ -1034,7 +1225,11 @@ TetMesh cracked_copy(const TetMesh& mesh, const std::vector<Needle3d>& needles,
     crack.depth_m = depth;
     double area = 0.0;
     std::vector<int> previous;
+    const std::size_t before = cracked.nodes.size();
     cracked = crack_mesh(cracked, crack, &area, &previous);
+    // crack_mesh appends one copy per opened node, on the side the normal points to.
+    for (std::size_t copy = before; copy < cracked.nodes.size(); ++copy)
+      pairs->push_back({previous[copy], static_cast<int>(copy), crack.normal});
     for (int& node : previous) node = (*original_node)[static_cast<std::size_t>(node)];
     *original_node = std::move(previous);
     areas->push_back(area);
@@ -1103,9 +1298,10 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   std::vector<double> crack_areas;
   TetMesh cracked;
   std::vector<int> original_node;
+  std::vector<CrackFacePair> face_pairs;
   if (options.crack_depth_m > 0.0)
     cracked = cracked_copy(mesh, needles, first_contact, options.crack_depth_m, &crack_areas,
-                           &original_node);
+                           &original_node, &face_pairs);
   const double meshing = seconds_since(start);
 
   Simulation3dResult result;
@@ -1124,6 +1320,7 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   // own search it captures a different set and U_intact - U_cracked loses its sign.
   if (cracked_run && options.contact == ContactMode::Sticking)
     cracked_run->hold_contact_of(run, std::move(original_node));
+  if (cracked_run) cracked_run->set_crack_faces(std::move(face_pairs), options.crack_face_contact);
   // Every mirror image of the meshed part holds the same cracks.
   const double whole = (mesh.mirror_x0 ? 2.0 : 1.0) * (mesh.mirror_y0 ? 2.0 : 1.0);
   double total_crack_area = 0.0;
@@ -1148,6 +1345,8 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
     if (cracked_run) {
       const Step3d opened = cracked_run->advance_to(depth);
       const double release = (step.strain_energy_J - opened.strain_energy_J) / total_crack_area;
+      step.crack_face_overlap_m = opened.crack_face_overlap_m;
+      step.crack_face_contacts = opened.crack_face_contacts;
       for (std::size_t n = 0; n < needles.size(); ++n) {
         step.needles[n].energy_release_rate_J_per_m2 = release;
         step.needles[n].crack_area_m2 =

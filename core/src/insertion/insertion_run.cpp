@@ -238,6 +238,7 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
       p.strain_energy_J = step.strain_energy_J;
       p.tip_stress_Pa = n.tip_stress_Pa;
       p.energy_release_rate_J_per_m2 = n.energy_release_rate_J_per_m2;
+      p.crack_face_overlap_m = step.crack_face_overlap_m;
       set_section(p, areas[i]);
       out.needles[i].points.push_back(p);
       out.needles[i].samples.push_back(sample_of(step.depth_m, n, areas[i]));
@@ -309,6 +310,7 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
     pt.strain_energy_J = st.strain_energy_J;
     pt.tip_stress_Pa = st.tip_stress_Pa;
     pt.energy_release_rate_J_per_m2 = st.energy_release_rate_J_per_m2;
+    pt.crack_face_overlap_m = st.crack_face_overlap_m;
     set_section(pt, area);
     out.needles[0].points.push_back(pt);
     out.needles[0].samples.push_back(sample_of(st.depth_m, st, area));
@@ -523,6 +525,7 @@ RunPoint interpolated_point(const std::vector<RunPoint>& points, double depth) {
       r.tip_stress_Pa = mix(before.tip_stress_Pa, p.tip_stress_Pa);
       r.energy_release_rate_J_per_m2 =
           mix(before.energy_release_rate_J_per_m2, p.energy_release_rate_J_per_m2);
+      r.crack_face_overlap_m = mix(before.crack_face_overlap_m, p.crack_face_overlap_m);
       return r;
     }
     before = p;

@@ -8,6 +8,8 @@
 #include <numbers>
 
 #include "mneedle/base/error.h"
+#include "mneedle/fe/crack.h"
+#include "mneedle/fe/solid3d.h"
 #include "needle_meshes.h"
 #include "small_skin.h"
 
@@ -446,6 +448,99 @@ TEST(Indentation3d, TipStressAndEnergyReleaseRateAreReportedWhenRequested) {
   EXPECT_THROW(
       simulate_3d(small_skin(), {{"cone", cone_needle(0.5, 60e-6, 1e-3), 0.0, 0.0}}, options),
       mneedle::InputError);
+}
+
+// Crack faces in contact (docs/model.md, "Crack faces in contact"). A bevel pushes the tissue
+// beside its tip sideways, so the crack under the tip closes on one side: with free faces the
+// two faces pass through each other by micrometres. In contact they must not, at any node pair
+// of the displacement field (not only as the run reports it); the contact force of each pair is
+// normal (frictionless), compressive and equal and opposite on the two faces; and the contact can
+// only stiffen the cracked block, so U_free <= U_contact <= U_intact.
+TEST(Indentation3d, CrackFacesUnderABevelDoNotPassThroughEachOther) {
+  const double R = 115e-6, depth = 150e-6, tolerance = 1e-13;  // m; see below for the tolerance
+  TissueBlockSpec spec = homogeneous_block(MaterialModel::Linear, 0.2e6, 0.49, 450e-6, 450e-6);
+  spec.sites = {{0.0, 0.0, R, Eigen::Vector2d(-R, 0.0)}};
+  spec.fidelity = Fidelity::Fast;
+  spec.overrides.tip_size_m = 60e-6;  // 11 node pairs on the crack's faces
+  spec.insertion_depth = depth;
+  spec.half_y = true;
+  const TetMesh mesh = generate_tissue_mesh(spec);
+  PlanarCrack crack;
+  crack.origin_m = crack_origin_under(mesh, {0.0, 0.0}, {-R, 0.0});
+  ASSERT_EQ(crack.origin_m.x(), -R);  // under the tip, not through the axis
+  crack.depth_m = 100e-6;
+  std::vector<int> original;
+  const TetMesh cracked = crack_mesh(mesh, crack, nullptr, &original);
+  std::vector<CrackFacePair> pairs;
+  for (std::size_t n = mesh.nodes.size(); n < cracked.nodes.size(); ++n)
+    pairs.push_back({original[n], static_cast<int>(n), Eigen::Vector3d::UnitX()});
+  ASSERT_GT(pairs.size(), 8U);
+  const std::vector<Needle3d> bevel = {
+      {"bevel", bevel_needle(R, std::numbers::pi / 6, 1e-3), 0.0, 0.0}};
+
+  auto gaps_of = [&](const Eigen::VectorXd& u) {
+    std::vector<double> gaps;
+    for (const CrackFacePair& p : pairs)
+      gaps.push_back(u(3 * p.positive_node) - u(3 * p.negative_node));
+    return gaps;
+  };
+  Indentation3d intact(mesh, bevel, depth);
+  const double intact_energy = intact.advance_to(depth).strain_energy_J;
+  double energy[2] = {0.0, 0.0};
+  for (bool contact : {false, true}) {
+    Indentation3d twin(cracked, bevel, depth);
+    twin.hold_contact_of(intact, original);
+    twin.set_crack_faces(pairs, contact);
+    const Step3d step = twin.advance_to(depth);
+    energy[contact] = step.strain_energy_J;
+    const Eigen::VectorXd u = twin.displacement();
+    const std::vector<double> gaps = gaps_of(u);
+    const double min_gap = *std::min_element(gaps.begin(), gaps.end());
+    if (!contact) {
+      // The defect contact removes: free faces overlap (by 52 um here).
+      EXPECT_LT(min_gap, -1e-6);
+      EXPECT_NEAR(step.crack_face_overlap_m, -min_gap, 1e-9 * -min_gap);
+      EXPECT_EQ(step.crack_face_contacts, 0);
+      continue;
+    }
+    // In contact: no overlap beyond round-off. The active set closes a pair whose faces
+    // overlap by more than 1e-10 x depth (1.5e-14 m); 1e-13 m is 1e-7 of the free overlap.
+    EXPECT_GE(min_gap, -tolerance);
+    EXPECT_LE(step.crack_face_overlap_m, tolerance);
+    EXPECT_GT(step.crack_face_contacts, 0);
+    // Contact forces from the field itself: the internal force K u at a face node below the
+    // surface (the needle holds some mouth nodes) is the contact force on it.
+    SolidModel model(cracked);
+    Eigen::VectorXd force;
+    model.assemble(u, nullptr, &force);
+    double largest = 0.0;
+    for (const CrackFacePair& p : pairs)
+      largest = std::max(largest, force.segment<3>(3 * p.positive_node).norm());
+    ASSERT_GT(largest, 0.0);
+    int pressed = 0;
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const CrackFacePair& p = pairs[k];
+      if (cracked.nodes[static_cast<std::size_t>(p.positive_node)].z() == 0.0) continue;
+      const Eigen::Vector3d plus = force.segment<3>(3 * p.positive_node);
+      const Eigen::Vector3d minus = force.segment<3>(3 * p.negative_node);
+      const bool on_mirror = cracked.nodes[static_cast<std::size_t>(p.positive_node)].y() == 0.0;
+      // Round-off of an assembled force: 1e-9 of the largest contact force.
+      const double floor = 1e-9 * largest;
+      EXPECT_GE(plus.x(), -floor) << "pair " << k << ": the contact pulls";
+      EXPECT_NEAR(plus.x() + minus.x(), 0.0, floor) << "pair " << k;
+      EXPECT_NEAR(plus.z(), 0.0, floor) << "pair " << k << ": friction on the faces";
+      if (!on_mirror) {  // on y = 0 the y force is the mirror plane's reaction
+        EXPECT_NEAR(plus.y(), 0.0, floor) << "pair " << k;
+      }
+      if (gaps[k] > tolerance) {
+        EXPECT_NEAR(plus.x(), 0.0, floor) << "open pair " << k;
+      }
+      pressed += plus.x() > floor;
+    }
+    EXPECT_GT(pressed, 0);
+  }
+  EXPECT_LT(energy[0], energy[1]);
+  EXPECT_LT(energy[1], intact_energy);
 }
 
 }  // namespace

@@ -33,16 +33,18 @@ void apply_simulate_settings(Scene& scene, const SimulateSettings& settings);
 /// The scene's run options with the settings applied (fields output is the caller's).
 InsertionRunOptions simulate_run_options(const Scene& scene, const SimulateSettings& settings);
 
-/// Where the run's penetration criterion does not hold (docs/model.md, "Penetration criterion"),
-/// one line each, naming the scene: a top layer thinner than the needle's diameter (no
-/// half-space), a layer so brittle against the needle that F_p is an upper bound. Empty for the
-/// other criteria. The CLI prints them on stderr, Python raises them as RuntimeWarnings.
-std::vector<std::string> penetration_warnings(const InsertionRun& run, const Scene& scene);
+/// Where the run's criterion does not hold, one line each, naming the scene. Penetration
+/// (docs/model.md, "Penetration criterion"): a top layer thinner than the needle's diameter (no
+/// half-space), a layer so brittle against the needle that F_p is an upper bound. Energy
+/// ("Crack faces in contact"): crack faces that passed through each other (their contact is not
+/// modelled on that path). Empty for the other criteria. The CLI prints them on stderr, Python
+/// raises them as RuntimeWarnings.
+std::vector<std::string> criterion_warnings(const InsertionRun& run, const Scene& scene);
 
 /// The run as `simulate --json` prints it (without provenance): needles with curves and
 /// punctures, mesh, total curve, models, reductions, criterion, loads, energy check, memory and
 /// time; each needle's mesh hash; `axis` when the settings gave one; `warnings`
-/// (penetration_warnings). Checked finite (SolverError naming the first NaN or Inf).
+/// (criterion_warnings). Checked finite (SolverError naming the first NaN or Inf).
 nlohmann::json simulation_json(const InsertionRun& run, const Scene& scene,
                                const std::vector<PreparedNeedle>& needles,
                                const SimulateSettings& settings);

@@ -80,9 +80,11 @@ AxisymmetricMesh make_axisymmetric_mesh(const std::vector<AxisymmetricLayer>& la
 /// (radius_m, -depth_m), the crack front, stays shared. The outer copy of the surface node is
 /// not a surface (contact) node: the needle presses the inside of the ring. `area_m2` receives
 /// 2 pi radius depth (one face). Throws InputError unless that line is a column of element edges
-/// ending at a node.
-AxisymmetricMesh crack_axisymmetric_mesh(const AxisymmetricMesh& mesh, double radius_m,
-                                         double depth_m, double* area_m2);
+/// ending at a node. `face_pairs`, when given, receives each doubled node with its outer copy
+/// ({inner, outer}): the faces overlap where u_r(outer) < u_r(inner).
+AxisymmetricMesh crack_axisymmetric_mesh(
+    const AxisymmetricMesh& mesh, double radius_m, double depth_m, double* area_m2,
+    std::vector<std::array<std::uint32_t, 2>>* face_pairs = nullptr);
 
 /// Result of one equilibrium solve.
 struct Equilibrium {
@@ -172,6 +174,11 @@ struct InsertionStep {
   /// crack at radius ring_crack_radius() from the surface down crack_depth_m.
   double energy_release_rate_J_per_m2 = 0.0;
   double crack_area_m2 = 0.0;  ///< 2 pi r_c c (one face)
+  /// The ring crack's faces (crack_depth_m > 0): how far the inner face has passed through the
+  /// outer one at a node pair (m, >= 0), and the pairs in contact (docs/model.md, "Crack faces
+  /// in contact").
+  double crack_face_overlap_m = 0.0;
+  int crack_face_contacts = 0;
 };
 
 struct InsertionOptions {
@@ -186,6 +193,9 @@ struct InsertionOptions {
   /// radius (ring_crack_radius of the needle) reaching at least this depth; a second, cracked
   /// model runs in lock-step with the intact one.
   double crack_depth_m = 0.0;
+  /// The ring crack's faces in frictionless contact (linear layers, sticking: exact; otherwise
+  /// the faces stay free and only their overlap is reported); false leaves them free.
+  bool crack_face_contact = true;
   /// Called after each output step; returning false stops the insertion there.
   std::function<bool(const InsertionStep&)> on_step;
   /// When set, step_<k>.vtu (k = 1..output steps) is written there (AxisymmetricModel::write_vtu)
@@ -225,6 +235,7 @@ struct AxisymmetricProblem {
   FidelityOverrides overrides;
   double stress_average_length_m = 0.0;  ///< as InsertionOptions
   double crack_depth_m = 0.0;            ///< as InsertionOptions
+  bool crack_face_contact = true;        ///< as InsertionOptions
   std::function<bool(const InsertionStep&)> on_step;
   std::string vtu_directory;
   std::string vtu_comment;

@@ -46,6 +46,19 @@ struct Step3d {
   std::vector<NeedleStep3d> needles;
   double strain_energy_J = 0.0;
   int newton_iterations = 0;  ///< linear solves of the step (1 per capture round when linear)
+  /// Crack faces (a run with set_crack_faces): the deepest one face has passed through
+  /// the other at a node pair (m, >= 0; 0 when none or no crack) and the pairs in contact.
+  double crack_face_overlap_m = 0.0;
+  int crack_face_contacts = 0;
+};
+
+/// Two nodes of a crack's opposite faces that coincide in the reference state (crack_mesh: the
+/// original on the negative side, its copy on the side the unit `normal` points to). The faces
+/// overlap when normal . (u_positive - u_negative) < 0.
+struct CrackFacePair {
+  int negative_node = -1;
+  int positive_node = -1;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();
 };
 
 /// Wall-clock split of the work (s).
@@ -103,6 +116,15 @@ class Indentation3d {
   /// and U_cracked <= U_intact. Advance the leader to each depth first. Sticking contact only
   /// (InputError otherwise); `leader` must outlive this run.
   void hold_contact_of(const Indentation3d& leader, std::vector<int> leader_node);
+  /// The node pairs of a crack's faces, whose overlap every Step3d reports. With `contact`, the
+  /// faces are in frictionless contact (docs/model.md, "Crack faces in contact"): at each pair
+  /// they may open and slide but not pass through each other, and a pair in contact carries a
+  /// compressive normal force only. Contact is exact (an active set on the condensed
+  /// compliance) for linear tissue with sticking needle contact; with frictionless needle
+  /// contact or nonlinear tissue the faces stay free (traction-free) and only their overlap is
+  /// reported. Call before the first advance_to. InputError for a node out of range or a
+  /// non-unit normal.
+  void set_crack_faces(std::vector<CrackFacePair> pairs, bool contact);
   /// Nodal displacement (3 per node, m) at the last depth.
   Eigen::VectorXd displacement() const;
   const Timing3d& timing() const;
@@ -145,6 +167,9 @@ struct Simulation3dOptions {
   /// Depth of the planar crack (normal x) through each needle's axis for G (0 = off); a second,
   /// cracked model runs in lock-step with the intact one.
   double crack_depth_m = 0.0;
+  /// The crack's faces in frictionless contact (Indentation3d::set_crack_faces); false
+  /// leaves them traction-free, free to pass through each other (for comparison only).
+  bool crack_face_contact = true;
   /// Called after each output step; returning false stops the insertion there.
   std::function<bool(const Step3d&)> on_step;
   /// When set, the problem at the last step not deeper than inp_depth_m is written there

@@ -87,6 +87,9 @@ struct RunPoint {
   /// Criterion quantities, computed only for the criterion in use (else 0).
   double tip_stress_Pa = 0.0;                 ///< stress: averaged max principal stress
   double energy_release_rate_J_per_m2 = 0.0;  ///< energy: G of the crack under the tip
+  /// energy: how far one crack face has passed through the other (m; 0 while the faces are in
+  /// contact, docs/model.md "Crack faces in contact")
+  double crack_face_overlap_m = 0.0;
   /// penetration: F_p of the section at the surface (docs/model.md, "Penetration criterion")
   double penetration_force_N = 0.0;
   // Post-puncture split (paper A eqs. 18-20, friction); zero before puncture.
