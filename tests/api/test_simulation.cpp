@@ -104,5 +104,31 @@ TEST(Simulation, SecondsByStageLieWithinTheRunsWallTime) {
   EXPECT_EQ(t["fe_3d_s"].get<double>(), run.seconds_by_stage.fe_3d_s);
 }
 
+// The energy criterion's crack faces stay free on the paths where their contact is not modelled
+// (docs/model.md, "Crack faces in contact"): an overlap above 1 nm is one warning line naming the
+// scene and the needle; round-off overlap (faces in contact) and other criteria say nothing.
+TEST(Simulation, OverlappingCrackFacesAreOneWarningNamingTheNeedle) {
+  Scene scene;
+  scene.source_name = "phantom.toml";
+  InsertionRun run;
+  run.criterion = PunctureCriterion::Energy;
+  NeedleRun needle;
+  needle.name = "sharp_bevel";
+  RunPoint point;
+  point.crack_face_overlap_m = 3e-20;  // in contact: round-off
+  needle.curve.push_back(point);
+  run.needles.push_back(needle);
+  EXPECT_TRUE(criterion_warnings(run, scene).empty());
+  run.needles[0].curve[0].crack_face_overlap_m = 4.2e-6;
+  const std::vector<std::string> warnings = criterion_warnings(run, scene);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("phantom.toml"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("'sharp_bevel'"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("4.2 um"), std::string::npos) << warnings[0];
+  EXPECT_EQ(warnings[0].find('\n'), std::string::npos);
+  run.criterion = PunctureCriterion::Pressure;
+  EXPECT_TRUE(criterion_warnings(run, scene).empty());
+}
+
 }  // namespace
 }  // namespace mneedle

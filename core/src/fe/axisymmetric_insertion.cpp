@@ -321,10 +321,12 @@ class CondensedSurface {
 using FacePairs = std::vector<std::array<std::uint32_t, 2>>;
 
 // Active-set rounds of the crack-face contact per solve; a pair closes when its faces overlap by
-// more than kCrackGapTolerance x the insertion depth (round-off of the condensed solve is
-// ~1e-16 of it).
+// more than kCrackGapTolerance x the current depth (round-off of the condensed solve is ~1e-16
+// of it).
 constexpr int kMaxCrackRounds = 100;
 constexpr double kCrackGapTolerance = 1e-10;
+// A closed pair pulls when its force is below -kCrackForceFloor x the largest condensed force.
+constexpr double kCrackForceFloor = 1e-12;
 
 class Stepper {
  public:
@@ -458,8 +460,7 @@ class LinearStepper : public Stepper {
         n_(model.dof_count()),
         sub_step_(options.depth_m / (options.output_steps * kSubsteps)),
         pairs_(std::move(pairs)),
-        close_pairs_(close_pairs),
-        gap_tolerance_(kCrackGapTolerance * options.depth_m) {
+        close_pairs_(close_pairs) {
     previous_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_));
     if (!candidates_.empty())
       surface_ = std::make_unique<CondensedSurface>(model, with_face_nodes(candidates_, pairs_),
@@ -516,24 +517,31 @@ class LinearStepper : public Stepper {
       surface_->solve(mesh_, state_, depth, u_, f_);
       return;
     }
+    const double tolerance = kCrackGapTolerance * std::max(depth, 1e-12);
     for (int round = 0; round < kMaxCrackRounds; ++round) {
       std::vector<std::array<int, 2>> dofs;
       for (std::size_t p : closed_)
         dofs.push_back({surface_->index_of(pairs_[p][0]), surface_->index_of(pairs_[p][1])});
       surface_->solve(mesh_, state_, depth, u_, f_, dofs);
-      const double force_floor = 1e-12 * f_.norm();
-      std::vector<std::size_t> next;
-      bool changed = false;
-      for (std::size_t p : closed_) {
-        if (f_[surface_->index_of(pairs_[p][1])] < -force_floor)
-          changed = true;
-        else
-          next.push_back(p);
+      // The pair pulled hardest opens, one per round; when none pulls, every overlapping pair
+      // closes.
+      const double floor = kCrackForceFloor * f_.lpNorm<Eigen::Infinity>();
+      std::size_t worst = closed_.size();
+      double worst_force = -floor;
+      for (std::size_t c = 0; c < closed_.size(); ++c) {
+        const double force = f_[surface_->index_of(pairs_[closed_[c]][1])];
+        if (force < worst_force) worst = c, worst_force = force;
+      }
+      if (worst < closed_.size()) {
+        closed_.erase(closed_.begin() + static_cast<std::ptrdiff_t>(worst));
+        continue;
       }
       const Eigen::VectorXd gaps = face_gaps(pairs_);
+      bool changed = false;
+      std::vector<std::size_t> next = closed_;
       for (std::size_t p = 0; p < pairs_.size(); ++p)
         if (!std::binary_search(closed_.begin(), closed_.end(), p) &&
-            gaps[static_cast<Eigen::Index>(p)] < -gap_tolerance_) {
+            gaps[static_cast<Eigen::Index>(p)] < -tolerance) {
           next.push_back(p);
           changed = true;
         }
@@ -557,7 +565,6 @@ class LinearStepper : public Stepper {
   double depth_ = 0.0;
   FacePairs pairs_;
   bool close_pairs_ = false;
-  double gap_tolerance_ = 0.0;
   std::vector<std::size_t> closed_;  // sorted
 };
 

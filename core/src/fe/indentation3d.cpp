@@ -56,10 +56,13 @@ constexpr int kMaxStepCuts = 12;
 constexpr int kMaxUzawa = 50;
 constexpr double kUzawaTolerance = 1e-4;
 constexpr int kMaxContactNewton = 60;
-// Crack-face contact: active-set rounds per solve; a pair opens while its gap stays above
-// -kCrackGapTolerance x depth (round-off of the condensed solve is ~1e-16 of it).
+// Crack-face contact: active-set rounds per solve; a pair closes when its faces overlap by more
+// than kCrackGapTolerance x the current depth (round-off of the condensed solve is ~1e-16 of it).
 constexpr int kMaxCrackRounds = 100;
 constexpr double kCrackGapTolerance = 1e-10;
+// A pair force below -kCrackForceFloor x the largest force of the solve pulls (round-off of a
+// dense solve is ~1e-15 of it).
+constexpr double kCrackForceFloor = 1e-12;
 
 }  // namespace
 
@@ -125,7 +128,7 @@ struct Indentation3d::Impl {
     return pair_contact && !pairs.empty() && model.is_linear() && !frictionless();
   }
   // Gap of pair p in the displacement field `field` (full length, or any vector indexed by dof).
-  double gap_of(std::size_t p, const Eigen::VectorXd& field) const {
+  double gap_of(std::size_t p, Eigen::Ref<const Eigen::VectorXd> field) const {
     const CrackFacePair& pair = pairs[p];
     return pair.normal.dot(field.segment<3>(3 * pair.positive_node) -
                            field.segment<3>(3 * pair.negative_node));
@@ -344,10 +347,9 @@ struct Indentation3d::Impl {
             static_cast<Eigen::Index>(p),
             pair_column[static_cast<std::size_t>(active_pairs[static_cast<std::size_t>(b)])]);
     }
-    // The gap rows and the pair columns are the same numbers computed twice; average away the
-    // round-off so that the Cholesky factorisation sees an exactly symmetric matrix.
-    const Eigen::MatrixXd symmetric = 0.5 * (coupling + coupling.transpose());
-    Eigen::LLT<Eigen::MatrixXd> llt(symmetric);
+    // LLT reads the lower triangle only: the captured block as before (runs without a crack
+    // are unchanged to the bit), the pairs' rows from capture_gaps and pair_gaps.
+    Eigen::LLT<Eigen::MatrixXd> llt(coupling);
     if (llt.info() != Eigen::Success)
       throw SolverError("3-D solve: contact compliance not positive definite at depth " +
                         micrometres(at_depth));
@@ -367,37 +369,40 @@ struct Indentation3d::Impl {
       solve_with_active_pairs(at_depth);
       return;
     }
-    // Active set (docs/model.md, "Crack faces in contact"): a pair in contact whose force pulls
-    // (λ < 0) opens; an open pair whose faces overlap closes; repeat until nothing changes.
+    // Active set (docs/model.md, "Crack faces in contact"): the pair in contact pulled hardest
+    // (λ < 0) opens, one per round; when none pulls, every open pair whose faces overlap
+    // closes; repeat until nothing changes.
     const double tolerance = kCrackGapTolerance * std::max(at_depth, 1e-12);
     for (int round = 0; round < kMaxCrackRounds; ++round) {
       std::erase_if(active_pairs, [&](int p) { return pair_held(static_cast<std::size_t>(p)); });
       pair_forces.resize(static_cast<Eigen::Index>(active_pairs.size()));
       solve_with_active_pairs(at_depth);
+      const double floor = kCrackForceFloor * std::max(multipliers.lpNorm<Eigen::Infinity>(),
+                                                       pair_forces.lpNorm<Eigen::Infinity>());
+      if (pair_forces.size() > 0 && pair_forces.minCoeff() < -floor) {
+        Eigen::Index worst = 0;
+        pair_forces.minCoeff(&worst);
+        active_pairs.erase(active_pairs.begin() + worst);
+        continue;
+      }
       const Eigen::VectorXd gaps = pair_gaps_now();
       std::vector<char> in_contact(pairs.size(), 0);
-      for (std::size_t a = 0; a < active_pairs.size(); ++a)
-        in_contact[static_cast<std::size_t>(active_pairs[a])] = 1;
-      std::vector<int> next, missing;
-      bool changed = false;
-      for (std::size_t a = 0; a < active_pairs.size(); ++a) {
-        if (pair_forces(static_cast<Eigen::Index>(a)) >= 0.0)
-          next.push_back(active_pairs[a]);
-        else
-          changed = true;
-      }
+      for (int p : active_pairs) in_contact[static_cast<std::size_t>(p)] = 1;
+      std::vector<int> missing;
+      bool closed = false;
       for (std::size_t p = 0; p < pairs.size(); ++p) {
         if (in_contact[p] || pair_held(p) || !(gaps(static_cast<Eigen::Index>(p)) < -tolerance))
           continue;
-        next.push_back(static_cast<int>(p));
+        active_pairs.push_back(static_cast<int>(p));
         if (pair_column[p] < 0) missing.push_back(static_cast<int>(p));
-        changed = true;
+        closed = true;
       }
-      if (!changed) return;
+      if (!closed) return;
       add_pair_columns(missing);
-      std::sort(next.begin(), next.end());
-      active_pairs = std::move(next);
+      std::sort(active_pairs.begin(), active_pairs.end());
     }
+    active_pairs.clear();  // keep the state consistent (pair_forces matches active_pairs)
+    pair_forces.resize(0);
     throw SolverError("3-D solve: crack-face contact did not settle at depth " +
                       micrometres(at_depth));
   }

@@ -484,39 +484,44 @@ TEST(Indentation3d, CrackFacesUnderABevelDoNotPassThroughEachOther) {
       gaps.push_back(u(3 * p.positive_node) - u(3 * p.negative_node));
     return gaps;
   };
+  // Advanced in three steps: the contact set carries over from depth to depth while captures
+  // are added (some on the crack's mouth, whose pairs the needle then holds).
   Indentation3d intact(mesh, bevel, depth);
-  const double intact_energy = intact.advance_to(depth).strain_energy_J;
-  double energy[2] = {0.0, 0.0};
-  for (bool contact : {false, true}) {
-    Indentation3d twin(cracked, bevel, depth);
-    twin.hold_contact_of(intact, original);
-    twin.set_crack_faces(pairs, contact);
-    const Step3d step = twin.advance_to(depth);
-    energy[contact] = step.strain_energy_J;
+  Indentation3d free_twin(cracked, bevel, depth), twin(cracked, bevel, depth);
+  free_twin.hold_contact_of(intact, original);
+  free_twin.set_crack_faces(pairs, false);
+  twin.hold_contact_of(intact, original);
+  twin.set_crack_faces(pairs, true);
+  const SolidModel model(cracked);
+  for (double at : {depth / 3, 2 * depth / 3, depth}) {
+    const double intact_energy = intact.advance_to(at).strain_energy_J;
+    const Step3d free_step = free_twin.advance_to(at);
+    const std::vector<double> free_gaps = gaps_of(free_twin.displacement());
+    const double free_min = *std::min_element(free_gaps.begin(), free_gaps.end());
+    // The defect contact removes: free faces overlap (by 52 um at 150 um).
+    EXPECT_LT(free_min, -1e-6) << "at " << at;
+    EXPECT_NEAR(free_step.crack_face_overlap_m, -free_min, 1e-9 * -free_min);
+    EXPECT_EQ(free_step.crack_face_contacts, 0);
+
+    const Step3d step = twin.advance_to(at);
     const Eigen::VectorXd u = twin.displacement();
     const std::vector<double> gaps = gaps_of(u);
-    const double min_gap = *std::min_element(gaps.begin(), gaps.end());
-    if (!contact) {
-      // The defect contact removes: free faces overlap (by 52 um here).
-      EXPECT_LT(min_gap, -1e-6);
-      EXPECT_NEAR(step.crack_face_overlap_m, -min_gap, 1e-9 * -min_gap);
-      EXPECT_EQ(step.crack_face_contacts, 0);
-      continue;
-    }
     // In contact: no overlap beyond round-off. The active set closes a pair whose faces
-    // overlap by more than 1e-10 x depth (1.5e-14 m); 1e-13 m is 1e-7 of the free overlap.
-    EXPECT_GE(min_gap, -tolerance);
+    // overlap by more than 1e-10 x depth (<= 1.5e-14 m here); 1e-13 m is 2e-9 of the free one.
+    EXPECT_GE(*std::min_element(gaps.begin(), gaps.end()), -tolerance) << "at " << at;
     EXPECT_LE(step.crack_face_overlap_m, tolerance);
     EXPECT_GT(step.crack_face_contacts, 0);
     // Contact forces from the field itself: the internal force K u at a face node below the
-    // surface (the needle holds some mouth nodes) is the contact force on it.
-    SolidModel model(cracked);
+    // surface is the contact force on it (mouth nodes on z = 0 may also carry the needle's).
     Eigen::VectorXd force;
     model.assemble(u, nullptr, &force);
     double largest = 0.0;
     for (const CrackFacePair& p : pairs)
-      largest = std::max(largest, force.segment<3>(3 * p.positive_node).norm());
+      if (cracked.nodes[static_cast<std::size_t>(p.positive_node)].z() < 0.0)
+        largest = std::max(largest, force.segment<3>(3 * p.positive_node).norm());
     ASSERT_GT(largest, 0.0);
+    // Round-off of an assembled force: 1e-9 of the largest contact force.
+    const double floor = 1e-9 * largest;
     int pressed = 0;
     for (std::size_t k = 0; k < pairs.size(); ++k) {
       const CrackFacePair& p = pairs[k];
@@ -524,8 +529,6 @@ TEST(Indentation3d, CrackFacesUnderABevelDoNotPassThroughEachOther) {
       const Eigen::Vector3d plus = force.segment<3>(3 * p.positive_node);
       const Eigen::Vector3d minus = force.segment<3>(3 * p.negative_node);
       const bool on_mirror = cracked.nodes[static_cast<std::size_t>(p.positive_node)].y() == 0.0;
-      // Round-off of an assembled force: 1e-9 of the largest contact force.
-      const double floor = 1e-9 * largest;
       EXPECT_GE(plus.x(), -floor) << "pair " << k << ": the contact pulls";
       EXPECT_NEAR(plus.x() + minus.x(), 0.0, floor) << "pair " << k;
       EXPECT_NEAR(plus.z(), 0.0, floor) << "pair " << k << ": friction on the faces";
@@ -537,10 +540,36 @@ TEST(Indentation3d, CrackFacesUnderABevelDoNotPassThroughEachOther) {
       }
       pressed += plus.x() > floor;
     }
-    EXPECT_GT(pressed, 0);
+    EXPECT_GT(pressed, 0) << "at " << at;
+    EXPECT_LT(free_step.strain_energy_J, step.strain_energy_J) << "at " << at;
+    EXPECT_LT(step.strain_energy_J, intact_energy) << "at " << at;
   }
-  EXPECT_LT(energy[0], energy[1]);
-  EXPECT_LT(energy[1], intact_energy);
+}
+
+// simulate_3d puts the cracked twin's faces in contact unless told not to (the comparison
+// option): the same bevel as above, through the one-call entry point.
+TEST(Indentation3d, SimulateKeepsTheCrackFacesInContactUnlessToldNotTo) {
+  Simulation3dOptions options;
+  options.depth = 150e-6;
+  options.steps = 1;
+  options.half_model = true;
+  options.fidelity = Fidelity::Fast;
+  options.overrides.tip_size_m = 60e-6;
+  options.crack_depth_m = 100e-6;
+  const TissueBlockSpec block =
+      homogeneous_block(MaterialModel::Linear, 0.2e6, 0.49, 450e-6, 450e-6);
+  const std::vector<Needle3d> bevel = {
+      {"bevel", bevel_needle(115e-6, std::numbers::pi / 6, 1e-3), 0.0, 0.0}};
+  const Step3d in_contact = simulate_3d(block, bevel, options).steps.back();
+  options.crack_face_contact = false;
+  const Step3d free_faces = simulate_3d(block, bevel, options).steps.back();
+  EXPECT_LE(in_contact.crack_face_overlap_m, 1e-13);  // as in the test above
+  EXPECT_GT(in_contact.crack_face_contacts, 0);
+  EXPECT_GT(free_faces.crack_face_overlap_m, 1e-6);
+  EXPECT_EQ(in_contact.needles[0].force_N, free_faces.needles[0].force_N);  // the intact run's
+  EXPECT_GT(in_contact.needles[0].energy_release_rate_J_per_m2, 0.0);
+  EXPECT_LT(in_contact.needles[0].energy_release_rate_J_per_m2,
+            free_faces.needles[0].energy_release_rate_J_per_m2);
 }
 
 }  // namespace

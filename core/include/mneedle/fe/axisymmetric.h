@@ -193,8 +193,9 @@ struct InsertionOptions {
   /// radius (ring_crack_radius of the needle) reaching at least this depth; a second, cracked
   /// model runs in lock-step with the intact one.
   double crack_depth_m = 0.0;
-  /// The ring crack's faces in frictionless contact (linear layers, sticking: exact; otherwise
-  /// the faces stay free and only their overlap is reported); false leaves them free.
+  /// The ring crack's faces in frictionless node-to-node contact (linear layers with sticking
+  /// contact; otherwise the faces stay free and only their overlap is reported); false leaves
+  /// them free.
   bool crack_face_contact = true;
   /// Called after each output step; returning false stops the insertion there.
   std::function<bool(const InsertionStep&)> on_step;

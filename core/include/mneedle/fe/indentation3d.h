@@ -119,8 +119,8 @@ class Indentation3d {
   /// The node pairs of a crack's faces, whose overlap every Step3d reports. With `contact`, the
   /// faces are in frictionless contact (docs/model.md, "Crack faces in contact"): at each pair
   /// they may open and slide but not pass through each other, and a pair in contact carries a
-  /// compressive normal force only. Contact is exact (an active set on the condensed
-  /// compliance) for linear tissue with sticking needle contact; with frictionless needle
+  /// compressive normal force only. Contact is solved (node to node, an active set on the
+  /// condensed compliance) for linear tissue with sticking needle contact; with frictionless needle
   /// contact or nonlinear tissue the faces stay free (traction-free) and only their overlap is
   /// reported. Call before the first advance_to. InputError for a node out of range or a
   /// non-unit normal.
