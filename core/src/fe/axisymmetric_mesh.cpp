@@ -86,7 +86,12 @@ std::vector<double> depth_grid(const std::vector<AxisymmetricLayer>& layers,
     for (double bottom : ends) {
       const double fraction = (bottom - top) / layers[k].thickness_m;
       const int minimum = std::max(1, static_cast<int>(std::ceil(layer_minimum * fraction - 1e-9)));
-      const double fine_end = std::clamp(o.fine_depth_m, top, bottom);
+      // A fine-zone end within round-off of a segment's end (a depth break computed as 2a where
+      // the fine zone ends at a + a) would leave a row of zero height.
+      double fine_end = std::clamp(o.fine_depth_m, top, bottom);
+      const double snap = 1e-9 * (bottom - top);
+      if (bottom - fine_end <= snap) fine_end = bottom;
+      if (fine_end - top <= snap) fine_end = top;
       if (fine_end > top) {
         const bool whole = fine_end >= bottom;
         append_uniform(s, top, fine_end, uniform_count(fine_end - top, o.h_m, whole ? minimum : 1));

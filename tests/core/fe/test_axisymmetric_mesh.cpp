@@ -64,6 +64,25 @@ TEST(AxisymmetricMesh, EveryElementIsCounterClockwiseAndLayerBoundariesAreClampe
   for (std::uint32_t n : mesh.surface_nodes) EXPECT_EQ(mesh.nodes[n].y(), 0.0);
 }
 
+// A depth break a round-off away from the end of the fine zone (a crack depth computed as 2 a
+// where the fine zone ends at a + a) is the same row, not a row of zero height.
+TEST(AxisymmetricMesh, DepthBreakWithinRoundOffOfTheFineZoneEndAddsNoSliverRow) {
+  AxisymmetricMeshOptions o;
+  o.radius_m = 2e-3;
+  o.h_m = 2e-5;
+  o.fine_radius_m = 2.3e-4;
+  o.fine_depth_m = 115e-6 + 115e-6;
+  o.depth_breaks_m = {std::nextafter(o.fine_depth_m, 1.0)};
+  const AxisymmetricMesh mesh =
+      make_axisymmetric_mesh({{1e-3, material(MaterialModel::Linear, 1e5, 0.4)}}, o);
+  EXPECT_GT(mesh.min_angle_deg, 1.0);
+  for (const auto& e : mesh.elements) {
+    const Eigen::Vector2d a = mesh.nodes[e[1]] - mesh.nodes[e[0]];
+    const Eigen::Vector2d b = mesh.nodes[e[2]] - mesh.nodes[e[0]];
+    ASSERT_GT(a.x() * b.y() - a.y() * b.x(), 1e-6 * o.h_m * o.h_m);
+  }
+}
+
 TEST(AxisymmetricMesh, RejectsEmptyLayersAndBadSizes) {
   AxisymmetricMeshOptions o;
   o.radius_m = 1e-3;
