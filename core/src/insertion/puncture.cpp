@@ -155,7 +155,7 @@ double interpolate_at(const std::vector<double>& depths_m, const std::vector<dou
 }
 
 double crack_depth_for(double needle_radius_m, double tip_element_size_m) {
-  return std::max(needle_radius_m, 2.0 * tip_element_size_m);
+  return std::max(2.0 * needle_radius_m, 2.0 * tip_element_size_m);
 }
 
 }  // namespace mneedle

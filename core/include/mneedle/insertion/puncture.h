@@ -67,7 +67,7 @@ std::optional<Crossing> first_crossing(const std::vector<double>& depths_m,
 double interpolate_at(const std::vector<double>& depths_m, const std::vector<double>& values,
                       double depth_m);
 
-/// Depth of the planar (3-D) or ring (axisymmetric) crack used for G: the needle's radius,
+/// Depth of the planar (3-D) or ring (axisymmetric) crack used for G: the needle's diameter,
 /// at least two tip elements so the mesh resolves it (docs/model.md, "Criteria").
 double crack_depth_for(double needle_radius_m, double tip_element_size_m);
 
