@@ -323,7 +323,8 @@ using FacePairs = std::vector<std::array<std::uint32_t, 2>>;
 // Active-set rounds of the crack-face contact per solve; a pair closes when its faces overlap by
 // more than kCrackGapTolerance x the current depth (round-off of the condensed solve is ~1e-16
 // of it).
-constexpr int kMaxCrackRounds = 100;
+constexpr int kMaxCrackRounds = 100;   // plus four per pair
+constexpr int kCrackBlockRounds = 20;  // rounds that open every pulling pair at once
 constexpr double kCrackGapTolerance = 1e-10;
 // A closed pair pulls when its force is below -kCrackForceFloor x the largest condensed force.
 constexpr double kCrackForceFloor = 1e-12;
@@ -518,22 +519,28 @@ class LinearStepper : public Stepper {
       return;
     }
     const double tolerance = kCrackGapTolerance * std::max(depth, 1e-12);
-    for (int round = 0; round < kMaxCrackRounds; ++round) {
+    const int rounds = kMaxCrackRounds + 4 * static_cast<int>(pairs_.size());
+    for (int round = 0; round < rounds; ++round) {
       std::vector<std::array<int, 2>> dofs;
       for (std::size_t p : closed_)
         dofs.push_back({surface_->index_of(pairs_[p][0]), surface_->index_of(pairs_[p][1])});
       surface_->solve(mesh_, state_, depth, u_, f_, dofs);
-      // The pair pulled hardest opens, one per round; when none pulls, every overlapping pair
-      // closes.
+      // Pulling pairs open, all at once for the first kCrackBlockRounds rounds and then the one
+      // pulled hardest per round; when none pulls, every overlapping pair closes.
       const double floor = kCrackForceFloor * f_.lpNorm<Eigen::Infinity>();
       std::size_t worst = closed_.size();
       double worst_force = -floor;
+      std::vector<std::size_t> kept;
       for (std::size_t c = 0; c < closed_.size(); ++c) {
         const double force = f_[surface_->index_of(pairs_[closed_[c]][1])];
         if (force < worst_force) worst = c, worst_force = force;
+        if (force >= -floor) kept.push_back(closed_[c]);
       }
       if (worst < closed_.size()) {
-        closed_.erase(closed_.begin() + static_cast<std::ptrdiff_t>(worst));
+        if (round < kCrackBlockRounds)
+          closed_ = std::move(kept);
+        else
+          closed_.erase(closed_.begin() + static_cast<std::ptrdiff_t>(worst));
         continue;
       }
       const Eigen::VectorXd gaps = face_gaps(pairs_);

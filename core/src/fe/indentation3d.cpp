@@ -58,7 +58,8 @@ constexpr double kUzawaTolerance = 1e-4;
 constexpr int kMaxContactNewton = 60;
 // Crack-face contact: active-set rounds per solve; a pair closes when its faces overlap by more
 // than kCrackGapTolerance x the current depth (round-off of the condensed solve is ~1e-16 of it).
-constexpr int kMaxCrackRounds = 100;
+constexpr int kMaxCrackRounds = 100;   // plus four per pair
+constexpr int kCrackBlockRounds = 20;  // rounds that open every pulling pair at once
 constexpr double kCrackGapTolerance = 1e-10;
 // A pair force below -kCrackForceFloor x the largest force of the solve pulls (round-off of a
 // dense solve is ~1e-15 of it).
@@ -369,20 +370,32 @@ struct Indentation3d::Impl {
       solve_with_active_pairs(at_depth);
       return;
     }
-    // Active set (docs/model.md, "Crack faces in contact"): the pair in contact pulled hardest
-    // (λ < 0) opens, one per round; when none pulls, every open pair whose faces overlap
-    // closes; repeat until nothing changes.
+    // Active set (docs/model.md, "Crack faces in contact"): pairs in contact that pull (λ < 0)
+    // open, all at once for the first kCrackBlockRounds rounds and then the one pulled hardest
+    // per round (which cannot cycle the way block exchanges can); when none pulls, every open
+    // pair whose faces overlap closes; repeat until nothing changes. The round limit grows with
+    // the pairs: a shallow step can close most of a fine mesh's crack at once and open it again
+    // pair by pair.
     const double tolerance = kCrackGapTolerance * std::max(at_depth, 1e-12);
-    for (int round = 0; round < kMaxCrackRounds; ++round) {
+    const int rounds = kMaxCrackRounds + 4 * static_cast<int>(pairs.size());
+    for (int round = 0; round < rounds; ++round) {
       std::erase_if(active_pairs, [&](int p) { return pair_held(static_cast<std::size_t>(p)); });
       pair_forces.resize(static_cast<Eigen::Index>(active_pairs.size()));
       solve_with_active_pairs(at_depth);
       const double floor = kCrackForceFloor * std::max(multipliers.lpNorm<Eigen::Infinity>(),
                                                        pair_forces.lpNorm<Eigen::Infinity>());
       if (pair_forces.size() > 0 && pair_forces.minCoeff() < -floor) {
-        Eigen::Index worst = 0;
-        pair_forces.minCoeff(&worst);
-        active_pairs.erase(active_pairs.begin() + worst);
+        if (round < kCrackBlockRounds) {
+          std::vector<int> kept;
+          for (std::size_t a = 0; a < active_pairs.size(); ++a)
+            if (pair_forces(static_cast<Eigen::Index>(a)) >= -floor)
+              kept.push_back(active_pairs[a]);
+          active_pairs = std::move(kept);
+        } else {
+          Eigen::Index worst = 0;
+          pair_forces.minCoeff(&worst);
+          active_pairs.erase(active_pairs.begin() + worst);
+        }
         continue;
       }
       const Eigen::VectorXd gaps = pair_gaps_now();
