@@ -145,6 +145,9 @@ double needle_force(const ContactState& state, const Eigen::VectorXd& reaction) 
   return force;
 }
 
+// A ring crack's faces: each doubled node {inner, outer}.
+using FacePairs = std::vector<std::array<std::uint32_t, 2>>;
+
 // Linear insertion: one factorisation, the stiffness condensed onto the reachable surface dofs
 // (Schur complement S); every depth is then a small dense solve.
 class CondensedSurface {
@@ -300,6 +303,16 @@ class CondensedSurface {
 
   int index_of(std::uint32_t node) const { return index_.at(node); }
 
+  /// Gap u_r(outer) - u_r(inner) of each crack-face pair in condensed displacements u (every
+  /// pair node condensed; zeros before the first solve).
+  Eigen::VectorXd gaps(const Eigen::VectorXd& u, const FacePairs& pairs) const {
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs.size()));
+    if (u.size() == 0) return g;
+    for (std::size_t p = 0; p < pairs.size(); ++p)
+      g[static_cast<Eigen::Index>(p)] = u[index_of(pairs[p][1])] - u[index_of(pairs[p][0])];
+    return g;
+  }
+
   // Full-length displacement vector holding only the candidates' values (for capture tests).
   Eigen::VectorXd scatter(const Eigen::VectorXd& u, std::size_t n) const {
     Eigen::VectorXd full = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
@@ -317,9 +330,6 @@ class CondensedSurface {
 };
 
 // One insertion on one model, advanced to a growing sequence of depths.
-// A ring crack's faces: each doubled node {inner, outer}.
-using FacePairs = std::vector<std::array<std::uint32_t, 2>>;
-
 // Active-set rounds of the crack-face contact per solve; a pair closes when its faces overlap by
 // more than kCrackGapTolerance x the current depth (round-off of the condensed solve is ~1e-16
 // of it).
@@ -469,12 +479,8 @@ class LinearStepper : public Stepper {
   }
 
   Eigen::VectorXd face_gaps(const FacePairs& pairs) const override {
-    Eigen::VectorXd gaps = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs.size()));
-    if (!surface_ || u_.size() == 0) return gaps;
-    for (std::size_t p = 0; p < pairs.size(); ++p)
-      gaps[static_cast<Eigen::Index>(p)] =
-          u_[surface_->index_of(pairs[p][1])] - u_[surface_->index_of(pairs[p][0])];
-    return gaps;
+    if (!surface_) return Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs.size()));
+    return surface_->gaps(u_, pairs);
   }
   int closed_pairs() const override { return static_cast<int>(closed_.size()); }
 
@@ -510,9 +516,9 @@ class LinearStepper : public Stepper {
   }
 
  private:
-  // Crack-face contact by an active set (docs/model.md, "Crack faces in contact"): a closed
-  // pair whose contact force pulls (the outer node's radial force below zero) opens, an open
-  // pair whose faces overlap closes, until nothing changes.
+  // Crack-face contact by an active set (docs/model.md, "Crack faces in contact"): closed pairs
+  // whose contact force pulls (the outer node's radial force below zero) open, open pairs whose
+  // faces overlap close, until nothing changes.
   void solve_contact(double depth) {
     if (!close_pairs_ || pairs_.empty()) {
       surface_->solve(mesh_, state_, depth, u_, f_);
@@ -609,12 +615,7 @@ class FrictionlessStepper : public Stepper {
   }
 
   Eigen::VectorXd face_gaps(const FacePairs& pairs) const override {
-    Eigen::VectorXd gaps = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs.size()));
-    if (u_.size() == 0) return gaps;
-    for (std::size_t p = 0; p < pairs.size(); ++p)
-      gaps[static_cast<Eigen::Index>(p)] =
-          u_[surface_->index_of(pairs[p][1])] - u_[surface_->index_of(pairs[p][0])];
-    return gaps;
+    return surface_->gaps(u_, pairs);
   }
 
   InsertionStep advance_to(double depth) override {

@@ -319,9 +319,10 @@ TEST(AxisymmetricCrack, NonlinearTwinMatchesLinearAtSmallStrain) {
   // Strain ~ d / a = 1e-4: the models differ by O(strain) in U; G is a difference of two U
   // about 10 % apart, so the relative difference grows to ~1e-3.
   EXPECT_NEAR(neo.energy_release_rate_J_per_m2 / linear.energy_release_rate_J_per_m2, 1.0, 1e-2);
-  // Both report the same overlap of the free faces (the inner face bulges out under the punch).
+  // Both report the same overlap of the free faces (the inner face bulges out under the punch): a
+  // displacement, so the models differ by O(strain) = 1e-4 (measured 1e-6); 1e-3 allows ten times.
   EXPECT_GT(linear.crack_face_overlap_m, 0.0);
-  EXPECT_NEAR(neo.crack_face_overlap_m / linear.crack_face_overlap_m, 1.0, 1e-2);
+  EXPECT_NEAR(neo.crack_face_overlap_m / linear.crack_face_overlap_m, 1.0, 1e-3);
 }
 
 TEST(AxisymmetricCrack, ConeCrackRadiusIsTheFootprintAtTheFinalDepth) {
