@@ -14,6 +14,7 @@
 
 #include "mneedle/base/error.h"
 #include "mneedle/fe/sparse_solver.h"
+#include "plane_strain_element.h"
 
 namespace mneedle::fe {
 namespace {
@@ -40,11 +41,6 @@ std::string str(double v) {
 
 double element_size(const CrackOpeningProblem& p) {
   return p.element_size_m > 0.0 ? p.element_size_m : p.crack_width_m * kCrackDefaultElementFraction;
-}
-
-// Number of intervals of a geometric sequence starting at h, ratio g, covering `length`.
-double graded_count(double length, double h, double g) {
-  return std::ceil(std::log1p(length * (g - 1.0) / h) / std::log(g));
 }
 
 void check(const CrackOpeningProblem& p) {
@@ -83,21 +79,6 @@ void check(const CrackOpeningProblem& p) {
                               " nodes, more than the limit " + str(kCrackMaxNodes));
 }
 
-// Points after `a` up to `b`: spacings start at h and grow by g; the last interval absorbs the
-// remainder (merged into the previous one when it is under half a spacing).
-void append_graded(std::vector<double>& points, double a, double b, double h, double g) {
-  double x = a;
-  while (true) {
-    if (x + h >= b - 0.5 * h) {
-      points.push_back(b);
-      return;
-    }
-    x += h;
-    points.push_back(x);
-    h *= g;
-  }
-}
-
 struct Grid {
   std::vector<double> x, y;
   int slit_end = 0;  // index of x = a (the crack tip) in x
@@ -121,42 +102,6 @@ Grid make_grid(const CrackOpeningProblem& p) {
   return g;
 }
 
-// Bilinear rectangle hx x hy, plane strain, selective reduced integration: the mu part at 2 x 2
-// Gauss points, the lambda (volumetric) part at the centre, so that nu near 0.5 does not lock.
-// Node order (0,0), (hx,0), (hx,hy), (0,hy); dofs u_x, u_y per node.
-Eigen::Matrix<double, 8, 8> rectangle_stiffness(double hx, double hy, double E, double nu) {
-  const double lambda = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
-  const double mu = E / (2.0 * (1.0 + nu));
-  const std::array<double, 4> xi_a{-1, 1, 1, -1}, eta_a{-1, -1, 1, 1};
-  auto B_at = [&](double xi, double eta) {
-    Eigen::Matrix<double, 3, 8> B = Eigen::Matrix<double, 3, 8>::Zero();
-    for (int k = 0; k < 4; ++k) {
-      const double dx = 0.25 * xi_a[k] * (1.0 + eta * eta_a[k]) * 2.0 / hx;
-      const double dy = 0.25 * eta_a[k] * (1.0 + xi * xi_a[k]) * 2.0 / hy;
-      B(0, 2 * k) = dx;
-      B(1, 2 * k + 1) = dy;
-      B(2, 2 * k) = dy;
-      B(2, 2 * k + 1) = dx;
-    }
-    return B;
-  };
-  const double detJ = 0.25 * hx * hy;
-  Eigen::Matrix3d D_mu = Eigen::Matrix3d::Zero();
-  D_mu(0, 0) = D_mu(1, 1) = 2.0 * mu;
-  D_mu(2, 2) = mu;
-  Eigen::Matrix<double, 8, 8> K = Eigen::Matrix<double, 8, 8>::Zero();
-  const double g = 1.0 / std::sqrt(3.0);
-  for (double xi : {-g, g})
-    for (double eta : {-g, g}) {
-      const Eigen::Matrix<double, 3, 8> B = B_at(xi, eta);
-      K += B.transpose() * D_mu * B * detJ;
-    }
-  const Eigen::Matrix<double, 3, 8> B0 = B_at(0.0, 0.0);
-  const Eigen::Matrix<double, 1, 8> div = B0.row(0) + B0.row(1);
-  K += lambda * div.transpose() * div * (4.0 * detJ);
-  return K;
-}
-
 class Model {
  public:
   explicit Model(const CrackOpeningProblem& p) : grid_(make_grid(p)) {
@@ -166,9 +111,9 @@ class Model {
     t.reserve(static_cast<std::size_t>(64) * (nx - 1) * (ny - 1));
     for (int j = 0; j + 1 < ny; ++j)
       for (int i = 0; i + 1 < nx; ++i) {
-        const Eigen::Matrix<double, 8, 8> k =
-            rectangle_stiffness(grid_.x[i + 1] - grid_.x[i], grid_.y[j + 1] - grid_.y[j],
-                                p.youngs_modulus_Pa, p.poisson_ratio);
+        const Eigen::Matrix<double, 8, 8> k = plane_strain_rectangle_stiffness(
+            grid_.x[i + 1] - grid_.x[i], grid_.y[j + 1] - grid_.y[j], p.youngs_modulus_Pa,
+            p.poisson_ratio);
         const std::array<int, 4> n{grid_.node(i, j), grid_.node(i + 1, j), grid_.node(i + 1, j + 1),
                                    grid_.node(i, j + 1)};
         for (int a = 0; a < 8; ++a)

@@ -1,0 +1,451 @@
+// Plane-strain insertion along a cut (paper C §6, docs/model.md "Plane-strain insertion"): a
+// graded grid of bilinear rectangles, factorised once; the contact of the cut's nodes with the
+// needle (frictionless tip, Coulomb shaft) and with their mirror image solved step by step on the
+// cut's compliance by an active set.
+#include "mneedle/fe/plane_strain_insertion.h"
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "mneedle/base/error.h"
+#include "mneedle/fe/sparse_solver.h"
+#include "plane_strain_element.h"
+
+namespace mneedle::fe {
+namespace {
+
+// A node counts as inside the needle (or its mirror) beyond this fraction of w, and a contact
+// force as tensile beyond this fraction of the largest force: round-off must not toggle a node.
+constexpr double kGapTolerance = 1e-9;
+constexpr double kForceTolerance = 1e-10;
+
+[[noreturn]] void bad(const std::string& field, const std::string& what) {
+  throw InputError("plane-strain insertion: " + field + " " + what);
+}
+
+std::string str(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+double element_size(const PlaneStrainInsertionProblem& p) {
+  return p.element_size_m > 0.0 ? p.element_size_m : p.needle_width_m / 8.0;
+}
+double uniform_zone(const PlaneStrainInsertionProblem& p) {
+  const double zone = p.uniform_zone_m > 0.0 ? p.uniform_zone_m : 4.0 * p.needle_width_m;
+  return std::min(zone, 0.5 * p.block_width_m);
+}
+double tip_length(const PlaneStrainInsertionProblem& p) {
+  return 0.5 * p.needle_width_m / std::tan(0.5 * p.tip_angle_rad);
+}
+
+void check(const PlaneStrainInsertionProblem& p) {
+  auto positive = [](const char* field, double v) {
+    if (!std::isfinite(v) || v <= 0.0) bad(field, "must be positive and finite, got " + str(v));
+  };
+  positive("youngs_modulus_Pa", p.youngs_modulus_Pa);
+  if (!std::isfinite(p.poisson_ratio) || p.poisson_ratio < 0.0 || p.poisson_ratio >= 0.5)
+    bad("poisson_ratio", "must be in [0, 0.5), got " + str(p.poisson_ratio));
+  positive("block_width_m", p.block_width_m);
+  positive("block_depth_m", p.block_depth_m);
+  positive("thickness_m", p.thickness_m);
+  positive("needle_width_m", p.needle_width_m);
+  if (!std::isfinite(p.tip_angle_rad) || p.tip_angle_rad <= 0.0 ||
+      p.tip_angle_rad >= std::numbers::pi)
+    bad("tip_angle_rad", "must be in (0, pi), got " + str(p.tip_angle_rad));
+  if (!std::isfinite(p.friction_coefficient) || p.friction_coefficient < 0.0)
+    bad("friction_coefficient",
+        "must be finite and not negative, got " + str(p.friction_coefficient));
+  positive("travel_m", p.travel_m);
+  if (p.travel_m > 2.0 * p.block_depth_m)
+    bad("travel_m",
+        str(p.travel_m) + " m is more than twice block_depth_m " + str(p.block_depth_m) + " m");
+  if (p.block_width_m < 4.0 * p.needle_width_m)
+    bad("block_width_m", str(p.block_width_m) + " m is less than 4 needle widths (" +
+                             str(4.0 * p.needle_width_m) + " m)");
+  for (const auto& [field, v] :
+       {std::pair{"element_size_m", p.element_size_m}, std::pair{"step_m", p.step_m},
+        std::pair{"uniform_zone_m", p.uniform_zone_m}})
+    if (!std::isfinite(v) || v < 0.0)
+      bad(field, "must be positive (or 0 for the default), got " + str(v));
+  const double h = element_size(p);
+  if (h > p.needle_width_m / 4.0)
+    bad("element_size_m", str(h) + " m leaves fewer than 2 cells across the needle's half width " +
+                              str(0.5 * p.needle_width_m) + " m");
+  if (h > 0.5 * tip_length(p))
+    bad("element_size_m", str(h) + " m leaves fewer than 2 cells along the tip's length " +
+                              str(tip_length(p)) + " m");
+  const double step = p.step_m > 0.0 ? p.step_m : kInsertionDefaultStepFraction * h;
+  if (step > h)
+    bad("step_m", str(step) + " m is longer than a cell (" + str(h) +
+                      " m): a cut node would cross the tip within one step");
+  // Counted before anything is allocated: a tiny size must not start unbounded work.
+  const double cut = std::ceil(p.block_depth_m / h) + 1.0;
+  if (cut > kInsertionMaxCutNodes)
+    bad("element_size_m", str(h) + " m puts " + str(cut) + " nodes on the cut, more than " +
+                              str(kInsertionMaxCutNodes));
+  const double zone = uniform_zone(p);
+  const double across =
+      std::ceil(zone / h) + graded_count(0.5 * p.block_width_m - zone, h, kInsertionGridGrowth) + 1;
+  if (across * cut > kInsertionMaxNodes)
+    bad("element_size_m", str(h) + " m would need about " + str(across * cut) +
+                              " nodes, more than the limit " + str(kInsertionMaxNodes));
+  if (std::ceil(p.travel_m / step) > kInsertionMaxSteps)
+    bad("step_m", str(step) + " m would need more than " + str(kInsertionMaxSteps) + " steps");
+}
+
+struct Grid {
+  std::vector<double> x;  // 0 (the cut) .. width/2
+  std::vector<double> y;  // 0 (top) .. -depth
+  int nx() const { return static_cast<int>(x.size()); }
+  int ny() const { return static_cast<int>(y.size()); }
+  int node(int i, int j) const { return j * nx() + i; }
+};
+
+Grid make_grid(const PlaneStrainInsertionProblem& p) {
+  Grid g;
+  const double zone = uniform_zone(p);
+  const int n = static_cast<int>(std::ceil(zone / element_size(p) - 1e-9));
+  const double hx = zone / n;
+  for (int i = 0; i <= n; ++i) g.x.push_back(zone * i / n);
+  if (zone < 0.5 * p.block_width_m)
+    append_graded(g.x, zone, 0.5 * p.block_width_m, hx, kInsertionGridGrowth);
+  const int m = static_cast<int>(std::ceil(p.block_depth_m / element_size(p) - 1e-9));
+  for (int j = 0; j <= m; ++j) g.y.push_back(-p.block_depth_m * j / m);
+  return g;
+}
+
+// Corner: held at the shoulder, where the flank meets the shaft; Apex: held at the tip, where the
+// flank meets the mirror plane. At either vertex the force may point anywhere between the two
+// faces' normals (a node sliding up the flank reaches the shaft at the corner; a node ahead of the
+// tip meets the flank at the apex).
+enum class State { Free, Mirror, Flank, Corner, Apex, Stick, Slip };
+bool on_needle(State s) {
+  return s == State::Flank || s == State::Corner || s == State::Apex || s == State::Stick ||
+         s == State::Slip;
+}
+bool on_shaft(State s) {
+  return s == State::Stick || s == State::Slip;
+}
+
+// The block: stiffness factorised once, and the compliance of the cut's dofs.
+class Block {
+ public:
+  explicit Block(const PlaneStrainInsertionProblem& p) : grid_(make_grid(p)) {
+    const int nx = grid_.nx(), ny = grid_.ny();
+    const int dofs = 2 * nx * ny;
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(static_cast<std::size_t>(64) * (nx - 1) * (ny - 1));
+    for (int j = 0; j + 1 < ny; ++j)
+      for (int i = 0; i + 1 < nx; ++i) {
+        // The rectangle's node order (0,0), (hx,0), (hx,hy), (0,hy) with y up: row j+1 is below.
+        const Eigen::Matrix<double, 8, 8> k = plane_strain_rectangle_stiffness(
+            grid_.x[i + 1] - grid_.x[i], grid_.y[j] - grid_.y[j + 1], p.youngs_modulus_Pa,
+            p.poisson_ratio);
+        const std::array<int, 4> n{grid_.node(i, j + 1), grid_.node(i + 1, j + 1),
+                                   grid_.node(i + 1, j), grid_.node(i, j)};
+        for (int a = 0; a < 8; ++a)
+          for (int b = 0; b < 8; ++b)
+            t.emplace_back(2 * n[a / 2] + a % 2, 2 * n[b / 2] + b % 2, k(a, b));
+      }
+    Eigen::SparseMatrix<double> K(dofs, dofs);
+    K.setFromTriplets(t.begin(), t.end());
+    fixed_.assign(dofs, 0);
+    for (int j = 0; j < ny; ++j)
+      for (int c = 0; c < 2; ++c) fixed_[2 * grid_.node(nx - 1, j) + c] = 1;  // pinned side
+    for (int i = 0; i < nx; ++i) fixed_[2 * grid_.node(i, ny - 1) + 1] = 1;   // bottom rollers
+    // Supports as unit rows and columns: the loads below are zero on them, so they stay zero.
+    for (Eigen::Index col = 0; col < K.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(K, col); it; ++it)
+        if (fixed_[it.row()] || fixed_[col]) it.valueRef() = it.row() == col ? 1.0 : 0.0;
+    K.makeCompressed();
+    solver_.factorize(K);
+    if (!solver_.ok())
+      throw SolverError("plane-strain insertion: the stiffness matrix could not be factorised");
+  }
+
+  const Grid& grid() const { return grid_; }
+  bool y_fixed(int j) const { return fixed_[2 * grid_.node(0, j) + 1] != 0; }
+
+  // C(2j + c, 2k + d): u_c of cut node j under a unit force d on cut node k (0 on supports).
+  Eigen::MatrixXd cut_compliance() const {
+    const int m = 2 * grid_.ny();
+    constexpr int kBlock = 64;
+    Eigen::MatrixXd C(m, m);
+    for (int first = 0; first < m; first += kBlock) {
+      const int b = std::min(kBlock, m - first);
+      Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(fixed_.size(), b);
+      for (int k = 0; k < b; ++k) {
+        const int dof = 2 * grid_.node(0, (first + k) / 2) + (first + k) % 2;
+        if (!fixed_[dof]) rhs(dof, k) = 1.0;
+      }
+      const Eigen::MatrixXd u = solver_.solve_many(rhs);
+      for (int r = 0; r < m; ++r) {
+        const int dof = 2 * grid_.node(0, r / 2) + r % 2;
+        if (fixed_[dof])
+          C.block(r, first, 1, b).setZero();
+        else
+          C.block(r, first, 1, b) = u.block(dof, 0, 1, b);
+      }
+    }
+    return C;
+  }
+
+ private:
+  Grid grid_;
+  std::vector<char> fixed_;
+  SparseSolver solver_;
+};
+
+}  // namespace
+
+PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInsertionProblem& p) {
+  check(p);
+  const Block block(p);
+  const Grid& g = block.grid();
+  const Eigen::MatrixXd C = block.cut_compliance();
+  const int m = g.ny();
+  const double w2 = 0.5 * p.needle_width_m;
+  const double mu = p.friction_coefficient;
+  const double tip = tip_length(p);
+  const double half_angle = 0.5 * p.tip_angle_rad;
+  // The right flank: tangent from the tip towards the shoulder, outward normal into the block.
+  const Eigen::Vector2d tangent(std::sin(half_angle), std::cos(half_angle));
+  const Eigen::Vector2d normal(std::cos(half_angle), -std::sin(half_angle));
+  const double gap_tol = kGapTolerance * p.needle_width_m;
+  const double scale = 2.0 * p.thickness_m;  // half model per metre -> whole block
+
+  PlaneStrainInsertionResult out;
+  out.nodes = g.nx() * g.ny();
+  out.elements = (g.nx() - 1) * (g.ny() - 1);
+  out.cut_nodes = m;
+  out.element_size_m = -g.y[1];
+  out.step_m = p.step_m > 0.0 ? p.step_m : kInsertionDefaultStepFraction * out.element_size_m;
+  out.tip_length_m = tip;
+  const int steps = static_cast<int>(std::ceil(p.travel_m / out.step_m - 1e-9));
+  out.steps.reserve(steps + 1);
+  out.steps.push_back({});
+
+  std::vector<State> state(m, State::Free);
+  std::vector<double> slip_sign(m, 1.0);
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(2 * m), u = Eigen::VectorXd::Zero(2 * m);
+  const int max_iterations = 50 + 4 * m;
+  for (int s = 1; s <= steps; ++s) {
+    const double travel = std::min(p.travel_m, s * out.step_m);
+    const double dd = travel - out.steps.back().travel_m;
+    const double tip_y = -travel, shoulder_y = tip_y + tip;
+    const Eigen::VectorXd f_prev = f, u_prev = u;
+    const std::vector<State> state_prev = state;
+    // Where a node at height y meets the needle: 2 shaft, 1 flank, 0 below the tip.
+    auto zone = [&](double y) { return y >= shoulder_y ? 2 : y >= tip_y ? 1 : 0; };
+    auto needle_gap = [&](int j, double ux, double uy) {
+      const double y = g.y[j] + uy;
+      switch (zone(y)) {
+        case 2:
+          return ux - w2;
+        case 1:
+          return normal.dot(Eigen::Vector2d(ux, y - tip_y));
+        default:
+          return std::numeric_limits<double>::infinity();
+      }
+    };
+    // The vertices move with the needle: a node held at one at the last step now lies beside the
+    // face that trails it (the shaft behind the shoulder, the flank behind the tip).
+    for (int j = 0; j < m; ++j) {
+      if (state[j] == State::Corner) state[j] = State::Slip, slip_sign[j] = 1.0;
+      if (state[j] == State::Apex) state[j] = State::Flank;
+    }
+    std::vector<int> vertex_visits(m, 0);
+    int iterations = 0;
+    for (;;) {
+      if (iterations == max_iterations)
+        throw SolverError("plane-strain insertion: the contact set did not settle at travel " +
+                          str(travel * 1e3) + " mm in " + std::to_string(max_iterations) +
+                          " active-set iterations");
+      ++iterations;
+      std::vector<int> act;
+      for (int j = 0; j < m; ++j)
+        if (state[j] != State::Free) act.push_back(j);
+      const int a = static_cast<int>(act.size());
+      std::vector<int> dof(2 * a);
+      for (int k = 0; k < a; ++k) dof[2 * k] = 2 * act[k], dof[2 * k + 1] = 2 * act[k] + 1;
+      Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * a, 2 * a);
+      Eigen::VectorXd b = Eigen::VectorXd::Zero(2 * a);
+      auto u_row = [&](int r) {  // the row giving cut dof r's displacement from the active forces
+        Eigen::RowVectorXd row(2 * a);
+        for (int c = 0; c < 2 * a; ++c) row[c] = C(r, dof[c]);
+        return row;
+      };
+      for (int k = 0; k < a; ++k) {
+        const int j = act[k];
+        const int rx = 2 * k, ry = 2 * k + 1;
+        switch (state[j]) {
+          case State::Mirror:  // u_x = 0, frictionless
+            A.row(rx) = u_row(2 * j);
+            A(ry, ry) = 1.0;
+            break;
+          case State::Flank:  // on the flank's line, frictionless: f along the normal
+            A.row(rx) = normal.x() * u_row(2 * j) + normal.y() * u_row(2 * j + 1);
+            b[rx] = normal.dot(Eigen::Vector2d(0.0, tip_y - g.y[j]));
+            A(ry, rx) = tangent.x();
+            A(ry, ry) = tangent.y();
+            break;
+          case State::Corner:  // at the shoulder point
+          case State::Apex:    // at the tip point
+            A.row(rx) = u_row(2 * j);
+            b[rx] = state[j] == State::Corner ? w2 : 0.0;
+            A.row(ry) = u_row(2 * j + 1);
+            b[ry] = (state[j] == State::Corner ? shoulder_y : tip_y) - g.y[j];
+            break;
+          case State::Stick:  // on the shaft, moving with the needle
+            A.row(rx) = u_row(2 * j);
+            b[rx] = w2;
+            A.row(ry) = u_row(2 * j + 1);
+            b[ry] = u_prev[2 * j + 1] - dd;
+            break;
+          case State::Slip:  // on the shaft, friction mu N against the slip
+            A.row(rx) = u_row(2 * j);
+            b[rx] = w2;
+            A(ry, ry) = 1.0;
+            A(ry, rx) = slip_sign[j] * mu;
+            break;
+          case State::Free:
+            break;
+        }
+      }
+      f.setZero();
+      if (a > 0) {
+        const Eigen::VectorXd x = A.partialPivLu().solve(b);
+        if (!x.allFinite())
+          throw SolverError("plane-strain insertion: singular contact system at travel " +
+                            str(travel * 1e3) + " mm");
+        for (int c = 0; c < 2 * a; ++c) f[dof[c]] = x[c];
+      }
+      u = C * f;
+      const double force_tol = kForceTolerance * std::max(f.cwiseAbs().maxCoeff(), 1e-300);
+      bool changed = false;
+      for (int j = 0; j < m; ++j) {
+        const double ux = u[2 * j], uy = u[2 * j + 1], fx = f[2 * j], fy = f[2 * j + 1];
+        const double gap = needle_gap(j, ux, uy);
+        const int z = zone(g.y[j] + uy);
+        const State before = state[j];
+        switch (state[j]) {
+          case State::Free:
+          case State::Mirror:
+            if (gap < -gap_tol) {
+              state[j] = z == 2 ? State::Slip : State::Flank;
+              slip_sign[j] = 1.0;
+            } else if (state[j] == State::Free && ux < -gap_tol) {
+              state[j] = State::Mirror;
+            } else if (state[j] == State::Mirror && fx < -force_tol) {
+              state[j] = State::Free;
+            }
+            break;
+          case State::Flank:
+            if (normal.x() * fx + normal.y() * fy < -force_tol)
+              state[j] = State::Free;
+            else if (z == 2)
+              state[j] = State::Corner;
+            else if (z == 0)
+              state[j] = State::Apex;
+            break;
+          case State::Slip: {
+            // Relative slip of the node along the needle over the step (positive: the node moves
+            // up relative to the needle); the friction force on the node is -sign * mu N.
+            const double rel = (uy - u_prev[2 * j + 1]) + dd;
+            if (fx < -force_tol)
+              state[j] = State::Free;
+            else if (z != 2)
+              state[j] = z == 1 ? State::Corner : State::Free;
+            else if (mu > 0.0 && slip_sign[j] * rel < -gap_tol && !block.y_fixed(j))
+              state[j] = State::Stick;
+            break;
+          }
+          case State::Corner:
+          case State::Apex: {
+            // f = a n + b e_x: a the flank's share, b the other face's (the shaft at the corner,
+            // the mirror plane at the apex); both must push. A node that has come back to the
+            // vertex twice in this step stays there: its force leans just past one normal while
+            // that face's own solution puts it beyond the vertex, so no face is consistent (a
+            // discretisation effect of the sharp vertex; docs/model.md, "Plane-strain insertion").
+            const double on_flank = -fy / std::sin(half_angle);
+            const double on_other = fx - on_flank * normal.x();
+            if (vertex_visits[j] > 2) break;
+            if (on_flank < -force_tol && on_other < -force_tol)
+              state[j] = State::Free;
+            else if (on_flank < -force_tol)
+              state[j] = state[j] == State::Corner ? State::Slip : State::Mirror,
+              slip_sign[j] = 1.0;
+            else if (on_other < -force_tol)
+              state[j] = State::Flank;
+            break;
+          }
+          case State::Stick:
+            if (fx < -force_tol)
+              state[j] = State::Free;
+            else if (std::abs(fy) > mu * fx + force_tol)
+              state[j] = State::Slip, slip_sign[j] = fy < 0.0 ? 1.0 : -1.0;
+            break;
+        }
+        if ((state[j] == State::Corner || state[j] == State::Apex) && state[j] != before)
+          ++vertex_visits[j];
+        changed = changed || state[j] != before;
+      }
+      if (!changed) {
+        PlaneStrainInsertionStep st;
+        st.travel_m = travel;
+        st.active_set_iterations = iterations;
+        double friction_work = 0.0;
+        for (int j = 0; j < m; ++j) {
+          const double fx = f[2 * j], fy = f[2 * j + 1];
+          out.max_penetration_m =
+              std::max({out.max_penetration_m, -needle_gap(j, u[2 * j], u[2 * j + 1]), -u[2 * j]});
+          if (!on_needle(state[j])) continue;
+          st.force_N -= scale * fy;
+          if (state[j] == State::Flank || state[j] == State::Corner || state[j] == State::Apex) {
+            ++st.tip_contacts;
+            continue;
+          }
+          ++st.shaft_contacts;
+          st.friction_force_N -= scale * fy;
+          st.normal_force_N += scale * fx;
+          if (state[j] == State::Stick) {
+            ++st.sticking;
+            continue;
+          }
+          // mu N times the slip, N averaged over the step where the node was on the shaft at
+          // both ends (the trapezoid of the external work), its end value otherwise.
+          const double rel = std::abs(u[2 * j + 1] - u_prev[2 * j + 1] + dd);
+          const double n_mean = on_shaft(state_prev[j]) ? 0.5 * (fx + f_prev[2 * j]) : fx;
+          friction_work += scale * mu * n_mean * rel;
+        }
+        const PlaneStrainInsertionStep& last = out.steps.back();
+        st.external_work_J = last.external_work_J + 0.5 * (last.force_N + st.force_N) * dd;
+        st.friction_work_J = last.friction_work_J + friction_work;
+        st.strain_energy_J = 0.5 * scale * f.dot(u);
+        if (st.external_work_J > 0.0)
+          st.balance_error =
+              (st.external_work_J - st.strain_energy_J - st.friction_work_J) / st.external_work_J;
+        out.steps.push_back(st);
+        break;
+      }
+    }
+  }
+  const double final_work = out.steps.back().external_work_J;
+  for (const PlaneStrainInsertionStep& st : out.steps)
+    if (st.external_work_J > 1e-3 * final_work)
+      out.max_abs_balance_error = std::max(out.max_abs_balance_error, std::abs(st.balance_error));
+  return out;
+}
+
+}  // namespace mneedle::fe

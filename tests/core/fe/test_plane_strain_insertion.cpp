@@ -1,0 +1,131 @@
+#include "mneedle/fe/plane_strain_insertion.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <numbers>
+#include <string>
+
+#include "mneedle/base/error.h"
+
+namespace mneedle::fe {
+namespace {
+
+// Paper C §6 (Oldfield et al. 2013): gelatine E 7 kPa, nu 0.475, block 160 mm wide and 86 mm
+// deep, 15 mm out of plane, needle 8 mm wide with a 50 degree tip, 1.6 mm cells, through the
+// block's depth.
+PlaneStrainInsertionProblem paper_c(double mu) {
+  PlaneStrainInsertionProblem p;
+  p.youngs_modulus_Pa = 7e3;
+  p.poisson_ratio = 0.475;
+  p.block_width_m = 0.16;
+  p.block_depth_m = 0.086;
+  p.thickness_m = 0.015;
+  p.needle_width_m = 0.008;
+  p.tip_angle_rad = 50.0 * std::numbers::pi / 180.0;
+  p.friction_coefficient = mu;
+  p.element_size_m = 1.6e-3;
+  p.travel_m = 0.086;
+  return p;
+}
+
+const PlaneStrainInsertionResult& paper_c_run() {
+  static const PlaneStrainInsertionResult r = simulate_plane_strain_insertion(paper_c(0.5));
+  return r;
+}
+
+// Paper C's Table 1, "finite element with no cohesion": external work 0.058 J, friction 0.052 J,
+// strain energy 0.006 J (mu 0.5, the block's depth). Our absolute level is 23 % lower (a miss,
+// docs/validation.md "Plane-strain insertion"); the split of the work is the paper's.
+TEST(PlaneStrainInsertion, PaperCRunWithoutCohesionSplitsTheWorkAsItsTable1Row) {
+  const PlaneStrainInsertionStep& end = paper_c_run().steps.back();
+  ASSERT_DOUBLE_EQ(end.travel_m, 0.086);
+  // Friction's share: paper 0.052 / 0.058 = 0.897, each number given to +-0.0005 J, so the
+  // share is known to +-2 %; ours 0.892.
+  EXPECT_NEAR(end.friction_work_J / end.external_work_J / (0.052 / 0.058), 1.0, 0.02);
+  // Strain energy's share: paper 0.006 / 0.058 = 0.103, known to +-9 % (one digit); ours 0.107.
+  EXPECT_NEAR(end.strain_energy_J / end.external_work_J / (0.006 / 0.058), 1.0, 0.09);
+  // Our converged external work (44.74 mJ on 0.4 mm cells, 44.57 mJ here): 1 % is twice the
+  // distance between the two meshes, far below the 23 % by which it misses the paper's 58 mJ.
+  EXPECT_NEAR(end.external_work_J / 44.74e-3, 1.0, 0.01);
+}
+
+TEST(PlaneStrainInsertion, EnergyLedgerClosesAtEveryStepWithFriction) {
+  // W_ext (trapezoid of the force) against U + W_f (mu N times each node's slip): independent
+  // sums that agree to first order in the step; measured 0.19 % at h/8, 4.4 % at h/2. 1 % is
+  // five times the measured value and half paper C's 2 % requirement.
+  EXPECT_LT(paper_c_run().max_abs_balance_error, 0.01);
+}
+
+TEST(PlaneStrainInsertion, ShaftFrictionIsCoulombsAndGrowsLinearlyWithDepth) {
+  const PlaneStrainInsertionResult& r = paper_c_run();
+  double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+  int n = 0;
+  for (const PlaneStrainInsertionStep& s : r.steps) {
+    // Never more than mu N; exactly mu N when no shaft node sticks (all slide here).
+    EXPECT_LE(s.friction_force_N, 0.5 * s.normal_force_N * (1.0 + 1e-9) + 1e-12);
+    if (s.sticking == 0) {
+      EXPECT_NEAR(s.friction_force_N, 0.5 * s.normal_force_N, 1e-9);
+    }
+    if (s.travel_m <= 2.0 * r.tip_length_m) continue;
+    sx += s.travel_m, sy += s.friction_force_N, sxx += s.travel_m * s.travel_m;
+    sxy += s.travel_m * s.friction_force_N, syy += s.friction_force_N * s.friction_force_N;
+    ++n;
+  }
+  // Paper C eq. 2 takes the friction force as linear in depth (F_max x / d); its FE (§7) finds it
+  // "essentially linear". Ours: R^2 = 0.9915 once the shoulder is two tip lengths in; 0.98 is
+  // what a force with a 10 % bow would give. And W_f = 0.923 F_f(d) d / 2: the friction work the
+  // energy method of eq. 2 would assume is 8 % above ours; 0.85-1.0 brackets it.
+  const double cov = sxy - sx * sy / n, vx = sxx - sx * sx / n, vy = syy - sy * sy / n;
+  EXPECT_GT(cov * cov / (vx * vy), 0.98);
+  const PlaneStrainInsertionStep& end = r.steps.back();
+  const double eq2 = end.friction_work_J / (0.5 * end.friction_force_N * end.travel_m);
+  EXPECT_GT(eq2, 0.85);
+  EXPECT_LT(eq2, 1.0);
+}
+
+TEST(PlaneStrainInsertion, NoCutNodeEntersTheNeedleOrItsMirrorImage) {
+  // Contact is enforced exactly at the nodes; the active set accepts 1e-9 w = 8e-12 m.
+  EXPECT_LT(paper_c_run().max_penetration_m, 8e-12);
+  EXPECT_GT(paper_c_run().steps.back().shaft_contacts, 40);  // 54 cut nodes, most on the shaft
+}
+
+TEST(PlaneStrainInsertion, FrictionlessShaftTakesNoShareOfTheForce) {
+  const PlaneStrainInsertionResult r = simulate_plane_strain_insertion(paper_c(0.0));
+  for (const PlaneStrainInsertionStep& s : r.steps) {
+    EXPECT_EQ(s.friction_force_N, 0.0);
+    EXPECT_EQ(s.friction_work_J, 0.0);
+  }
+  // The wedged-open block stores less than with friction (no drag): 2.90 mJ against 4.79 mJ.
+  EXPECT_LT(r.steps.back().strain_energy_J, 0.7 * paper_c_run().steps.back().strain_energy_J);
+}
+
+void expect_refused(const std::function<void(PlaneStrainInsertionProblem&)>& edit,
+                    const std::string& field) {
+  PlaneStrainInsertionProblem p = paper_c(0.5);
+  edit(p);
+  try {
+    simulate_plane_strain_insertion(p);
+    ADD_FAILURE() << "accepted a bad " << field;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+  }
+}
+
+TEST(PlaneStrainInsertion, BadProblemIsRefusedNamingTheField) {
+  expect_refused([](auto& p) { p.youngs_modulus_Pa = -1.0; }, "youngs_modulus_Pa");
+  expect_refused([](auto& p) { p.poisson_ratio = 0.5; }, "poisson_ratio");
+  expect_refused([](auto& p) { p.tip_angle_rad = std::numbers::pi; }, "tip_angle_rad");
+  expect_refused([](auto& p) { p.friction_coefficient = std::nan(""); }, "friction_coefficient");
+  expect_refused([](auto& p) { p.travel_m = 0.2; }, "travel_m");
+  expect_refused([](auto& p) { p.block_width_m = 0.02; }, "block_width_m");
+  expect_refused([](auto& p) { p.element_size_m = 3e-3; }, "element_size_m");
+  expect_refused([](auto& p) { p.step_m = 2e-3; }, "step_m");
+  // A tiny cell is refused before any allocation: the cut's nodes bound every step's work.
+  expect_refused([](auto& p) { p.element_size_m = 1e-6; }, "element_size_m");
+}
+
+}  // namespace
+}  // namespace mneedle::fe
