@@ -27,6 +27,10 @@ namespace {
 // force as tensile beyond this fraction of the largest force: round-off must not toggle a node.
 constexpr double kGapTolerance = 1e-9;
 constexpr double kForceTolerance = 1e-10;
+// An arc node's normal has converged when it moves by less than this (unit vectors): the gap
+// error is then of order rho * 1e-12, the force's direction off by 1e-6. The update converges
+// linearly (ratio up to 0.95 on paper C's shoulder), so a tighter value costs hundreds of solves.
+constexpr double kNormalTolerance = 1e-6;
 
 [[noreturn]] void bad(const std::string& field, const std::string& what) {
   throw InputError("plane-strain insertion: " + field + " " + what);
@@ -44,6 +48,9 @@ double element_size(const PlaneStrainInsertionProblem& p) {
 double uniform_zone(const PlaneStrainInsertionProblem& p) {
   const double zone = p.uniform_zone_m > 0.0 ? p.uniform_zone_m : 4.0 * p.needle_width_m;
   return std::min(zone, 0.5 * p.block_width_m);
+}
+double shoulder_radius(const PlaneStrainInsertionProblem& p) {
+  return p.shoulder_radius_m > 0.0 ? p.shoulder_radius_m : 0.25 * p.needle_width_m;
 }
 double tip_length(const PlaneStrainInsertionProblem& p) {
   return 0.5 * p.needle_width_m / std::tan(0.5 * p.tip_angle_rad);
@@ -67,6 +74,10 @@ void check(const PlaneStrainInsertionProblem& p) {
     bad("friction_coefficient",
         "must be finite and not negative, got " + str(p.friction_coefficient));
   positive("travel_m", p.travel_m);
+  if (!std::isfinite(p.shoulder_radius_m) || p.shoulder_radius_m < 0.0 ||
+      p.shoulder_radius_m > 0.25 * p.needle_width_m)
+    bad("shoulder_radius_m",
+        "must be in (0, needle_width_m / 4] (or 0 for w / 4), got " + str(p.shoulder_radius_m));
   if (p.travel_m > 2.0 * p.block_depth_m)
     bad("travel_m",
         str(p.travel_m) + " m is more than twice block_depth_m " + str(p.block_depth_m) + " m");
@@ -125,17 +136,14 @@ Grid make_grid(const PlaneStrainInsertionProblem& p) {
   return g;
 }
 
-// Corner: held at the shoulder, where the flank meets the shaft; Apex: held at the tip, where the
-// flank meets the mirror plane. At either vertex the force may point anywhere between the two
-// faces' normals (a node sliding up the flank reaches the shaft at the corner; a node ahead of the
-// tip meets the flank at the apex).
-enum class State { Free, Mirror, Flank, Corner, Apex, Stick, Slip };
+// Contact states of a cut node. Slide: on the needle's smooth outline (flank, shoulder arc,
+// shaft), held along the outline's normal through the node and sliding against mu(n) N (zero on
+// the flank, the tip being frictionless; mu on the shaft; growing along the arc). Stick: on the
+// shaft, moving with the needle. Apex: held at the tip, where the flank meets the mirror plane;
+// its force may point anywhere between the two normals (a node ahead of the tip meets it there).
+enum class State { Free, Mirror, Slide, Apex, Stick };
 bool on_needle(State s) {
-  return s == State::Flank || s == State::Corner || s == State::Apex || s == State::Stick ||
-         s == State::Slip;
-}
-bool on_shaft(State s) {
-  return s == State::Stick || s == State::Slip;
+  return s == State::Slide || s == State::Apex || s == State::Stick;
 }
 
 // The block: stiffness factorised once, and the compliance of the cut's dofs.
@@ -217,13 +225,25 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
   const int m = g.ny();
   const double w2 = 0.5 * p.needle_width_m;
   const double mu = p.friction_coefficient;
-  const double tip = tip_length(p);
   const double half_angle = 0.5 * p.tip_angle_rad;
   // The right flank: tangent from the tip towards the shoulder, outward normal into the block.
   const Eigen::Vector2d tangent(std::sin(half_angle), std::cos(half_angle));
-  const Eigen::Vector2d normal(std::cos(half_angle), -std::sin(half_angle));
+  const Eigen::Vector2d flank_normal(std::cos(half_angle), -std::sin(half_angle));
   const double gap_tol = kGapTolerance * p.needle_width_m;
   const double scale = 2.0 * p.thickness_m;  // half model per metre -> whole block
+  // The shoulder: an arc of radius rho about `centre` (relative to the apex), tangent to the
+  // flank at arc_start (along the flank) and to the shaft, which starts at height centre.y().
+  const double rho = shoulder_radius(p);
+  const Eigen::Vector2d centre(w2 - rho,
+                               (std::cos(half_angle) * (w2 - rho) + rho) / std::sin(half_angle));
+  const double arc_start = tangent.dot(centre);
+  // Friction along the outline grows with the normal's turn from the flank's (0: the tip is
+  // frictionless) to the shaft's (mu): a jump in mu where two faces meet would trap a node there,
+  // dragged down by friction on one side and sliding up frictionless on the other.
+  auto friction_of = [&](const Eigen::Vector2d& n) {
+    const double turn = std::atan2(n.y(), n.x()) + half_angle;
+    return mu * std::clamp(turn / half_angle, 0.0, 1.0);
+  };
 
   PlaneStrainInsertionResult out;
   out.nodes = g.nx() * g.ny();
@@ -231,41 +251,53 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
   out.cut_nodes = m;
   out.element_size_m = -g.y[1];
   out.step_m = p.step_m > 0.0 ? p.step_m : kInsertionDefaultStepFraction * out.element_size_m;
-  out.tip_length_m = tip;
+  out.tip_length_m = tip_length(p);
+  out.shoulder_radius_m = rho;
   const int steps = static_cast<int>(std::ceil(p.travel_m / out.step_m - 1e-9));
   out.steps.reserve(steps + 1);
   out.steps.push_back({});
 
   std::vector<State> state(m, State::Free);
-  std::vector<double> slip_sign(m, 1.0);
+  // A sliding node's face (2 shaft, 3 arc, 1 flank) and normal, fixed for a solve and updated
+  // from its new position until they stop changing.
+  std::vector<int> face_of(m, 1);
+  std::vector<Eigen::Vector2d> normal_of(m, flank_normal);
   Eigen::VectorXd f = Eigen::VectorXd::Zero(2 * m), u = Eigen::VectorXd::Zero(2 * m);
   const int max_iterations = 50 + 4 * m;
   for (int s = 1; s <= steps; ++s) {
     const double travel = std::min(p.travel_m, s * out.step_m);
     const double dd = travel - out.steps.back().travel_m;
-    const double tip_y = -travel, shoulder_y = tip_y + tip;
+    const Eigen::Vector2d apex(0.0, -travel);
     const Eigen::VectorXd f_prev = f, u_prev = u;
     const std::vector<State> state_prev = state;
-    // Where a node at height y meets the needle: 2 shaft, 1 flank, 0 below the tip.
-    auto zone = [&](double y) { return y >= shoulder_y ? 2 : y >= tip_y ? 1 : 0; };
-    auto needle_gap = [&](int j, double ux, double uy) {
-      const double y = g.y[j] + uy;
-      switch (zone(y)) {
-        case 2:
-          return ux - w2;
-        case 1:
-          return normal.dot(Eigen::Vector2d(ux, y - tip_y));
-        default:
-          return std::numeric_limits<double>::infinity();
-      }
+    // Which face of the outline a node at (ux, Y + uy) faces (2 shaft, 3 arc, 1 flank, 0 below
+    // the tip), that face's outward normal there and the node's gap to it.
+    struct Facing {
+      int face;
+      Eigen::Vector2d normal;
+      double gap;
     };
-    // The vertices move with the needle: a node held at one at the last step now lies beside the
-    // face that trails it (the shaft behind the shoulder, the flank behind the tip).
-    for (int j = 0; j < m; ++j) {
-      if (state[j] == State::Corner) state[j] = State::Slip, slip_sign[j] = 1.0;
-      if (state[j] == State::Apex) state[j] = State::Flank;
-    }
-    std::vector<int> vertex_visits(m, 0);
+    auto facing = [&](int j, double ux, double uy) -> Facing {
+      const Eigen::Vector2d q = Eigen::Vector2d(ux, g.y[j] + uy) - apex;
+      if (q.y() >= centre.y()) return {2, Eigen::Vector2d::UnitX(), ux - w2};
+      if (tangent.dot(q) >= arc_start) {
+        const Eigen::Vector2d d = q - centre;
+        const double r = d.norm();
+        return {3, d / r, r - rho};
+      }
+      if (q.y() >= 0.0) return {1, flank_normal, flank_normal.dot(q)};
+      return {0, Eigen::Vector2d::UnitX(), std::numeric_limits<double>::infinity()};
+    };
+    auto start_sliding = [&](int j, const Facing& at) {
+      state[j] = State::Slide;
+      face_of[j] = at.face;
+      normal_of[j] = at.normal;
+    };
+    // The apex moves with the needle: a node held there at the last step now lies beside the
+    // flank that trails it.
+    for (int j = 0; j < m; ++j)
+      if (state[j] == State::Apex) start_sliding(j, {1, flank_normal, 0.0});
+    std::vector<int> apex_visits(m, 0), face_changes(m, 0);
     int iterations = 0;
     for (;;) {
       if (iterations == max_iterations)
@@ -289,35 +321,35 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
       for (int k = 0; k < a; ++k) {
         const int j = act[k];
         const int rx = 2 * k, ry = 2 * k + 1;
+        const Eigen::Vector2d x0 = Eigen::Vector2d(0.0, g.y[j]) - apex;  // reference, from apex
         switch (state[j]) {
           case State::Mirror:  // u_x = 0, frictionless
             A.row(rx) = u_row(2 * j);
             A(ry, ry) = 1.0;
             break;
-          case State::Flank:  // on the flank's line, frictionless: f along the normal
-            A.row(rx) = normal.x() * u_row(2 * j) + normal.y() * u_row(2 * j + 1);
-            b[rx] = normal.dot(Eigen::Vector2d(0.0, tip_y - g.y[j]));
-            A(ry, rx) = tangent.x();
-            A(ry, ry) = tangent.y();
+          case State::Slide: {
+            const Eigen::Vector2d& n = normal_of[j];
+            const Eigen::Vector2d t(-n.y(), n.x());  // along the outline, towards the shaft
+            // On the face's line through the node's normal: n . q = level.
+            const double level = face_of[j] == 2 ? w2 : face_of[j] == 3 ? rho + n.dot(centre) : 0.0;
+            A.row(rx) = n.x() * u_row(2 * j) + n.y() * u_row(2 * j + 1);
+            b[rx] = level - n.dot(x0);
+            // Along the outline: friction mu(n) N against the upward slip.
+            const double k_f = friction_of(n);
+            A(ry, rx) = t.x() + k_f * n.x();
+            A(ry, ry) = t.y() + k_f * n.y();
             break;
-          case State::Corner:  // at the shoulder point
-          case State::Apex:    // at the tip point
+          }
+          case State::Apex:  // at the tip point
             A.row(rx) = u_row(2 * j);
-            b[rx] = state[j] == State::Corner ? w2 : 0.0;
             A.row(ry) = u_row(2 * j + 1);
-            b[ry] = (state[j] == State::Corner ? shoulder_y : tip_y) - g.y[j];
+            b[ry] = apex.y() - g.y[j];
             break;
           case State::Stick:  // on the shaft, moving with the needle
             A.row(rx) = u_row(2 * j);
             b[rx] = w2;
             A.row(ry) = u_row(2 * j + 1);
             b[ry] = u_prev[2 * j + 1] - dd;
-            break;
-          case State::Slip:  // on the shaft, friction mu N against the slip
-            A.row(rx) = u_row(2 * j);
-            b[rx] = w2;
-            A(ry, ry) = 1.0;
-            A(ry, rx) = slip_sign[j] * mu;
             break;
           case State::Free:
             break;
@@ -336,69 +368,68 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
       bool changed = false;
       for (int j = 0; j < m; ++j) {
         const double ux = u[2 * j], uy = u[2 * j + 1], fx = f[2 * j], fy = f[2 * j + 1];
-        const double gap = needle_gap(j, ux, uy);
-        const int z = zone(g.y[j] + uy);
+        const Facing at = facing(j, ux, uy);
         const State before = state[j];
         switch (state[j]) {
           case State::Free:
           case State::Mirror:
-            if (gap < -gap_tol) {
-              state[j] = z == 2 ? State::Slip : State::Flank;
-              slip_sign[j] = 1.0;
-            } else if (state[j] == State::Free && ux < -gap_tol) {
+            if (at.gap < -gap_tol)
+              start_sliding(j, at);
+            else if (state[j] == State::Free && ux < -gap_tol)
               state[j] = State::Mirror;
-            } else if (state[j] == State::Mirror && fx < -force_tol) {
+            else if (state[j] == State::Mirror && fx < -force_tol)
               state[j] = State::Free;
+            break;
+          case State::Slide: {
+            const double lambda = normal_of[j].dot(Eigen::Vector2d(fx, fy));
+            // Relative slip of the node along the shaft over the step (positive: the node moves
+            // up relative to the needle, as the friction force -mu N assumes).
+            const double rel = (uy - u_prev[2 * j + 1]) + dd;
+            if (lambda < -force_tol) {
+              state[j] = State::Free;
+            } else if (at.face == 0) {
+              state[j] = State::Apex;
+            } else if ((at.face != face_of[j] && face_changes[j] < 3) ||
+                       (at.face == face_of[j] &&
+                        (at.normal - normal_of[j]).norm() > kNormalTolerance)) {
+              // The face and normal through the node's new position. Where the arc meets the
+              // flank or the shaft the curvature jumps, so a node right at the junction can be
+              // sent across it by either face's linearisation: after three changes of face in
+              // a step it keeps the last (its normal is then the junction's to within the
+              // step's slide, and its gap to the other face second order in it).
+              face_changes[j] += at.face != face_of[j];
+              face_of[j] = at.face;
+              normal_of[j] = at.normal;
+              changed = true;
+            } else if (at.face == 2 && mu > 0.0 && rel < -gap_tol && !block.y_fixed(j)) {
+              state[j] = State::Stick;
             }
             break;
-          case State::Flank:
-            if (normal.x() * fx + normal.y() * fy < -force_tol)
-              state[j] = State::Free;
-            else if (z == 2)
-              state[j] = State::Corner;
-            else if (z == 0)
-              state[j] = State::Apex;
-            break;
-          case State::Slip: {
-            // Relative slip of the node along the needle over the step (positive: the node moves
-            // up relative to the needle); the friction force on the node is -sign * mu N.
-            const double rel = (uy - u_prev[2 * j + 1]) + dd;
-            if (fx < -force_tol)
-              state[j] = State::Free;
-            else if (z != 2)
-              state[j] = z == 1 ? State::Corner : State::Free;
-            else if (mu > 0.0 && slip_sign[j] * rel < -gap_tol && !block.y_fixed(j))
-              state[j] = State::Stick;
-            break;
           }
-          case State::Corner:
           case State::Apex: {
-            // f = a n + b e_x: a the flank's share, b the other face's (the shaft at the corner,
-            // the mirror plane at the apex); both must push. A node that has come back to the
-            // vertex twice in this step stays there: its force leans just past one normal while
-            // that face's own solution puts it beyond the vertex, so no face is consistent (a
-            // discretisation effect of the sharp vertex; docs/model.md, "Plane-strain insertion").
+            // f = a n + b e_x: a the flank's share, b the mirror plane's; both must push. A node
+            // that has come back to the apex twice in this step stays there: its force leans
+            // just past one normal while that face's own solution puts it beyond the apex (the
+            // sharp vertex's discretisation; docs/model.md, "Plane-strain insertion").
             const double on_flank = -fy / std::sin(half_angle);
-            const double on_other = fx - on_flank * normal.x();
-            if (vertex_visits[j] > 2) break;
-            if (on_flank < -force_tol && on_other < -force_tol)
+            const double on_mirror = fx - on_flank * flank_normal.x();
+            if (apex_visits[j] > 2) break;
+            if (on_flank < -force_tol && on_mirror < -force_tol)
               state[j] = State::Free;
             else if (on_flank < -force_tol)
-              state[j] = state[j] == State::Corner ? State::Slip : State::Mirror,
-              slip_sign[j] = 1.0;
-            else if (on_other < -force_tol)
-              state[j] = State::Flank;
+              state[j] = State::Mirror;
+            else if (on_mirror < -force_tol)
+              start_sliding(j, {1, flank_normal, 0.0});
             break;
           }
           case State::Stick:
             if (fx < -force_tol)
               state[j] = State::Free;
             else if (std::abs(fy) > mu * fx + force_tol)
-              state[j] = State::Slip, slip_sign[j] = fy < 0.0 ? 1.0 : -1.0;
+              start_sliding(j, {2, Eigen::Vector2d::UnitX(), 0.0});
             break;
         }
-        if ((state[j] == State::Corner || state[j] == State::Apex) && state[j] != before)
-          ++vertex_visits[j];
+        if (state[j] == State::Apex && before != State::Apex) ++apex_visits[j];
         changed = changed || state[j] != before;
       }
       if (!changed) {
@@ -409,25 +440,33 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
         for (int j = 0; j < m; ++j) {
           const double fx = f[2 * j], fy = f[2 * j + 1];
           out.max_penetration_m =
-              std::max({out.max_penetration_m, -needle_gap(j, u[2 * j], u[2 * j + 1]), -u[2 * j]});
+              std::max({out.max_penetration_m, -facing(j, u[2 * j], u[2 * j + 1]).gap, -u[2 * j]});
           if (!on_needle(state[j])) continue;
           st.force_N -= scale * fy;
-          if (state[j] == State::Flank || state[j] == State::Corner || state[j] == State::Apex) {
+          const bool shaft = state[j] == State::Stick || face_of[j] == 2;
+          if (!shaft || state[j] == State::Apex) {
             ++st.tip_contacts;
+          } else {
+            ++st.shaft_contacts;
+            st.friction_force_N -= scale * fy;
+            st.normal_force_N += scale * fx;
+          }
+          if (state[j] != State::Slide) {
+            st.sticking += state[j] == State::Stick;
             continue;
           }
-          ++st.shaft_contacts;
-          st.friction_force_N -= scale * fy;
-          st.normal_force_N += scale * fx;
-          if (state[j] == State::Stick) {
-            ++st.sticking;
-            continue;
-          }
-          // mu N times the slip, N averaged over the step where the node was on the shaft at
-          // both ends (the trapezoid of the external work), its end value otherwise.
-          const double rel = std::abs(u[2 * j + 1] - u_prev[2 * j + 1] + dd);
-          const double n_mean = on_shaft(state_prev[j]) ? 0.5 * (fx + f_prev[2 * j]) : fx;
-          friction_work += scale * mu * n_mean * rel;
+          // mu(n) N times the slip along the outline relative to the needle; N averaged over the
+          // step where the node slid at both ends (the trapezoid of the external work).
+          const Eigen::Vector2d& n = normal_of[j];
+          const Eigen::Vector2d t(-n.y(), n.x());
+          const double rel =
+              t.x() * (u[2 * j] - u_prev[2 * j]) + t.y() * (u[2 * j + 1] - u_prev[2 * j + 1] + dd);
+          const double normal_now = n.dot(Eigen::Vector2d(fx, fy));
+          const double normal_mean =
+              state_prev[j] == State::Slide
+                  ? 0.5 * (normal_now + n.dot(Eigen::Vector2d(f_prev[2 * j], f_prev[2 * j + 1])))
+                  : normal_now;
+          friction_work += scale * friction_of(n) * normal_mean * std::abs(rel);
         }
         const PlaneStrainInsertionStep& last = out.steps.back();
         st.external_work_J = last.external_work_J + 0.5 * (last.force_N + st.force_N) * dd;

@@ -24,6 +24,9 @@ struct PlaneStrainInsertionProblem {
   double needle_width_m = 0.0;        ///< w, shaft width
   double tip_angle_rad = 0.0;         ///< included angle of the wedge tip, in (0, pi)
   double friction_coefficient = 0.0;  ///< Coulomb, shaft only; the tip is frictionless
+  /// Radius of the arc joining the tip's flank to the shaft, at most w/4; 0: w/4. A sharp
+  /// shoulder is not offered: nodes snap off it (docs/model.md, "Plane-strain insertion").
+  double shoulder_radius_m = 0.0;
   double travel_m = 0.0;  ///< tip travel from touching the top surface, at most 2 x depth
   /// Travel per step, at most one cell; 0: kInsertionDefaultStepFraction of the cell size.
   double step_m = 0.0;
@@ -50,14 +53,14 @@ inline constexpr double kInsertionMaxSteps = 20000.0;
 struct PlaneStrainInsertionStep {
   double travel_m = 0.0;
   double force_N = 0.0;           ///< pushing the needle down: tip normal forces + shaft friction
-  double friction_force_N = 0.0;  ///< the shaft friction's share of force_N
-  double normal_force_N = 0.0;    ///< total normal force of the cut faces on the shaft (both sides)
+  double friction_force_N = 0.0;  ///< the shaft's share of force_N (its friction)
+  double normal_force_N = 0.0;    ///< normal force of the cut faces on the shaft (both sides)
   double external_work_J = 0.0;   ///< integral of force over travel (trapezoidal)
   double strain_energy_J = 0.0;   ///< 1/2 u^T K u
   double friction_work_J = 0.0;   ///< sum of mu N times slip, from the slipping nodes
   /// (W_ext - U - W_f) / W_ext: the ledger's closure; 0 before the needle has done work.
   double balance_error = 0.0;
-  int tip_contacts = 0;    ///< cut nodes on the tip's flank
+  int tip_contacts = 0;    ///< cut nodes on the tip: flank, shoulder arc, apex
   int shaft_contacts = 0;  ///< cut nodes on the shaft
   int sticking = 0;        ///< shaft nodes that stick (the rest slide)
   int active_set_iterations = 0;
@@ -70,7 +73,8 @@ struct PlaneStrainInsertionResult {
   int cut_nodes = 0;
   double element_size_m = 0.0;
   double step_m = 0.0;
-  double tip_length_m = 0.0;           ///< the wedge's height, (w/2) / tan(angle/2)
+  double tip_length_m = 0.0;           ///< the sharp wedge's height, (w/2) / tan(angle/2)
+  double shoulder_radius_m = 0.0;      ///< the arc's radius actually used
   double max_abs_balance_error = 0.0;  ///< over steps with external work above 1e-3 of the last
   double max_penetration_m = 0.0;      ///< deepest cut node inside the needle or its mirror face
 };
