@@ -30,6 +30,7 @@ void add_simulate_command(CLI::App& app);
 void add_toughness_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
 void add_energy_command(CLI::App& app);
+void add_plane_strain_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 void add_report_command(CLI::App& app);
 void add_uncertainty_command(CLI::App& app);

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   mneedle::cli::add_toughness_command(app);
   mneedle::cli::add_calibrate_command(app);
   mneedle::cli::add_energy_command(app);
+  mneedle::cli::add_plane_strain_command(app);
   mneedle::cli::add_export_command(app);
   mneedle::cli::add_report_command(app);
   mneedle::cli::add_uncertainty_command(app);

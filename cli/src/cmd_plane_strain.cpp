@@ -1,0 +1,208 @@
+// mneedle plane-strain: paper C §6's plane-strain insertion of a rigid needle along a cut, with
+// its force curve and energy ledger (docs/model.md, "Plane-strain insertion along a cut").
+#include <CLI/CLI.hpp>
+
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "commands.h"
+#include "json_output.h"
+#include "mneedle/base/error.h"
+#include "mneedle/base/text.h"
+#include "mneedle/base/units.h"
+#include "mneedle/fe/plane_strain_insertion.h"
+#include "mneedle/plot/figure.h"
+
+namespace mneedle::cli {
+namespace {
+
+struct PlaneStrainArgs {
+  std::string tissue, block, thickness, needle_width, tip_angle, shoulder_radius, travel,
+      element_size, step;
+  double friction = 0.0;
+  std::string csv, plot;
+  bool json = false;
+};
+
+double quantity(const std::string& option, std::string_view text, Dimension d) {
+  try {
+    return parse_quantity(text, d);
+  } catch (const InputError& e) {
+    throw InputError(option + ": " + e.what());
+  }
+}
+
+// "A,B" -> two quantities of one dimension.
+std::pair<double, double> pair_of(const std::string& option, const std::string& text,
+                                  Dimension first, Dimension second, const char* example) {
+  const auto comma = text.find(',');
+  if (comma == std::string::npos)
+    throw InputError(option + " '" + text + "': expected two values, e.g. " + example);
+  return {quantity(option, trim(text.substr(0, comma)), first),
+          quantity(option, trim(text.substr(comma + 1)), second)};
+}
+
+std::string sig(double v, int digits = 4) {
+  std::ostringstream s;
+  s << std::setprecision(digits) << v;
+  return s.str();
+}
+
+void write_csv(const std::string& file, const fe::PlaneStrainInsertionResult& r) {
+  std::ofstream out(file);
+  if (!out) throw InputError(file + ": cannot be written");
+  out << std::setprecision(10)
+      << "travel [m],force [N],shaft friction [N],shaft normal force [N],external work [J],"
+         "strain energy [J],friction work [J],balance error [1],tip contacts,shaft contacts,"
+         "sticking\n";
+  for (const auto& s : r.steps)
+    out << s.travel_m << ',' << s.force_N << ',' << s.friction_force_N << ',' << s.normal_force_N
+        << ',' << s.external_work_J << ',' << s.strain_energy_J << ',' << s.friction_work_J << ','
+        << s.balance_error << ',' << s.tip_contacts << ',' << s.shaft_contacts << ',' << s.sticking
+        << '\n';
+  if (!out) throw InputError(file + ": write failed");
+}
+
+void run_plane_strain(const PlaneStrainArgs& a) {
+  fe::PlaneStrainInsertionProblem p;
+  const auto [E, nu] =
+      pair_of("--tissue", a.tissue, Dimension::Pressure, Dimension::Dimensionless, "7kPa,0.475");
+  p.youngs_modulus_Pa = E;
+  p.poisson_ratio = nu;
+  const auto [width, depth] =
+      pair_of("--block", a.block, Dimension::Length, Dimension::Length, "160mm,86mm");
+  p.block_width_m = width;
+  p.block_depth_m = depth;
+  p.thickness_m = quantity("--thickness", a.thickness, Dimension::Length);
+  p.needle_width_m = quantity("--needle-width", a.needle_width, Dimension::Length);
+  p.tip_angle_rad = quantity("--tip-angle", a.tip_angle, Dimension::Angle);
+  p.friction_coefficient = a.friction;
+  p.travel_m = a.travel.empty() ? depth : quantity("--travel", a.travel, Dimension::Length);
+  if (!a.shoulder_radius.empty())
+    p.shoulder_radius_m = quantity("--shoulder-radius", a.shoulder_radius, Dimension::Length);
+  if (!a.element_size.empty())
+    p.element_size_m = quantity("--element-size", a.element_size, Dimension::Length);
+  if (!a.step.empty()) p.step_m = quantity("--step", a.step, Dimension::Length);
+  const fe::PlaneStrainInsertionResult r = fe::simulate_plane_strain_insertion(p);
+  const fe::PlaneStrainInsertionStep& end = r.steps.back();
+
+  if (!a.csv.empty()) write_csv(a.csv, r);
+  if (!a.plot.empty()) {
+    plot::Figure f;
+    f.title = "plane-strain insertion along a cut (paper C)";
+    f.x.name = "needle travel";
+    std::vector<double> x, force, friction;
+    for (const auto& s : r.steps) {
+      x.push_back(s.travel_m);
+      force.push_back(s.force_N);
+      friction.push_back(s.friction_force_N);
+    }
+    f.series.push_back({"insertion force", x, force, plot::Mark::Line});
+    f.series.push_back({"shaft friction", x, friction, plot::Mark::Line});
+    f.lines.push_back({"tip at the bottom", p.block_depth_m});
+    plot::write_svg(a.plot, f);
+  }
+
+  const double balance_bound = 0.02;  // paper C's requirement for the ledger (issue text)
+  nlohmann::json warnings = nlohmann::json::array();
+  if (r.max_abs_balance_error > balance_bound)
+    warnings.push_back("the energy ledger closes only to " + sig(100 * r.max_abs_balance_error, 3) +
+                       " % at its worst step (above 2 %): refine --element-size or --step");
+  if (a.json) {
+    nlohmann::ordered_json out;
+    out["problem"] = {{"youngs_modulus_Pa", p.youngs_modulus_Pa},
+                      {"poisson_ratio", p.poisson_ratio},
+                      {"block_width_m", p.block_width_m},
+                      {"block_depth_m", p.block_depth_m},
+                      {"thickness_m", p.thickness_m},
+                      {"needle_width_m", p.needle_width_m},
+                      {"tip_angle_rad", p.tip_angle_rad},
+                      {"shoulder_radius_m", r.shoulder_radius_m},
+                      {"friction_coefficient", p.friction_coefficient},
+                      {"travel_m", p.travel_m}};
+    out["mesh"] = {{"nodes", r.nodes},
+                   {"elements", r.elements},
+                   {"cut_nodes", r.cut_nodes},
+                   {"element_size_m", r.element_size_m},
+                   {"step_m", r.step_m}};
+    out["end"] = {{"travel_m", end.travel_m},
+                  {"force_N", end.force_N},
+                  {"friction_force_N", end.friction_force_N},
+                  {"normal_force_N", end.normal_force_N},
+                  {"external_work_J", end.external_work_J},
+                  {"strain_energy_J", end.strain_energy_J},
+                  {"friction_work_J", end.friction_work_J},
+                  {"balance_error", end.balance_error}};
+    out["max_abs_balance_error"] = r.max_abs_balance_error;
+    out["max_penetration_m"] = r.max_penetration_m;
+    nlohmann::ordered_json steps;
+    for (const char* k : {"travel_m", "force_N", "friction_force_N", "external_work_J",
+                          "strain_energy_J", "friction_work_J", "balance_error"})
+      steps[k] = nlohmann::json::array();
+    for (const auto& s : r.steps) {
+      steps["travel_m"].push_back(s.travel_m);
+      steps["force_N"].push_back(s.force_N);
+      steps["friction_force_N"].push_back(s.friction_force_N);
+      steps["external_work_J"].push_back(s.external_work_J);
+      steps["strain_energy_J"].push_back(s.strain_energy_J);
+      steps["friction_work_J"].push_back(s.friction_work_J);
+      steps["balance_error"].push_back(s.balance_error);
+    }
+    out["steps"] = steps;
+    out["warnings"] = warnings;
+    print_checked_json(std::cout, out, "plane-strain");
+    return;
+  }
+  const auto mj = [](double j) { return sig(j * 1e3) + " mJ"; };
+  std::cout << "plane-strain insertion along a cut: " << r.nodes << " nodes, " << r.cut_nodes
+            << " on the cut, cells " << format_quantity(r.element_size_m, Dimension::Length) << ", "
+            << r.steps.size() - 1 << " steps of " << format_quantity(r.step_m, Dimension::Length)
+            << "\n"
+            << "at travel " << format_quantity(end.travel_m, Dimension::Length) << ": force "
+            << format_quantity(end.force_N, Dimension::Force) << " (shaft friction "
+            << format_quantity(end.friction_force_N, Dimension::Force) << ")\n"
+            << "energy: W_ext " << mj(end.external_work_J) << " = U " << mj(end.strain_energy_J)
+            << " + W_f " << mj(end.friction_work_J) << " (closure "
+            << sig(100 * end.balance_error, 3) << " %, worst step "
+            << sig(100 * r.max_abs_balance_error, 3) << " %)\n";
+  for (const auto& w : warnings) std::cout << "warning: " << w.get<std::string>() << "\n";
+}
+
+}  // namespace
+
+void add_plane_strain_command(CLI::App& app) {
+  auto a = std::make_shared<PlaneStrainArgs>();
+  auto* cmd = app.add_subcommand(
+      "plane-strain", "Paper C's plane-strain insertion along a cut: force and energy ledger");
+  cmd->footer(
+      "A rigid needle (a strip with a wedge tip) pushed down a block already cut along its path:\n"
+      "frictionless tip, Coulomb shaft. Every value needs its unit.\n"
+      "Example (paper C, no cohesion):\n"
+      "  mneedle plane-strain --tissue 7kPa,0.475 --block 160mm,86mm --thickness 15mm \\\n"
+      "      --needle-width 8mm --tip-angle 50deg --friction 0.5 --json");
+  cmd->add_option("--tissue", a->tissue, "E,nu of the block, e.g. 7kPa,0.475")->required();
+  cmd->add_option("--block", a->block, "Width,depth of the block, e.g. 160mm,86mm")->required();
+  cmd->add_option("--thickness", a->thickness, "Out-of-plane thickness, e.g. 15mm")->required();
+  cmd->add_option("--needle-width", a->needle_width, "Needle width, e.g. 8mm")->required();
+  cmd->add_option("--tip-angle", a->tip_angle, "Included angle of the tip, e.g. 50deg")->required();
+  cmd->add_option("--friction", a->friction, "Coulomb coefficient on the shaft")
+      ->capture_default_str();
+  cmd->add_option("--shoulder-radius", a->shoulder_radius,
+                  "Radius rounding the shoulder (default and largest: width/4)");
+  cmd->add_option("--travel", a->travel, "Tip travel (default: the block's depth)");
+  cmd->add_option("--element-size", a->element_size, "Cell size along the cut (default w/8)");
+  cmd->add_option("--step", a->step, "Travel per step (default: cell/8)");
+  cmd->add_option("--csv", a->csv, "Write every step (unit-bracketed columns) to this file");
+  cmd->add_option("--plot", a->plot, "Write the force curve as SVG");
+  cmd->add_flag("--json", a->json, "Print one JSON object");
+  cmd->callback([a] { run_plane_strain(*a); });
+}
+
+}  // namespace mneedle::cli

@@ -1,0 +1,78 @@
+// Runs the built `mneedle plane-strain` end to end: paper C's run without cohesion, its CSV and
+// plot, and what happens to bad input.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "run_mneedle.h"
+
+namespace {
+
+using mneedle::test::run_mneedle;
+
+const std::filesystem::path kWork = std::filesystem::temp_directory_path() /
+                                    ("mneedle_test_plane_strain_" + std::to_string(::getpid()));
+
+struct ScratchCleanup {
+  ~ScratchCleanup() {
+    std::error_code ignored;
+    std::filesystem::remove_all(kWork, ignored);
+  }
+} const kScratchCleanup;
+
+const std::string kPaperC =
+    "plane-strain --tissue 7kPa,0.475 --block 160mm,86mm --thickness 15mm --needle-width 8mm "
+    "--tip-angle 50deg --friction 0.5 --element-size 1.6mm";
+
+TEST(CmdPlaneStrain, PaperCRunGivesTheLibrarysLedgerWithItsFiles) {
+  std::filesystem::create_directories(kWork);
+  const auto csv = (kWork / "steps.csv").string(), svg = (kWork / "force.svg").string();
+  const auto run = run_mneedle(kPaperC + " --json --csv '" + csv + "' --plot '" + svg + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  // The library's value for this problem (test_plane_strain_insertion: 44.58 mJ at 1.6 mm
+  // cells); the CLI adds only parsing, so the same number to round-off.
+  EXPECT_NEAR(j["end"]["external_work_J"].get<double>(), 44.58e-3, 0.01e-3);
+  EXPECT_DOUBLE_EQ(j["end"]["travel_m"].get<double>(), 0.086);  // default travel: the depth
+  EXPECT_DOUBLE_EQ(j["problem"]["shoulder_radius_m"].get<double>(), 2e-3);
+  EXPECT_NEAR(j["problem"]["tip_angle_rad"].get<double>(), 50.0 * M_PI / 180.0, 1e-15);
+  EXPECT_EQ(j["steps"]["travel_m"].size(), 433u);
+  EXPECT_LT(j["max_abs_balance_error"].get<double>(), 0.02);
+  EXPECT_TRUE(j["warnings"].empty());
+  std::ifstream in(csv);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header.rfind("travel [m],force [N],", 0), 0u) << header;
+  int rows = 0;
+  for (std::string line; std::getline(in, line);) ++rows;
+  EXPECT_EQ(rows, 433);
+  EXPECT_GT(std::filesystem::file_size(svg), 1000u);
+}
+
+TEST(CmdPlaneStrain, ValueWithoutUnitIsOneLineNamingTheOption) {
+  const auto run = run_mneedle(
+      "plane-strain --tissue 7kPa,0.475 --block 160mm,86mm --thickness 15 --needle-width 8mm "
+      "--tip-angle 50deg");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("--thickness"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("needs a unit"), std::string::npos) << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+}
+
+TEST(CmdPlaneStrain, BadMaterialIsRefusedNamingTheField) {
+  const auto run = run_mneedle(
+      "plane-strain --tissue 7kPa,0.6 --block 160mm,86mm --thickness 15mm --needle-width 8mm "
+      "--tip-angle 50deg");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("poisson_ratio"), std::string::npos) << run.err;
+  EXPECT_TRUE(run.out.empty()) << run.out;
+}
+
+}  // namespace
