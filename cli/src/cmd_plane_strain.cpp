@@ -26,6 +26,7 @@ namespace {
 struct PlaneStrainArgs {
   std::string tissue, block, thickness, needle_width, tip_angle, shoulder_radius, travel,
       element_size, step;
+  std::string toughness, openings, initial_cut, viscosity;  // the cohesive interface
   double friction = 0.0;
   std::string csv, plot;
   bool json = false;
@@ -60,11 +61,12 @@ void write_csv(const std::string& file, const fe::PlaneStrainInsertionResult& r)
   if (!out) throw InputError(file + ": cannot be written");
   out << std::setprecision(10)
       << "travel [m],force [N],shaft friction [N],shaft normal force [N],external work [J],"
-         "strain energy [J],friction work [J],balance error [1],tip contacts,shaft contacts,"
-         "sticking\n";
+         "strain energy [J],friction work [J],cohesive work [J],fracture energy [J],"
+         "crack depth [m],balance error [1],tip contacts,shaft contacts,sticking\n";
   for (const auto& s : r.steps)
     out << s.travel_m << ',' << s.force_N << ',' << s.friction_force_N << ',' << s.normal_force_N
         << ',' << s.external_work_J << ',' << s.strain_energy_J << ',' << s.friction_work_J << ','
+        << s.cohesive_work_J << ',' << s.fracture_energy_J << ',' << s.crack_depth_m << ','
         << s.balance_error << ',' << s.tip_contacts << ',' << s.shaft_contacts << ',' << s.sticking
         << '\n';
   if (!out) throw InputError(file + ": write failed");
@@ -90,6 +92,24 @@ void run_plane_strain(const PlaneStrainArgs& a) {
   if (!a.element_size.empty())
     p.element_size_m = quantity("--element-size", a.element_size, Dimension::Length);
   if (!a.step.empty()) p.step_m = quantity("--step", a.step, Dimension::Length);
+  const bool cohesive = !a.toughness.empty();
+  if (!cohesive && (!a.openings.empty() || !a.initial_cut.empty() || !a.viscosity.empty()))
+    throw InputError(
+        "plane-strain: --cohesive-openings, --initial-cut and --viscosity need "
+        "--toughness (the cohesive interface)");
+  if (cohesive) {
+    if (a.openings.empty())
+      throw InputError("plane-strain: --toughness needs --cohesive-openings (e.g. 7mm,7.5mm)");
+    p.cohesion.toughness_J_per_m2 = quantity("--toughness", a.toughness, Dimension::Toughness);
+    const auto [peak, failure] = pair_of("--cohesive-openings", a.openings, Dimension::Length,
+                                         Dimension::Length, "7mm,7.5mm");
+    p.cohesion.peak_opening_m = peak;
+    p.cohesion.failure_opening_m = failure;
+    if (!a.initial_cut.empty())
+      p.cohesion.initial_cut_m = quantity("--initial-cut", a.initial_cut, Dimension::Length);
+    if (!a.viscosity.empty())
+      p.cohesion.viscosity_m = quantity("--viscosity", a.viscosity, Dimension::Length);
+  }
   const fe::PlaneStrainInsertionResult r = fe::simulate_plane_strain_insertion(p);
   const fe::PlaneStrainInsertionStep& end = r.steps.back();
 
@@ -107,6 +127,7 @@ void run_plane_strain(const PlaneStrainArgs& a) {
     f.series.push_back({"insertion force", x, force, plot::Mark::Line});
     f.series.push_back({"shaft friction", x, friction, plot::Mark::Line});
     f.lines.push_back({"tip at the bottom", p.block_depth_m});
+    if (r.puncture_travel_m > 0.0) f.lines.push_back({"crack runs", r.puncture_travel_m});
     plot::write_svg(a.plot, f);
   }
 
@@ -127,6 +148,12 @@ void run_plane_strain(const PlaneStrainArgs& a) {
                       {"shoulder_radius_m", r.shoulder_radius_m},
                       {"friction_coefficient", p.friction_coefficient},
                       {"travel_m", p.travel_m}};
+    if (cohesive)
+      out["problem"]["cohesion"] = {{"toughness_J_per_m2", p.cohesion.toughness_J_per_m2},
+                                    {"peak_opening_m", p.cohesion.peak_opening_m},
+                                    {"failure_opening_m", p.cohesion.failure_opening_m},
+                                    {"initial_cut_m", p.cohesion.initial_cut_m},
+                                    {"viscosity_m", p.cohesion.viscosity_m}};
     out["mesh"] = {{"nodes", r.nodes},
                    {"elements", r.elements},
                    {"cut_nodes", r.cut_nodes},
@@ -139,12 +166,21 @@ void run_plane_strain(const PlaneStrainArgs& a) {
                   {"external_work_J", end.external_work_J},
                   {"strain_energy_J", end.strain_energy_J},
                   {"friction_work_J", end.friction_work_J},
+                  {"cohesive_work_J", end.cohesive_work_J},
+                  {"fracture_energy_J", end.fracture_energy_J},
+                  {"crack_depth_m", end.crack_depth_m},
                   {"balance_error", end.balance_error}};
+    if (cohesive)
+      out["puncture"] = r.puncture_travel_m > 0.0
+                            ? nlohmann::ordered_json{{"travel_m", r.puncture_travel_m},
+                                                     {"force_N", r.puncture_force_N}}
+                            : nlohmann::ordered_json(nullptr);
     out["max_abs_balance_error"] = r.max_abs_balance_error;
     out["max_penetration_m"] = r.max_penetration_m;
     nlohmann::ordered_json steps;
     for (const char* k : {"travel_m", "force_N", "friction_force_N", "external_work_J",
-                          "strain_energy_J", "friction_work_J", "balance_error"})
+                          "strain_energy_J", "friction_work_J", "cohesive_work_J",
+                          "fracture_energy_J", "crack_depth_m", "balance_error"})
       steps[k] = nlohmann::json::array();
     for (const auto& s : r.steps) {
       steps["travel_m"].push_back(s.travel_m);
@@ -153,6 +189,9 @@ void run_plane_strain(const PlaneStrainArgs& a) {
       steps["external_work_J"].push_back(s.external_work_J);
       steps["strain_energy_J"].push_back(s.strain_energy_J);
       steps["friction_work_J"].push_back(s.friction_work_J);
+      steps["cohesive_work_J"].push_back(s.cohesive_work_J);
+      steps["fracture_energy_J"].push_back(s.fracture_energy_J);
+      steps["crack_depth_m"].push_back(s.crack_depth_m);
       steps["balance_error"].push_back(s.balance_error);
     }
     out["steps"] = steps;
@@ -169,9 +208,22 @@ void run_plane_strain(const PlaneStrainArgs& a) {
             << format_quantity(end.force_N, Dimension::Force) << " (shaft friction "
             << format_quantity(end.friction_force_N, Dimension::Force) << ")\n"
             << "energy: W_ext " << mj(end.external_work_J) << " = U " << mj(end.strain_energy_J)
-            << " + W_f " << mj(end.friction_work_J) << " (closure "
-            << sig(100 * end.balance_error, 3) << " %, worst step "
+            << " + W_f " << mj(end.friction_work_J);
+  if (cohesive)
+    std::cout << " + W_coh " << mj(end.cohesive_work_J) << " (fracture "
+              << mj(end.fracture_energy_J) << ")";
+  std::cout << " (closure " << sig(100 * end.balance_error, 3) << " %, worst step "
             << sig(100 * r.max_abs_balance_error, 3) << " %)\n";
+  if (cohesive) {
+    std::cout << "crack from the initial cut to "
+              << format_quantity(end.crack_depth_m, Dimension::Length) << "; ";
+    if (r.puncture_travel_m > 0.0)
+      std::cout << "puncture (the first cell fails) at travel "
+                << format_quantity(r.puncture_travel_m, Dimension::Length) << ", force "
+                << format_quantity(r.puncture_force_N, Dimension::Force) << "\n";
+    else
+      std::cout << "no cell failed: no puncture within the travel\n";
+  }
   for (const auto& w : warnings) std::cout << "warning: " << w.get<std::string>() << "\n";
 }
 
@@ -199,6 +251,13 @@ void add_plane_strain_command(CLI::App& app) {
   cmd->add_option("--travel", a->travel, "Tip travel (default: the block's depth)");
   cmd->add_option("--element-size", a->element_size, "Cell size along the cut (default w/8)");
   cmd->add_option("--step", a->step, "Travel per step (default: cell/8)");
+  cmd->add_option("--toughness", a->toughness,
+                  "G_c of a cohesive interface along the path, e.g. 17.43J/m2 (default: cut)");
+  cmd->add_option("--cohesive-openings", a->openings,
+                  "Openings at the peak traction and at failure, e.g. 7mm,7.5mm");
+  cmd->add_option("--initial-cut", a->initial_cut, "Depth cut before the insertion (default 0)");
+  cmd->add_option("--viscosity", a->viscosity,
+                  "Travel over which damage relaxes to the law (default 0.5mm; 0mm: none)");
   cmd->add_option("--csv", a->csv, "Write every step (unit-bracketed columns) to this file");
   cmd->add_option("--plot", a->plot, "Write the force curve as SVG");
   cmd->add_flag("--json", a->json, "Print one JSON object");

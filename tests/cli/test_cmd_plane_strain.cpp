@@ -56,6 +56,27 @@ TEST(CmdPlaneStrain, PaperCRunGivesTheLibrarysLedgerWithItsFiles) {
   EXPECT_GT(std::filesystem::file_size(svg), 1000u);
 }
 
+TEST(CmdPlaneStrain, CohesiveRunReportsThePunctureAndTheCrack) {
+  const auto run = run_mneedle(kPaperC +
+                               " --toughness 17.43J/m2 --cohesive-openings 7mm,7.5mm "
+                               "--initial-cut 3.2mm --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  // The library's values for this problem (test_plane_strain_insertion): the first cell fails
+  // at 24.29 mm travel (0.777 N), 20.36 mJ dissipated by 86 mm; the CLI only parses.
+  EXPECT_NEAR(j["puncture"]["travel_m"].get<double>(), 24.29e-3, 0.01e-3);
+  EXPECT_NEAR(j["puncture"]["force_N"].get<double>(), 0.777, 0.001);
+  EXPECT_NEAR(j["end"]["fracture_energy_J"].get<double>(), 20.36e-3, 0.01e-3);
+  EXPECT_DOUBLE_EQ(j["problem"]["cohesion"]["viscosity_m"].get<double>(), 0.5e-3);
+  EXPECT_EQ(j["steps"]["crack_depth_m"].size(), 433u);
+}
+
+TEST(CmdPlaneStrain, CohesiveOptionsWithoutToughnessAreRefused) {
+  const auto run = run_mneedle(kPaperC + " --initial-cut 3.2mm");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("need --toughness"), std::string::npos) << run.err;
+}
+
 TEST(CmdPlaneStrain, ValueWithoutUnitIsOneLineNamingTheOption) {
   const auto run = run_mneedle(
       "plane-strain --tissue 7kPa,0.475 --block 160mm,86mm --thickness 15 --needle-width 8mm "

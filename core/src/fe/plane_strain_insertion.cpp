@@ -31,6 +31,12 @@ constexpr double kForceTolerance = 1e-10;
 // error is then of order rho * 1e-12, the force's direction off by 1e-6. The update converges
 // linearly (ratio up to 0.95 on paper C's shoulder), so a tighter value costs hundreds of solves.
 constexpr double kNormalTolerance = 1e-6;
+// A cohesive node's secant has converged when it moves by less than this fraction of the law's
+// initial stiffness.
+constexpr double kSecantTolerance = 1e-9;
+// With viscosity the damage approaches 1 geometrically: a cell counts as failed (and is removed)
+// within this much of it.
+constexpr double kFailedDamage = 1e-3;
 
 [[noreturn]] void bad(const std::string& field, const std::string& what) {
   throw InputError("plane-strain insertion: " + field + " " + what);
@@ -74,6 +80,23 @@ void check(const PlaneStrainInsertionProblem& p) {
     bad("friction_coefficient",
         "must be finite and not negative, got " + str(p.friction_coefficient));
   positive("travel_m", p.travel_m);
+  const CohesiveLaw& c = p.cohesion;
+  if (!std::isfinite(c.toughness_J_per_m2) || c.toughness_J_per_m2 < 0.0)
+    bad("cohesion.toughness_J_per_m2",
+        "must be finite and not negative, got " + str(c.toughness_J_per_m2));
+  if (c.toughness_J_per_m2 > 0.0) {
+    if (!std::isfinite(c.peak_opening_m) || c.peak_opening_m <= 0.0)
+      bad("cohesion.peak_opening_m", "must be positive and finite, got " + str(c.peak_opening_m));
+    if (!std::isfinite(c.failure_opening_m) || c.failure_opening_m <= c.peak_opening_m)
+      bad("cohesion.failure_opening_m", "must be finite and above peak_opening_m " +
+                                            str(c.peak_opening_m) + " m, got " +
+                                            str(c.failure_opening_m));
+    if (!std::isfinite(c.initial_cut_m) || c.initial_cut_m < 0.0 ||
+        c.initial_cut_m >= p.block_depth_m)
+      bad("cohesion.initial_cut_m", "must be in [0, block_depth_m), got " + str(c.initial_cut_m));
+    if (!std::isfinite(c.viscosity_m) || c.viscosity_m < 0.0)
+      bad("cohesion.viscosity_m", "must be finite and not negative, got " + str(c.viscosity_m));
+  }
   if (!std::isfinite(p.shoulder_radius_m) || p.shoulder_radius_m < 0.0 ||
       p.shoulder_radius_m > 0.25 * p.needle_width_m)
     bad("shoulder_radius_m",
@@ -141,7 +164,8 @@ Grid make_grid(const PlaneStrainInsertionProblem& p) {
 // the flank, the tip being frictionless; mu on the shaft; growing along the arc). Stick: on the
 // shaft, moving with the needle. Apex: held at the tip, where the flank meets the mirror plane;
 // its force may point anywhere between the two normals (a node ahead of the tip meets it there).
-enum class State { Free, Mirror, Slide, Apex, Stick };
+// Bonded: held to its mirror image by the cohesive law (traction along x only).
+enum class State { Free, Mirror, Bonded, Slide, Apex, Stick };
 bool on_needle(State s) {
   return s == State::Slide || s == State::Apex || s == State::Stick;
 }
@@ -245,6 +269,47 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
     return mu * std::clamp(turn / half_angle, 0.0, 1.0);
   };
 
+  // The cohesive law, per cut node: its share L_j of the cut's length, whether it is bonded at all
+  // (below the initial cut), the largest opening it has reached (history) and the secant
+  // stiffness t(delta)/delta of the current iterate, so that its force on the half model is
+  // f_x = -2 L_j s_j u_x (the opening delta = 2 u_x: both halves move apart).
+  const CohesiveLaw& law = p.cohesion;
+  const bool cohesive = law.toughness_J_per_m2 > 0.0;
+  const double peak_traction =
+      cohesive ? 2.0 * law.toughness_J_per_m2 / law.failure_opening_m : 0.0;
+  auto traction = [&](double delta) {  // the envelope
+    if (delta <= law.peak_opening_m) return peak_traction * delta / law.peak_opening_m;
+    if (delta >= law.failure_opening_m) return 0.0;
+    return peak_traction * (law.failure_opening_m - delta) /
+           (law.failure_opening_m - law.peak_opening_m);
+  };
+  std::vector<double> share(m, 0.0), opened(m, 0.0), secant(m, 0.0), damage(m, 0.0);
+  const double stiffness0 = cohesive ? peak_traction / law.peak_opening_m : 0.0;
+  // The law's damage at the largest opening reached: t = (1 - D) K delta on unloading.
+  auto law_damage = [&](double reached) {
+    return reached <= law.peak_opening_m ? 0.0 : 1.0 - traction(reached) / (stiffness0 * reached);
+  };
+  double relax = 0.0;  // travel of this step over the viscosity (0: none)
+  std::vector<char> bonded(m, 0);
+  for (int j = 0; j < m; ++j) {
+    share[j] =
+        0.5 * ((j > 0 ? g.y[j - 1] - g.y[j] : 0.0) + (j + 1 < m ? g.y[j] - g.y[j + 1] : 0.0));
+    bonded[j] = cohesive && -g.y[j] > law.initial_cut_m + 1e-12 * p.block_depth_m;
+    if (bonded[j]) secant[j] = peak_traction / law.peak_opening_m;
+  }
+  // The secant at the opening delta with the node's history: loading along the envelope,
+  // unloading to the origin from the largest opening reached.
+  // With a viscosity eta (travel), the damage relaxes towards the law's over the step:
+  // D = (D_old + r D_law) / (1 + r), r = step / eta (backward Euler; Abaqus's viscous
+  // regularisation, with the needle's travel as time).
+  auto secant_at = [&](int j, double delta) {
+    const double reached = std::max(delta, opened[j]);
+    const double d_law = law_damage(reached);
+    const double d = law.viscosity_m > 0.0 ? (damage[j] + relax * d_law) / (1.0 + relax) : d_law;
+    return (1.0 - d) * stiffness0;
+  };
+  auto holding = [&](int j) { return bonded[j] && secant[j] > 0.0; };
+
   PlaneStrainInsertionResult out;
   out.nodes = g.nx() * g.ny();
   out.elements = (g.nx() - 1) * (g.ny() - 1);
@@ -256,19 +321,26 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
   const int steps = static_cast<int>(std::ceil(p.travel_m / out.step_m - 1e-9));
   out.steps.reserve(steps + 1);
   out.steps.push_back({});
+  if (cohesive) out.steps[0].crack_depth_m = law.initial_cut_m;
 
   std::vector<State> state(m, State::Free);
+  for (int j = 0; j < m; ++j)
+    if (bonded[j]) state[j] = State::Bonded;
   // A sliding node's face (2 shaft, 3 arc, 1 flank) and normal, fixed for a solve and updated
   // from its new position until they stop changing.
   std::vector<int> face_of(m, 1);
   std::vector<Eigen::Vector2d> normal_of(m, flank_normal);
   Eigen::VectorXd f = Eigen::VectorXd::Zero(2 * m), u = Eigen::VectorXd::Zero(2 * m);
-  const int max_iterations = 50 + 4 * m;
+  // Softening cohesion adds secant iterations: a crack running through many cells in one step
+  // fails them one after another.
+  const int max_iterations = cohesive ? 50 + 20 * m : 50 + 4 * m;
   for (int s = 1; s <= steps; ++s) {
     const double travel = std::min(p.travel_m, s * out.step_m);
     const double dd = travel - out.steps.back().travel_m;
     const Eigen::Vector2d apex(0.0, -travel);
     const Eigen::VectorXd f_prev = f, u_prev = u;
+    const std::vector<double> secant_prev = secant;
+    relax = law.viscosity_m > 0.0 ? dd / law.viscosity_m : 0.0;
     const std::vector<State> state_prev = state;
     // Which face of the outline a node at (ux, Y + uy) faces (2 shaft, 3 arc, 1 flank, 0 below
     // the tip), that face's outward normal there and the node's gap to it.
@@ -322,9 +394,17 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
         const int j = act[k];
         const int rx = 2 * k, ry = 2 * k + 1;
         const Eigen::Vector2d x0 = Eigen::Vector2d(0.0, g.y[j]) - apex;  // reference, from apex
+        // The cohesive force the node also feels, f_coh,x = -coh u_x: the needle's force on it is
+        // f - f_coh, so the needle's own conditions add coh u_x to f_x.
+        const double coh = holding(j) ? 2.0 * share[j] * secant[j] : 0.0;
         switch (state[j]) {
           case State::Mirror:  // u_x = 0, frictionless
             A.row(rx) = u_row(2 * j);
+            A(ry, ry) = 1.0;
+            break;
+          case State::Bonded:  // f_x = -coh u_x, no shear
+            A.row(rx) = coh * u_row(2 * j);
+            A(rx, rx) += 1.0;
             A(ry, ry) = 1.0;
             break;
           case State::Slide: {
@@ -336,8 +416,9 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
             b[rx] = level - n.dot(x0);
             // Along the outline: friction mu(n) N against the upward slip.
             const double k_f = friction_of(n);
-            A(ry, rx) = t.x() + k_f * n.x();
-            A(ry, ry) = t.y() + k_f * n.y();
+            A.row(ry) = (t.x() + k_f * n.x()) * coh * u_row(2 * j);
+            A(ry, rx) += t.x() + k_f * n.x();
+            A(ry, ry) += t.y() + k_f * n.y();
             break;
           }
           case State::Apex:  // at the tip point
@@ -367,17 +448,32 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
       const double force_tol = kForceTolerance * std::max(f.cwiseAbs().maxCoeff(), 1e-300);
       bool changed = false;
       for (int j = 0; j < m; ++j) {
-        const double ux = u[2 * j], uy = u[2 * j + 1], fx = f[2 * j], fy = f[2 * j + 1];
+        // fx: the needle's (or the mirror's) share of the node's force, cohesion taken out.
+        const double ux = u[2 * j], uy = u[2 * j + 1], fy = f[2 * j + 1];
+        const double fx = f[2 * j] + (holding(j) ? 2.0 * share[j] * secant[j] * ux : 0.0);
         const Facing at = facing(j, ux, uy);
         const State before = state[j];
+        if (bonded[j]) {
+          // The secant through this iterate's opening (a fixed point: a crack that runs fails
+          // its cells one after another within the step).
+          const double s_new = ux > 0.0 ? secant_at(j, 2.0 * ux) : secant[j];
+          if (std::abs(s_new - secant[j]) >
+              kSecantTolerance * (peak_traction / law.peak_opening_m)) {
+            secant[j] = s_new;
+            changed = true;
+          }
+        }
         switch (state[j]) {
           case State::Free:
           case State::Mirror:
+          case State::Bonded:
             if (at.gap < -gap_tol)
               start_sliding(j, at);
-            else if (state[j] == State::Free && ux < -gap_tol)
+            else if (state[j] != State::Mirror && ux < -gap_tol)
               state[j] = State::Mirror;
             else if (state[j] == State::Mirror && fx < -force_tol)
+              state[j] = holding(j) ? State::Bonded : State::Free;
+            else if (state[j] == State::Bonded && !holding(j))
               state[j] = State::Free;
             break;
           case State::Slide: {
@@ -386,7 +482,7 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
             // up relative to the needle, as the friction force -mu N assumes).
             const double rel = (uy - u_prev[2 * j + 1]) + dd;
             if (lambda < -force_tol) {
-              state[j] = State::Free;
+              state[j] = holding(j) ? State::Bonded : State::Free;
             } else if (at.face == 0) {
               state[j] = State::Apex;
             } else if ((at.face != face_of[j] && face_changes[j] < 3) ||
@@ -411,11 +507,11 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
             // that has come back to the apex twice in this step stays there: its force leans
             // just past one normal while that face's own solution puts it beyond the apex (the
             // sharp vertex's discretisation; docs/model.md, "Plane-strain insertion").
-            const double on_flank = -fy / std::sin(half_angle);
+            const double on_flank = -fy / std::sin(half_angle);  // fy: the needle's alone
             const double on_mirror = fx - on_flank * flank_normal.x();
             if (apex_visits[j] > 2) break;
             if (on_flank < -force_tol && on_mirror < -force_tol)
-              state[j] = State::Free;
+              state[j] = holding(j) ? State::Bonded : State::Free;
             else if (on_flank < -force_tol)
               state[j] = State::Mirror;
             else if (on_mirror < -force_tol)
@@ -424,7 +520,7 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
           }
           case State::Stick:
             if (fx < -force_tol)
-              state[j] = State::Free;
+              state[j] = holding(j) ? State::Bonded : State::Free;
             else if (std::abs(fy) > mu * fx + force_tol)
               start_sliding(j, {2, Eigen::Vector2d::UnitX(), 0.0});
             break;
@@ -436,9 +532,23 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
         PlaneStrainInsertionStep st;
         st.travel_m = travel;
         st.active_set_iterations = iterations;
-        double friction_work = 0.0;
+        double friction_work = 0.0, cohesive_work = 0.0, cohesive_stored = 0.0;
+        // The needle's share of a node's x force at the end and at the start of the step.
+        auto needle_fx = [&](const Eigen::VectorXd& ff, const Eigen::VectorXd& uu,
+                             const std::vector<double>& ss, int j) {
+          return ff[2 * j] + (bonded[j] ? 2.0 * share[j] * ss[j] * uu[2 * j] : 0.0);
+        };
         for (int j = 0; j < m; ++j) {
-          const double fx = f[2 * j], fy = f[2 * j + 1];
+          if (bonded[j]) {
+            // Work into the interface, trapezoidal in the opening (exact on each linear branch),
+            // and what it stores: half the model's share, times 2 t for the whole block.
+            const double d0 = 2.0 * std::max(0.0, u_prev[2 * j]),
+                         d1 = 2.0 * std::max(0.0, u[2 * j]);
+            const double t0 = secant_prev[j] * d0, t1 = secant[j] * d1;
+            cohesive_work += 0.5 * scale * share[j] * 0.5 * (t0 + t1) * (d1 - d0);
+            cohesive_stored += 0.5 * scale * share[j] * 0.5 * t1 * d1;
+          }
+          const double fx = needle_fx(f, u, secant, j), fy = f[2 * j + 1];
           out.max_penetration_m =
               std::max({out.max_penetration_m, -facing(j, u[2 * j], u[2 * j + 1]).gap, -u[2 * j]});
           if (!on_needle(state[j])) continue;
@@ -464,20 +574,54 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
           const double normal_now = n.dot(Eigen::Vector2d(fx, fy));
           const double normal_mean =
               state_prev[j] == State::Slide
-                  ? 0.5 * (normal_now + n.dot(Eigen::Vector2d(f_prev[2 * j], f_prev[2 * j + 1])))
+                  ? 0.5 * (normal_now +
+                           n.dot(Eigen::Vector2d(needle_fx(f_prev, u_prev, secant_prev, j),
+                                                 f_prev[2 * j + 1])))
                   : normal_now;
           friction_work += scale * friction_of(n) * normal_mean * std::abs(rel);
         }
         const PlaneStrainInsertionStep& last = out.steps.back();
         st.external_work_J = last.external_work_J + 0.5 * (last.force_N + st.force_N) * dd;
         st.friction_work_J = last.friction_work_J + friction_work;
+        st.cohesive_work_J = last.cohesive_work_J + cohesive_work;
         st.strain_energy_J = 0.5 * scale * f.dot(u);
+        // The interface's history: the largest opening; a node opened past delta_0 has failed.
+        for (int j = 0; j < m; ++j) {
+          if (!bonded[j]) continue;
+          opened[j] = std::max(opened[j], 2.0 * u[2 * j]);
+          damage[j] = 1.0 - secant[j] / stiffness0;
+          if (opened[j] >= law.failure_opening_m && damage[j] > 1.0 - kFailedDamage) {
+            bonded[j] = 0;
+            secant[j] = 0.0;
+            if (state[j] == State::Bonded) state[j] = State::Free;
+          }
+        }
+        st.fracture_energy_J = st.cohesive_work_J - cohesive_stored;
+        // The crack: the initial cut and every failed cell below it, down to the first cell
+        // still bonded.
+        if (cohesive) {
+          st.crack_depth_m = law.initial_cut_m;
+          for (int j = 0; j < m && !bonded[j]; ++j)
+            st.crack_depth_m = std::max(st.crack_depth_m, -g.y[j]);
+        }
         if (st.external_work_J > 0.0)
           st.balance_error =
-              (st.external_work_J - st.strain_energy_J - st.friction_work_J) / st.external_work_J;
+              (st.external_work_J - st.strain_energy_J - st.friction_work_J - st.cohesive_work_J) /
+              st.external_work_J;
         out.steps.push_back(st);
         break;
       }
+    }
+  }
+  // Puncture: the first cell of the interface to fail, where the crack starts to run from the
+  // initial cut; its force the largest up to there.
+  double largest = 0.0;
+  for (const PlaneStrainInsertionStep& st : out.steps) {
+    largest = std::max(largest, st.force_N);
+    if (cohesive && st.crack_depth_m > law.initial_cut_m + 1e-12 * p.block_depth_m) {
+      out.puncture_travel_m = st.travel_m;
+      out.puncture_force_N = largest;
+      break;
     }
   }
   const double final_work = out.steps.back().external_work_J;

@@ -107,6 +107,71 @@ TEST(PlaneStrainInsertion, NoCutNodeEntersTheNeedleOrItsMirrorImage) {
   EXPECT_GT(paper_c_run().steps.back().shaft_contacts, 40);  // 54 cut nodes, most on the shaft
 }
 
+// Paper C's run with cohesion (§6): G_c 17.43 J/m^2, delta_y 7 mm, delta_0 7.5 mm, two 1.6 mm
+// cells cut at the top; our viscosity 0.5 mm (the default).
+PlaneStrainInsertionProblem paper_c_cohesive() {
+  PlaneStrainInsertionProblem p = paper_c(0.5);
+  p.cohesion.toughness_J_per_m2 = 17.43;
+  p.cohesion.peak_opening_m = 7e-3;
+  p.cohesion.failure_opening_m = 7.5e-3;
+  p.cohesion.initial_cut_m = 3.2e-3;
+  return p;
+}
+
+const PlaneStrainInsertionResult& paper_c_cohesive_run() {
+  static const PlaneStrainInsertionResult r = simulate_plane_strain_insertion(paper_c_cohesive());
+  return r;
+}
+
+// Paper C's Table 1, "finite element with cohesion": external work 0.084 J, cutting 0.022 J,
+// friction 0.059 J, strain energy 0.004 J; the issue asks 15 %. External work and cutting are
+// within it on every mesh (-8.1 % / -7.5 % here, -8.2 % / -7.1 % on 0.4 mm cells). Friction and
+// strain energy miss (converged -15.9 % and +53 %, docs/validation.md "Plane-strain insertion"):
+// they are pinned to our converged values, 2 % being above the meshes' spread (1.4 %, 0.2 %).
+TEST(PlaneStrainInsertion, PaperCRunWithCohesionMatchesItsTable1RowInWorkAndCutting) {
+  const PlaneStrainInsertionStep& end = paper_c_cohesive_run().steps.back();
+  EXPECT_NEAR(end.external_work_J / 0.084, 1.0, 0.15);
+  EXPECT_NEAR(end.fracture_energy_J / 0.022, 1.0, 0.15);
+  EXPECT_NEAR(end.friction_work_J / 49.61e-3, 1.0, 0.02);
+  EXPECT_NEAR(end.strain_energy_J / 6.10e-3, 1.0, 0.02);
+}
+
+TEST(PlaneStrainInsertion, EnergyLedgerClosesWithCohesion) {
+  // W_ext = U + W_f + W_coh at every step. Measured 1.02 % / 0.48 % / 0.26 % at 1.6 / 0.8 /
+  // 0.4 mm cells; without the viscosity 5.6 % at 1.6 mm (each failing cell snaps the block open
+  // within a step, and the friction of that snap is not resolved). Bound: paper C's 2 %.
+  EXPECT_LT(paper_c_cohesive_run().max_abs_balance_error, 0.02);
+}
+
+TEST(PlaneStrainInsertion, FractureEnergyPerCrackAreaIsTheToughnessPlusTheProcessZone) {
+  // Dissipated energy over the area failed below the initial cut: at least G_c; above it by the
+  // cells past the peak that have not failed yet (the process zone along the flank) and by the
+  // viscosity's overshoot. Measured 1.19 G_c; 1.3 would mean energy dissipated elsewhere.
+  const PlaneStrainInsertionStep& end = paper_c_cohesive_run().steps.back();
+  const double area = 0.015 * (end.crack_depth_m - 3.2e-3);
+  const double g = end.fracture_energy_J / area;
+  EXPECT_GT(g, 17.43);
+  EXPECT_LT(g, 1.3 * 17.43);
+}
+
+TEST(PlaneStrainInsertion, PunctureIsWhereTheCrackStartsToRun) {
+  const PlaneStrainInsertionResult& r = paper_c_cohesive_run();
+  // The first cell below the cut fails at 24.29 mm (0.777 N); 22.89 and 22.10 mm on 0.8 and
+  // 0.4 mm cells (bench/bench_plane_strain_insertion): converging, the 1.6 mm cells 10 % late.
+  // 1 % pins this mesh's value against a change of the model.
+  EXPECT_NEAR(r.puncture_travel_m / 24.29e-3, 1.0, 0.01);
+  EXPECT_NEAR(r.puncture_force_N / 0.777, 1.0, 0.01);
+  for (const PlaneStrainInsertionStep& s : r.steps) {
+    if (s.travel_m < r.puncture_travel_m) {
+      EXPECT_DOUBLE_EQ(s.crack_depth_m, 3.2e-3);
+    } else {
+      EXPECT_GT(s.crack_depth_m, 3.2e-3);
+    }
+  }
+  // The cut block has no puncture.
+  EXPECT_EQ(paper_c_run().puncture_travel_m, 0.0);
+}
+
 void expect_refused(const std::function<void(PlaneStrainInsertionProblem&)>& edit,
                     const std::string& field) {
   PlaneStrainInsertionProblem p = paper_c(0.5);
@@ -129,6 +194,20 @@ TEST(PlaneStrainInsertion, BadProblemIsRefusedNamingTheField) {
   expect_refused([](auto& p) { p.block_width_m = 0.02; }, "block_width_m");
   expect_refused([](auto& p) { p.element_size_m = 3e-3; }, "element_size_m");
   expect_refused([](auto& p) { p.step_m = 2e-3; }, "step_m");
+  expect_refused(
+      [](auto& p) {
+        p.cohesion.toughness_J_per_m2 = 17.43;
+        p.cohesion.peak_opening_m = 7e-3;
+        p.cohesion.failure_opening_m = 7e-3;
+      },
+      "cohesion.failure_opening_m");
+  expect_refused(
+      [](auto& p) {
+        p.cohesion.toughness_J_per_m2 = 17.43;
+        p.cohesion.peak_opening_m = 0.0;
+      },
+      "cohesion.peak_opening_m");
+  expect_refused([](auto& p) { p.cohesion.toughness_J_per_m2 = -1.0; }, "cohesion.toughness");
   // A tiny cell is refused before any allocation: the cut's nodes bound every step's work.
   expect_refused([](auto& p) { p.element_size_m = 1e-6; }, "element_size_m");
 }

@@ -15,6 +15,24 @@
 
 namespace mneedle::fe {
 
+/// Paper C's bilinear traction-separation law (its Fig. 3) on the cut ahead of the needle: the
+/// traction rises linearly to its peak 2 G_c / delta_0 at the opening delta_y, falls linearly to
+/// zero at delta_0 (G_c the area under it) and never heals: below the largest opening reached it
+/// unloads to the origin. Mode I only (the symmetric half model has no shear across the cut).
+struct CohesiveLaw {
+  double toughness_J_per_m2 = 0.0;  ///< G_c; 0: no cohesion, the block is cut through
+  double peak_opening_m = 0.0;      ///< delta_y
+  double failure_opening_m = 0.0;   ///< delta_0 > delta_y
+  /// Depth cut before the insertion, from the top surface (paper C removes two 1.6 mm elements
+  /// "to enable initial separation").
+  double initial_cut_m = 0.0;
+  /// Viscous regularisation (a travel): the damage relaxes towards the law's over this much
+  /// travel of the needle, so that a cell failing does not snap the block open within one step
+  /// (docs/model.md, "Cohesive interface"). 0: none (rate-independent; the ledger then misses
+  /// by the energy of each snap).
+  double viscosity_m = 0.5e-3;
+};
+
 struct PlaneStrainInsertionProblem {
   double youngs_modulus_Pa = 0.0;
   double poisson_ratio = 0.0;
@@ -28,6 +46,7 @@ struct PlaneStrainInsertionProblem {
   /// shoulder is not offered: nodes snap off it (docs/model.md, "Plane-strain insertion").
   double shoulder_radius_m = 0.0;
   double travel_m = 0.0;  ///< tip travel from touching the top surface, at most 2 x depth
+  CohesiveLaw cohesion;   ///< toughness 0 (the default): the cut runs through the whole block
   /// Travel per step, at most one cell; 0: kInsertionDefaultStepFraction of the cell size.
   double step_m = 0.0;
   /// Cell size along the cut and across the uniform zone; 0: w / 8.
@@ -52,13 +71,16 @@ inline constexpr double kInsertionMaxSteps = 20000.0;
 /// One step's state, for the whole block.
 struct PlaneStrainInsertionStep {
   double travel_m = 0.0;
-  double force_N = 0.0;           ///< pushing the needle down: tip normal forces + shaft friction
-  double friction_force_N = 0.0;  ///< the shaft's share of force_N (its friction)
-  double normal_force_N = 0.0;    ///< normal force of the cut faces on the shaft (both sides)
-  double external_work_J = 0.0;   ///< integral of force over travel (trapezoidal)
-  double strain_energy_J = 0.0;   ///< 1/2 u^T K u
-  double friction_work_J = 0.0;   ///< sum of mu N times slip, from the slipping nodes
-  /// (W_ext - U - W_f) / W_ext: the ledger's closure; 0 before the needle has done work.
+  double force_N = 0.0;            ///< pushing the needle down: tip normal forces + shaft friction
+  double friction_force_N = 0.0;   ///< the shaft's share of force_N (its friction)
+  double normal_force_N = 0.0;     ///< normal force of the cut faces on the shaft (both sides)
+  double external_work_J = 0.0;    ///< integral of force over travel (trapezoidal)
+  double strain_energy_J = 0.0;    ///< 1/2 u^T K u
+  double friction_work_J = 0.0;    ///< sum of mu N times slip, from the slipping nodes
+  double cohesive_work_J = 0.0;    ///< work into the cohesive interface (dissipated + stored)
+  double fracture_energy_J = 0.0;  ///< the dissipated part of cohesive_work_J
+  double crack_depth_m = 0.0;  ///< the crack's end below the surface: initial cut + failed cells
+  /// (W_ext - U - W_f - W_coh) / W_ext: the ledger's closure; 0 before the needle has done work.
   double balance_error = 0.0;
   int tip_contacts = 0;    ///< cut nodes on the tip: flank, shoulder arc, apex
   int shaft_contacts = 0;  ///< cut nodes on the shaft
@@ -77,6 +99,10 @@ struct PlaneStrainInsertionResult {
   double shoulder_radius_m = 0.0;      ///< the arc's radius actually used
   double max_abs_balance_error = 0.0;  ///< over steps with external work above 1e-3 of the last
   double max_penetration_m = 0.0;      ///< deepest cut node inside the needle or its mirror face
+  /// With cohesion: the puncture, where the first cell below the initial cut fails and the crack
+  /// starts to run (travel 0 when none fails), and the largest force up to there.
+  double puncture_travel_m = 0.0;
+  double puncture_force_N = 0.0;
 };
 
 /// Runs the insertion. Throws InputError (one line naming the field) on a bad problem and
