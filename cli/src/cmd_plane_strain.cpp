@@ -2,6 +2,7 @@
 // its force curve and energy ledger (docs/model.md, "Plane-strain insertion along a cut").
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -101,6 +102,9 @@ void run_plane_strain(const PlaneStrainArgs& a) {
     if (a.openings.empty())
       throw InputError("plane-strain: --toughness needs --cohesive-openings (e.g. 7mm,7.5mm)");
     p.cohesion.toughness_J_per_m2 = quantity("--toughness", a.toughness, Dimension::Toughness);
+    if (!(p.cohesion.toughness_J_per_m2 > 0.0))
+      throw InputError("--toughness '" + a.toughness +
+                       "': must be positive (leave it out for a cut block)");
     const auto [peak, failure] = pair_of("--cohesive-openings", a.openings, Dimension::Length,
                                          Dimension::Length, "7mm,7.5mm");
     p.cohesion.peak_opening_m = peak;

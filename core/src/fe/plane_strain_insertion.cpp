@@ -76,9 +76,13 @@ void check(const PlaneStrainInsertionProblem& p) {
   if (!std::isfinite(p.tip_angle_rad) || p.tip_angle_rad <= 0.0 ||
       p.tip_angle_rad >= std::numbers::pi)
     bad("tip_angle_rad", "must be in (0, pi), got " + str(p.tip_angle_rad));
-  if (!std::isfinite(p.friction_coefficient) || p.friction_coefficient < 0.0)
+  // Above 0.6 the sliding state's assumption (the cut faces slip up along the needle) fails:
+  // stick and slip cycle and the contact set does not settle (measured at 0.7 and above on
+  // paper C's case; docs/model.md, "Plane-strain insertion along a cut").
+  if (!std::isfinite(p.friction_coefficient) || p.friction_coefficient < 0.0 ||
+      p.friction_coefficient > kInsertionMaxFriction)
     bad("friction_coefficient",
-        "must be finite and not negative, got " + str(p.friction_coefficient));
+        "must be in [0, " + str(kInsertionMaxFriction) + "], got " + str(p.friction_coefficient));
   positive("travel_m", p.travel_m);
   const CohesiveLaw& c = p.cohesion;
   if (!std::isfinite(c.toughness_J_per_m2) || c.toughness_J_per_m2 < 0.0)
@@ -112,7 +116,12 @@ void check(const PlaneStrainInsertionProblem& p) {
         std::pair{"uniform_zone_m", p.uniform_zone_m}})
     if (!std::isfinite(v) || v < 0.0)
       bad(field, "must be positive (or 0 for the default), got " + str(v));
-  const double h = element_size(p);
+  const double h_requested = element_size(p);
+  if (p.uniform_zone_m != 0.0 && p.uniform_zone_m < h_requested)
+    bad("uniform_zone_m", str(p.uniform_zone_m) + " m is below the cell size " + str(h_requested) +
+                              " m (0 for the default)");
+  // The cells along the cut divide the depth evenly: at most the requested size.
+  const double h = p.block_depth_m / std::ceil(p.block_depth_m / h_requested - 1e-9);
   if (h > p.needle_width_m / 4.0)
     bad("element_size_m", str(h) + " m leaves fewer than 2 cells across the needle's half width " +
                               str(0.5 * p.needle_width_m) + " m");
@@ -370,6 +379,7 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
     for (int j = 0; j < m; ++j)
       if (state[j] == State::Apex) start_sliding(j, {1, flank_normal, 0.0});
     std::vector<int> apex_visits(m, 0), face_changes(m, 0);
+    std::vector<double> relaxation(m, 1.0), last_turn(m, 0.0);
     int iterations = 0;
     for (;;) {
       if (iterations == max_iterations)
@@ -456,7 +466,7 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
         if (bonded[j]) {
           // The secant through this iterate's opening (a fixed point: a crack that runs fails
           // its cells one after another within the step).
-          const double s_new = ux > 0.0 ? secant_at(j, 2.0 * ux) : secant[j];
+          const double s_new = secant_at(j, 2.0 * std::max(ux, 0.0));
           if (std::abs(s_new - secant[j]) >
               kSecantTolerance * (peak_traction / law.peak_opening_m)) {
             secant[j] = s_new;
@@ -493,9 +503,22 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
               // sent across it by either face's linearisation: after three changes of face in
               // a step it keeps the last (its normal is then the junction's to within the
               // step's slide, and its gap to the other face second order in it).
+              // On the arc the update is relaxed where it overshoots: with friction the normal's
+              // fixed point can oscillate (mu 1: +-0.09 rad, growing); a reversal of the turn
+              // halves the node's relaxation factor.
+              if (at.face == 3 && face_of[j] == 3) {
+                const double from = std::atan2(normal_of[j].y(), normal_of[j].x());
+                const double turn = std::atan2(at.normal.y(), at.normal.x()) - from;
+                if (turn * last_turn[j] < 0.0)
+                  relaxation[j] = std::max(1.0 / 64.0, 0.5 * relaxation[j]);
+                last_turn[j] = turn;
+                const double to = from + relaxation[j] * turn;
+                normal_of[j] = Eigen::Vector2d(std::cos(to), std::sin(to));
+              } else {
+                normal_of[j] = at.normal;
+              }
               face_changes[j] += at.face != face_of[j];
               face_of[j] = at.face;
-              normal_of[j] = at.normal;
               changed = true;
             } else if (at.face == 2 && mu > 0.0 && rel < -gap_tol && !block.y_fixed(j)) {
               state[j] = State::Stick;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <numbers>
@@ -67,7 +68,8 @@ TEST(PlaneStrainInsertion, FrictionlessInsertionStoresTheWorkDone) {
   EXPECT_LT(r.max_abs_balance_error, 0.05);
   EXPECT_LT(std::abs(r.steps.back().balance_error), 0.01);
   for (const PlaneStrainInsertionStep& s : r.steps) {
-    EXPECT_EQ(s.friction_force_N, 0.0);
+    // mu(n) = 0 makes the tangential rows f_y = 0 up to the LU's round-off.
+    EXPECT_NEAR(s.friction_force_N, 0.0, 1e-12 * (1.0 + s.normal_force_N));
     EXPECT_EQ(s.friction_work_J, 0.0);
   }
   // The wedged-open block stores less than with friction (no drag): 2.90 mJ against 4.79 mJ.
@@ -190,6 +192,8 @@ TEST(PlaneStrainInsertion, BadProblemIsRefusedNamingTheField) {
   expect_refused([](auto& p) { p.tip_angle_rad = std::numbers::pi; }, "tip_angle_rad");
   expect_refused([](auto& p) { p.shoulder_radius_m = 3e-3; }, "shoulder_radius_m");
   expect_refused([](auto& p) { p.friction_coefficient = std::nan(""); }, "friction_coefficient");
+  // At 0.7 stick and slip cycle ("the contact set did not settle at travel 8.8 mm").
+  expect_refused([](auto& p) { p.friction_coefficient = 0.7; }, "friction_coefficient");
   expect_refused([](auto& p) { p.travel_m = 0.2; }, "travel_m");
   expect_refused([](auto& p) { p.block_width_m = 0.02; }, "block_width_m");
   expect_refused([](auto& p) { p.element_size_m = 3e-3; }, "element_size_m");
@@ -208,6 +212,27 @@ TEST(PlaneStrainInsertion, BadProblemIsRefusedNamingTheField) {
       },
       "cohesion.peak_opening_m");
   expect_refused([](auto& p) { p.cohesion.toughness_J_per_m2 = -1.0; }, "cohesion.toughness");
+  expect_refused(
+      [](auto& p) {
+        p.cohesion = {17.43, 7e-3, 7.5e-3, 0.086, 0.5e-3};
+      },
+      "cohesion.initial_cut_m");
+  expect_refused(
+      [](auto& p) {
+        p.cohesion = {17.43, 7e-3, 7.5e-3, 3.2e-3, -1e-3};
+      },
+      "cohesion.viscosity_m");
+  expect_refused([](auto& p) { p.uniform_zone_m = 1e-12; }, "uniform_zone_m");
+  // The step is checked against the cells the mesh has (the depth divided evenly: 2.4 mm in
+  // 1 mm cells gives 0.8 mm cells), not the size asked for.
+  expect_refused(
+      [](auto& p) {
+        p.block_depth_m = 2.4e-3;
+        p.element_size_m = 1e-3;
+        p.step_m = 1e-3;
+        p.travel_m = 2e-3;
+      },
+      "step_m");
   // A tiny cell is refused before any allocation: the cut's nodes bound every step's work.
   expect_refused([](auto& p) { p.element_size_m = 1e-6; }, "element_size_m");
 }

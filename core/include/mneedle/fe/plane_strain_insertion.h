@@ -1,11 +1,13 @@
 #pragma once
 // Plane-strain insertion of a rigid needle along a cut through a block (paper C §6: Oldfield,
 // Dini, Giordano, Rodriguez y Baena, CMBBE 16(5):530-543, 2013): the needle is a strip of width
-// w with a wedge tip, pushed down along the block's mid-plane, where the block is already cut
-// (paper C's run "with no cohesion"). Its tip slides on the cut faces without friction; its
-// shaft holds them with Coulomb friction. The run records, step by step, the insertion force and
-// the energy ledger: external work, strain energy, friction dissipation
-// (docs/model.md, "Plane-strain insertion").
+// w with a wedge tip and a rounded shoulder, pushed down along the block's mid-plane, where the
+// block is either already cut (paper C's run "with no cohesion") or held together by paper C's
+// cohesive interface, which fails ahead of the needle. The tip's flank is frictionless, the
+// shaft holds the cut faces with Coulomb friction, and friction grows along the shoulder's arc
+// between the two. The run records, step by step, the insertion force and the energy ledger:
+// external work, strain energy, friction dissipation, cohesive work
+// (docs/model.md, "Plane-strain insertion along a cut").
 // Half model x >= 0 (the cut on x = 0, the needle's axis), y up, top surface y = 0, bottom
 // y = -depth on rollers (u_y = 0), side x = width/2 pinned. Small-strain linear elasticity, the
 // bilinear rectangles of the plane-strain crack model. SI units; forces and energies are for
@@ -36,12 +38,13 @@ struct CohesiveLaw {
 struct PlaneStrainInsertionProblem {
   double youngs_modulus_Pa = 0.0;
   double poisson_ratio = 0.0;
-  double block_width_m = 0.0;         ///< full width; the cut at its centre
-  double block_depth_m = 0.0;         ///< top surface to the bottom supports
-  double thickness_m = 0.0;           ///< out of plane
-  double needle_width_m = 0.0;        ///< w, shaft width
-  double tip_angle_rad = 0.0;         ///< included angle of the wedge tip, in (0, pi)
-  double friction_coefficient = 0.0;  ///< Coulomb, shaft only; the tip is frictionless
+  double block_width_m = 0.0;   ///< full width; the cut at its centre
+  double block_depth_m = 0.0;   ///< top surface to the bottom supports
+  double thickness_m = 0.0;     ///< out of plane
+  double needle_width_m = 0.0;  ///< w, shaft width
+  double tip_angle_rad = 0.0;   ///< included angle of the wedge tip, in (0, pi)
+  /// Coulomb, on the shaft; 0 on the tip's flank, growing along the shoulder's arc between.
+  double friction_coefficient = 0.0;
   /// Radius of the arc joining the tip's flank to the shaft, at most w/4; 0: w/4. A sharp
   /// shoulder is not offered: nodes snap off it (docs/model.md, "Plane-strain insertion").
   double shoulder_radius_m = 0.0;
@@ -65,6 +68,8 @@ inline constexpr double kInsertionGridGrowth = 1.1;
 /// on the cut's nodes, so their number bounds the work of every step.
 inline constexpr double kInsertionMaxNodes = 1.0e6;
 inline constexpr double kInsertionMaxCutNodes = 2000.0;
+/// Largest friction coefficient accepted: above it the sliding state's upward slip fails.
+inline constexpr double kInsertionMaxFriction = 0.6;
 /// Largest number of steps accepted.
 inline constexpr double kInsertionMaxSteps = 20000.0;
 
@@ -72,7 +77,7 @@ inline constexpr double kInsertionMaxSteps = 20000.0;
 struct PlaneStrainInsertionStep {
   double travel_m = 0.0;
   double force_N = 0.0;            ///< pushing the needle down: tip normal forces + shaft friction
-  double friction_force_N = 0.0;   ///< the shaft's share of force_N (its friction)
+  double friction_force_N = 0.0;   ///< the shaft's share of force_N (the arc's friction is not)
   double normal_force_N = 0.0;     ///< normal force of the cut faces on the shaft (both sides)
   double external_work_J = 0.0;    ///< integral of force over travel (trapezoidal)
   double strain_energy_J = 0.0;    ///< 1/2 u^T K u
