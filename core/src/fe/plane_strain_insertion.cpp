@@ -128,6 +128,17 @@ void check(const PlaneStrainInsertionProblem& p) {
   if (h > 0.5 * tip_length(p))
     bad("element_size_m", str(h) + " m leaves fewer than 2 cells along the tip's length " +
                               str(tip_length(p)) + " m");
+  if (c.toughness_J_per_m2 > 0.0) {
+    // The cohesive zone must be resolved: Hillerborg's length E G_c / sigma_max^2 (the scale of
+    // the process zone) at least kInsertionMinCellsPerCohesiveLength cells, or the puncture
+    // depth follows the mesh (docs/model.md, "Cohesive interface").
+    const double peak = 2.0 * c.toughness_J_per_m2 / c.failure_opening_m;
+    const double length = p.youngs_modulus_Pa * c.toughness_J_per_m2 / (peak * peak);
+    if (length < kInsertionMinCellsPerCohesiveLength * h)
+      bad("element_size_m",
+          str(h) + " m does not resolve the cohesive length E G_c / sigma_max^2 = " + str(length) +
+              " m: at most " + str(length / kInsertionMinCellsPerCohesiveLength) + " m");
+  }
   const double step = p.step_m > 0.0 ? p.step_m : kInsertionDefaultStepFraction * h;
   if (step > h)
     bad("step_m", str(step) + " m is longer than a cell (" + str(h) +

@@ -223,6 +223,13 @@ TEST(PlaneStrainInsertion, BadProblemIsRefusedNamingTheField) {
       },
       "cohesion.viscosity_m");
   expect_refused([](auto& p) { p.uniform_zone_m = 1e-12; }, "uniform_zone_m");
+  // Cohesive length 7 kPa x 17.43 / (4648 Pa)^2 = 5.65 mm: 2 mm cells span 2.8 of it.
+  expect_refused(
+      [](auto& p) {
+        p.cohesion = {17.43, 7e-3, 7.5e-3, 3.2e-3, 0.5e-3};
+        p.element_size_m = 2e-3;
+      },
+      "cohesive length");
   // The step is checked against the cells the mesh has (the depth divided evenly: 2.4 mm in
   // 1 mm cells gives 0.8 mm cells), not the size asked for.
   expect_refused(

@@ -70,6 +70,9 @@ inline constexpr double kInsertionMaxNodes = 1.0e6;
 inline constexpr double kInsertionMaxCutNodes = 2000.0;
 /// Largest friction coefficient accepted: above it the sliding state's upward slip fails.
 inline constexpr double kInsertionMaxFriction = 0.6;
+/// Cells the cohesive length E G_c / sigma_max^2 must span (the 3-5 elements in the
+/// process zone; paper C's 1.6 mm cells give 3.5).
+inline constexpr double kInsertionMinCellsPerCohesiveLength = 3.0;
 /// Largest number of steps accepted.
 inline constexpr double kInsertionMaxSteps = 20000.0;
 
