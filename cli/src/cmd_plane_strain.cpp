@@ -2,7 +2,6 @@
 // its force curve and energy ledger (docs/model.md, "Plane-strain insertion along a cut").
 #include <CLI/CLI.hpp>
 
-#include <algorithm>
 #include <fstream>
 #include <iomanip>
 #include <iostream>

@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -31,12 +30,6 @@ constexpr double kNormalTolerance = 1e-10;
 
 [[noreturn]] void bad(const std::string& field, const std::string& what) {
   throw InputError("plane-strain crack: " + field + " " + what);
-}
-
-std::string str(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
 }
 
 double element_size(const CrackOpeningProblem& p) {

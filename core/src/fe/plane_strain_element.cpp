@@ -3,8 +3,15 @@
 
 #include <array>
 #include <cmath>
+#include <sstream>
 
 namespace mneedle::fe {
+
+std::string str(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
 
 Eigen::Matrix<double, 8, 8> plane_strain_rectangle_stiffness(double hx, double hy, double E,
                                                              double nu) {

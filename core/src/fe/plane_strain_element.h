@@ -4,9 +4,13 @@
 // of a tensor-product grid and the geometric grading of that grid away from the needle.
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 namespace mneedle::fe {
+
+/// A number as the models' error messages print it (default stream format).
+std::string str(double v);
 
 /// Stiffness of a bilinear rectangle hx x hy (m), plane strain, per metre out of plane, with
 /// selective reduced integration: the shear part at 2 x 2 Gauss points, the volumetric part at

@@ -12,7 +12,6 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -40,12 +39,6 @@ constexpr double kFailedDamage = 1e-3;
 
 [[noreturn]] void bad(const std::string& field, const std::string& what) {
   throw InputError("plane-strain insertion: " + field + " " + what);
-}
-
-std::string str(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
 }
 
 double element_size(const PlaneStrainInsertionProblem& p) {
@@ -540,7 +533,7 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
             // f = a n + b e_x: a the flank's share, b the mirror plane's; both must push. A node
             // that has come back to the apex twice in this step stays there: its force leans
             // just past one normal while that face's own solution puts it beyond the apex (the
-            // sharp vertex's discretisation; docs/model.md, "Plane-strain insertion").
+            // sharp vertex's discretisation; docs/model.md, "Plane-strain insertion along a cut").
             const double on_flank = -fy / std::sin(half_angle);  // fy: the needle's alone
             const double on_mirror = fx - on_flank * flank_normal.x();
             if (apex_visits[j] > 2) break;

@@ -60,7 +60,8 @@ struct PlaneStrainInsertionProblem {
 };
 
 /// Default step as a fraction of the cell size: the energy ledger's closure is first order in
-/// the step (paper C's case, 1.6 mm cells: 4.4 % at h/2, 0.17 % at h/8).
+/// the step (paper C's case, 1.6 mm cells, worst step: 1.5 % at h/8 with friction, 3.4 %
+/// frictionless; docs/performance.md).
 inline constexpr double kInsertionDefaultStepFraction = 0.125;
 /// Growth ratio of neighbouring cells beyond the uniform zone.
 inline constexpr double kInsertionGridGrowth = 1.1;
