@@ -73,7 +73,7 @@ struct Sample {
 
 Sample simulate(const TissueBlockSpec& block, const Needle3d& needle, int order, double tip_size,
                 ContactMode contact, int steps, int through_top = 0, double crack_depth = 0.0,
-                double average_length = 0.0) {
+                double average_length = 0.0, int refinement_levels = 0, double growth = 0.0) {
   Simulation3dOptions options;
   options.depth = kDepth;
   options.contact = contact;
@@ -82,6 +82,8 @@ Sample simulate(const TissueBlockSpec& block, const Needle3d& needle, int order,
   options.overrides.tip_size_m = tip_size;
   options.overrides.steps = steps;
   if (through_top > 0) options.overrides.elements_through_top = through_top;
+  if (refinement_levels > 0) options.overrides.refinement_levels = refinement_levels;
+  if (growth > 0) options.overrides.growth = growth;
   options.crack_depth_m = crack_depth;
   options.stress_average_length_m = average_length;
   const double cpu_start = cpu_seconds();
@@ -167,6 +169,21 @@ void punch_coarsest_study() {
     std::fflush(stdout);
     if (std::abs(error) <= 0.02) return;
   }
+}
+
+void punch_refined_study() {
+  const auto [a, exact, beta, punch, block] = bonded_punch();
+  std::printf("\n# a, refined\nlevels growth spacings nodes wall_s force_N rel_error\n");
+  for (int levels : {0, 1, 2, 3})
+    for (double growth : {1.6, 2.0})
+      for (double spacings_per_radius : {2.5, 3.5, 5.5}) {
+        const double per_radius = spacings_per_radius / 2.0;
+        const Sample s = simulate(block, punch, 2, a / per_radius, ContactMode::Sticking, 1, 0, 0.0,
+                                  0.0, levels, growth);
+        std::printf("%d %.1f %.1f %d %.3f %.6g %+.4f\n", levels, growth, spacings_per_radius,
+                    s.nodes, s.wall_seconds, s.force, s.force / exact - 1.0);
+        std::fflush(stdout);
+      }
 }
 
 // a'. The same punch in frictionless contact against Hayes' frictionless layer, F = 2 a E* d
@@ -354,6 +371,8 @@ int main(int argc, char** argv) {
     for (const std::string& study : studies) {
       if (study == "punch")
         punch_study();
+      else if (study == "punch_refined")
+        punch_refined_study();
       else if (study == "punch_coarsest")
         punch_coarsest_study();
       else if (study == "frictionless")
