@@ -28,7 +28,7 @@ struct PlaneStrainArgs {
       element_size, step;
   std::string toughness, openings, initial_cut, viscosity;  // the cohesive interface
   double friction = 0.0;
-  std::string csv, plot;
+  std::string csv, plot, energy_plot;
   bool json = false;
 };
 
@@ -70,6 +70,34 @@ void write_csv(const std::string& file, const fe::PlaneStrainInsertionResult& r)
         << s.balance_error << ',' << s.tip_contacts << ',' << s.shaft_contacts << ',' << s.sticking
         << '\n';
   if (!out) throw InputError(file + ": write failed");
+}
+
+// Paper C's Fig. 14: the ledger's terms against travel, W_ext = U + W_f + W_coh at every step.
+plot::Figure energy_figure(const fe::PlaneStrainInsertionProblem& p,
+                           const fe::PlaneStrainInsertionResult& r) {
+  plot::Figure f;
+  f.title = "energy ledger of the insertion (paper C, Fig. 14)";
+  f.x.name = "needle travel";
+  f.y = {"energy", Dimension::Energy, "", false};
+  std::vector<double> x, external, strain, friction, cohesive, fracture;
+  for (const auto& s : r.steps) {
+    x.push_back(s.travel_m);
+    external.push_back(s.external_work_J);
+    strain.push_back(s.strain_energy_J);
+    friction.push_back(s.friction_work_J);
+    cohesive.push_back(s.cohesive_work_J);
+    fracture.push_back(s.fracture_energy_J);
+  }
+  f.series.push_back({"external work", x, external, plot::Mark::Line});
+  f.series.push_back({"strain energy", x, strain, plot::Mark::Line});
+  f.series.push_back({"friction work", x, friction, plot::Mark::Line});
+  if (p.cohesion.toughness_J_per_m2 > 0.0) {
+    f.series.push_back({"cohesive work", x, cohesive, plot::Mark::Line});
+    f.series.push_back({"fracture energy (dissipated)", x, fracture, plot::Mark::Line});
+  }
+  f.lines.push_back({"tip at the bottom", p.block_depth_m});
+  if (r.puncture_travel_m > 0.0) f.lines.push_back({"crack runs", r.puncture_travel_m});
+  return f;
 }
 
 void run_plane_strain(const PlaneStrainArgs& a) {
@@ -133,6 +161,7 @@ void run_plane_strain(const PlaneStrainArgs& a) {
     if (r.puncture_travel_m > 0.0) f.lines.push_back({"crack runs", r.puncture_travel_m});
     plot::write_svg(a.plot, f);
   }
+  if (!a.energy_plot.empty()) plot::write_svg(a.energy_plot, energy_figure(p, r));
 
   const double balance_bound = 0.02;  // paper C's requirement for the ledger (issue text)
   nlohmann::json warnings = nlohmann::json::array();
@@ -263,6 +292,8 @@ void add_plane_strain_command(CLI::App& app) {
                   "Travel over which damage relaxes to the law (default 0.5mm; 0mm: none)");
   cmd->add_option("--csv", a->csv, "Write every step (unit-bracketed columns) to this file");
   cmd->add_option("--plot", a->plot, "Write the force curve as SVG");
+  cmd->add_option("--energy-plot", a->energy_plot,
+                  "Write the energy ledger against travel as SVG (paper C, Fig. 14)");
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->callback([a] { run_plane_strain(*a); });
 }

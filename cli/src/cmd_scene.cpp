@@ -50,6 +50,8 @@ std::string si_suffix(Dimension d) {
       return "_Pa_s";
     case Dimension::Stiffness:
       return "_N_per_m";
+    case Dimension::Energy:
+      return "_J";
   }
   return "";
 }

@@ -99,6 +99,8 @@ DisplayUnit display_unit(Dimension d, double largest) {
       return pick({{"Pa", 1.0}, {"kPa", 1e3}, {"MPa", 1e6}, {"GPa", 1e9}});
     case Dimension::Time:
       return pick({{"ms", 1e-3}, {"s", 1.0}});
+    case Dimension::Energy:
+      return pick({{"uJ", 1e-6}, {"mJ", 1e-3}, {"J", 1.0}});
     default:
       return {std::string(si_unit(d)), 1.0};
   }

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "../plot/svg_reader.h"
 #include "run_mneedle.h"
 
 namespace {
@@ -69,6 +70,33 @@ TEST(CmdPlaneStrain, CohesiveRunReportsThePunctureAndTheCrack) {
   EXPECT_NEAR(j["end"]["fracture_energy_J"].get<double>(), 20.36e-3, 0.01e-3);
   EXPECT_DOUBLE_EQ(j["problem"]["cohesion"]["viscosity_m"].get<double>(), 0.5e-3);
   EXPECT_EQ(j["steps"]["crack_depth_m"].size(), 433u);
+}
+
+TEST(CmdPlaneStrain, EnergyPlotDrawsEveryTermOfTheLedgerLikePaperCsFigure14) {
+  std::filesystem::create_directories(kWork);
+  const auto svg = (kWork / "energy.svg").string();
+  const auto run = run_mneedle(kPaperC +
+                               " --toughness 17.43J/m2 --cohesive-openings 7mm,7.5mm "
+                               "--initial-cut 3.2mm --energy-plot '" +
+                               svg + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto t = mneedle::test::texts(mneedle::test::read_svg(svg));
+  // 77 mJ of work at the end: the axis picks mJ.
+  for (const char* label :
+       {"energy [mJ]", "needle travel [mm]", "external work", "strain energy", "friction work",
+        "cohesive work", "fracture energy (dissipated)", "crack runs"})
+    EXPECT_TRUE(mneedle::test::has_text(t, label)) << label;
+}
+
+TEST(CmdPlaneStrain, EnergyPlotWithoutCohesionLeavesTheCohesiveTermsOut) {
+  std::filesystem::create_directories(kWork);
+  const auto svg = (kWork / "energy_cut.svg").string();
+  const auto run = run_mneedle(kPaperC + " --travel 20mm --energy-plot '" + svg + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto t = mneedle::test::texts(mneedle::test::read_svg(svg));
+  EXPECT_TRUE(mneedle::test::has_text(t, "external work"));
+  EXPECT_TRUE(mneedle::test::has_text(t, "friction work"));
+  EXPECT_FALSE(mneedle::test::has_text(t, "cohesive work"));
 }
 
 TEST(CmdPlaneStrain, CohesiveOptionsWithoutToughnessAreRefused) {

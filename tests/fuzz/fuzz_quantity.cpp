@@ -18,7 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     (void)mneedle::format_quantity(q.value_si, q.dimension);
   } catch (const mneedle::InputError&) {
   }
-  for (int k = 0; k <= static_cast<int>(mneedle::Dimension::Stiffness); ++k) {
+  for (int k = 0; k <= static_cast<int>(mneedle::Dimension::Energy); ++k) {
     const auto d = static_cast<mneedle::Dimension>(k);
     try {
       if (!std::isfinite(mneedle::parse_quantity(text, d))) std::abort();

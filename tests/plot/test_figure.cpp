@@ -82,6 +82,8 @@ TEST(DisplayUnit, PicksTheUnitByMagnitude) {
   EXPECT_EQ(mneedle::plot::display_unit(Dimension::Force, 2e-3).name, "mN");
   EXPECT_EQ(mneedle::plot::display_unit(Dimension::Force, 2.0).name, "N");
   EXPECT_EQ(mneedle::plot::display_unit(Dimension::Length, 1e-9).name, "um");
+  EXPECT_EQ(mneedle::plot::display_unit(Dimension::Energy, 84e-3).name, "mJ");
+  EXPECT_EQ(mneedle::plot::display_unit(Dimension::Energy, 5e-6).name, "uJ");
 }
 
 TEST(WriteSvg, AxesCarryTheirUnitsAndTheLabelsAreWritten) {

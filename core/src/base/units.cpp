@@ -67,6 +67,11 @@ constexpr std::array kUnits{
     UnitDef{"mJ/m^2", 1e-3, Dimension::Toughness},
     UnitDef{"mJ/m2", 1e-3, Dimension::Toughness},
     UnitDef{"J/m\xC2\xB2", 1.0, Dimension::Toughness},
+    UnitDef{"J", 1.0, Dimension::Energy},
+    UnitDef{"mJ", 1e-3, Dimension::Energy},
+    UnitDef{"uJ", 1e-6, Dimension::Energy},
+    UnitDef{"\xC2\xB5J", 1e-6, Dimension::Energy},
+    UnitDef{"\xCE\xBCJ", 1e-6, Dimension::Energy},
     UnitDef{"N/m", 1.0, Dimension::Stiffness},
     UnitDef{"N/mm", 1e3, Dimension::Stiffness},
     UnitDef{"kg/m^3", 1.0, Dimension::Density},
@@ -201,6 +206,8 @@ std::string_view dimension_name(Dimension d) {
       return "viscosity";
     case Dimension::Stiffness:
       return "stiffness";
+    case Dimension::Energy:
+      return "energy";
   }
   return "unknown";
 }
@@ -229,6 +236,8 @@ std::string_view si_unit(Dimension d) {
       return "Pa s";
     case Dimension::Stiffness:
       return "N/m";
+    case Dimension::Energy:
+      return "J";
   }
   return "";
 }

@@ -96,6 +96,16 @@ TEST(Units, ToughnessInNewtonPerMillimetreEqualsJoulePerSquareMetre) {
   EXPECT_THROW(parse_quantity("73.2 mJ/m", Dimension::Toughness), mneedle::InputError);
 }
 
+TEST(Units, EnergyIsJouleAndNotAnEnergyPerLengthOrArea) {
+  EXPECT_DOUBLE_EQ(parse_quantity("84 mJ", Dimension::Energy), 84e-3);
+  EXPECT_DOUBLE_EQ(parse_quantity("3 uJ", Dimension::Energy), 3e-6);
+  EXPECT_DOUBLE_EQ(parse_quantity("0.5 J", Dimension::Energy), 0.5);
+  EXPECT_THROW(parse_quantity("84 mJ/m", Dimension::Energy), mneedle::InputError);
+  EXPECT_THROW(parse_quantity("84 mJ", Dimension::Force), mneedle::InputError);
+  EXPECT_THROW(parse_quantity("19 J", Dimension::Toughness), mneedle::InputError);
+  EXPECT_EQ(mneedle::si_unit(Dimension::Energy), "J");
+}
+
 TEST(Units, ToughnessAndStiffnessShareNewtonPerMetre) {
   EXPECT_DOUBLE_EQ(parse_quantity("2 N/m", Dimension::Stiffness), 2.0);
   EXPECT_DOUBLE_EQ(parse_quantity("2 N/m", Dimension::Toughness), 2.0);

@@ -21,10 +21,11 @@ enum class Dimension {
   Density,    ///< kg/m^3
   Viscosity,  ///< Pa s
   Stiffness,  ///< N/m (force per displacement)
+  Energy,     ///< J (work, strain energy, dissipated energy)
 };
 
 /// "dimensionless", "length", "angle", "pressure", "force", "speed", "time", "toughness",
-/// "density", "viscosity", "stiffness".
+/// "density", "viscosity", "stiffness", "energy".
 std::string_view dimension_name(Dimension d);
 
 /// The SI unit of a dimension as written in output ("m", "rad", "Pa", "N/m", ...; "" if none).
