@@ -192,7 +192,8 @@ std::vector<std::string> energy_warnings(const InsertionRun& run, const Scene& s
     if (overlap > 1e-9)
       out.push_back(scene.source_name + ": needle '" + n.name + "': the crack's faces pass " +
                     "through each other by up to " + format_quantity(overlap, Dimension::Length) +
-                    " (their contact is modelled for linear tissue with sticking contact only), " +
+                    " (their contact is modelled with sticking needle contact, in 3-D for linear "
+                    "tissue only), " +
                     "so G is too high (docs/model.md, \"Crack faces in contact\")");
   }
   return out;

@@ -95,6 +95,10 @@ void AxisymmetricModel::Impl::build_pattern() {
   for (const auto& el : mesh.elements)
     for (int a = 0; a < kDofs; ++a)
       for (int b = 0; b < kDofs; ++b) triplets.emplace_back(dof(el, a), dof(el, b), 0.0);
+  for (const auto& [in, out] : face_pairs) {
+    triplets.emplace_back(2 * in, 2 * out, 0.0);
+    triplets.emplace_back(2 * out, 2 * in, 0.0);
+  }
   pattern.resize(n, n);
   pattern.setFromTriplets(triplets.begin(), triplets.end());
   pattern.makeCompressed();
@@ -108,6 +112,15 @@ void AxisymmetricModel::Impl::build_pattern() {
         const int* pos = std::lower_bound(inner + outer[col], inner + outer[col + 1], row);
         slots[(e * kDofs + a) * kDofs + b] = static_cast<int>(pos - inner);
       }
+  const auto slot = [&](std::uint32_t row, std::uint32_t col) {
+    const int* pos =
+        std::lower_bound(inner + outer[col], inner + outer[col + 1], static_cast<int>(row));
+    return static_cast<int>(pos - inner);
+  };
+  pair_slots.clear();
+  for (const auto& [in, out] : face_pairs)
+    pair_slots.push_back({slot(2 * in, 2 * in), slot(2 * out, 2 * out), slot(2 * in, 2 * out),
+                          slot(2 * out, 2 * in)});
 }
 
 // Internal force and tangent of one element. Components (r, theta, z) map to material indices
@@ -212,8 +225,77 @@ Eigen::VectorXd AxisymmetricModel::internal_force(const Eigen::VectorXd& u, doub
     for (int a = 0; a < kDofs; ++a)
       for (int b = 0; b < kDofs; ++b) values[slot[a * kDofs + b]] += ke(a, b);
   }
+  // Closed crack-face pairs: the radial force lambda + k g on the outer node and its opposite on
+  // the inner one, g = u_r(outer) - u_r(inner); their energy is not strain energy and is left out.
+  for (std::size_t p = 0; p < m.face_pairs.size(); ++p) {
+    if (!m.pair_closed[p]) continue;
+    const auto [in, out] = m.face_pairs[p];
+    const auto i = static_cast<Eigen::Index>(p);
+    const double k = m.pair_penalty[i];
+    const double t = m.pair_multiplier[i] + k * (u[2 * out] - u[2 * in]);
+    f[2 * out] += t;
+    f[2 * in] -= t;
+    if (!tangent) continue;
+    double* values = tangent->valuePtr();
+    values[m.pair_slots[p][0]] += k;
+    values[m.pair_slots[p][1]] += k;
+    values[m.pair_slots[p][2]] -= k;
+    values[m.pair_slots[p][3]] -= k;
+  }
   if (energy) *energy = total_energy;
   return f;
+}
+
+void AxisymmetricModel::set_face_pairs(std::vector<std::array<std::uint32_t, 2>> pairs) {
+  Impl& m = *impl_;
+  for (const auto& pair : pairs)
+    for (std::uint32_t node : pair)
+      if (node >= m.mesh.nodes.size())
+        throw InputError("axisymmetric model: crack-face pair names node " + std::to_string(node) +
+                         " of " + std::to_string(m.mesh.nodes.size()));
+  m.face_pairs = std::move(pairs);
+  const auto count = static_cast<Eigen::Index>(m.face_pairs.size());
+  m.pair_closed.assign(m.face_pairs.size(), 0);
+  m.pair_multiplier = Eigen::VectorXd::Zero(count);
+  m.build_pattern();
+  m.analyzed = m.has_factor = false;
+  // Penalty: kFacePenalty times the pair's mean radial stiffness in the reference state, so the
+  // multiplier update removes all but ~1 / kFacePenalty of an overlap per round.
+  Eigen::SparseMatrix<double> K;
+  internal_force(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(dof_count())), nullptr, &K);
+  m.pair_penalty.resize(count);
+  for (Eigen::Index p = 0; p < count; ++p) {
+    const auto [in, out] = m.face_pairs[static_cast<std::size_t>(p)];
+    m.pair_penalty[p] = kFacePenalty * 0.5 * (K.coeff(2 * in, 2 * in) + K.coeff(2 * out, 2 * out));
+  }
+}
+
+void AxisymmetricModel::set_pair_state(std::vector<char> closed, Eigen::VectorXd multipliers) {
+  Impl& m = *impl_;
+  if (closed.size() != m.face_pairs.size() ||
+      multipliers.size() != static_cast<Eigen::Index>(m.face_pairs.size()))
+    throw InputError("axisymmetric model: pair state for " + std::to_string(closed.size()) +
+                     " pairs, the model has " + std::to_string(m.face_pairs.size()));
+  // Another closed set is another stiffness: the factorisation cannot be reused.
+  if (closed != m.pair_closed) m.has_factor = false;
+  m.pair_closed = std::move(closed);
+  m.pair_multiplier = std::move(multipliers);
+}
+
+Eigen::VectorXd AxisymmetricModel::pair_forces(const Eigen::VectorXd& u) const {
+  const Impl& m = *impl_;
+  Eigen::VectorXd t = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m.face_pairs.size()));
+  for (std::size_t p = 0; p < m.face_pairs.size(); ++p)
+    if (m.pair_closed[p]) {
+      const auto i = static_cast<Eigen::Index>(p);
+      t[i] = m.pair_multiplier[i] +
+             m.pair_penalty[i] * (u[2 * m.face_pairs[p][1]] - u[2 * m.face_pairs[p][0]]);
+    }
+  return t;
+}
+
+Eigen::VectorXd AxisymmetricModel::pair_penalties() const {
+  return impl_->pair_penalty;
 }
 
 namespace {

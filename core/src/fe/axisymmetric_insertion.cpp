@@ -367,20 +367,45 @@ std::vector<std::uint32_t> with_face_nodes(std::vector<std::uint32_t> nodes,
   return nodes;
 }
 
+// Nonlinear crack-face contact (augmented Lagrangian, AxisymmetricModel::set_face_pairs): a
+// closed pair's overlap must fall below kNonlinearGapTolerance x the depth, the scale of Newton's
+// own 1e-8 residual tolerance (the linear path's 1e-10 is the condensed solve's round-off).
+constexpr double kNonlinearGapTolerance = 1e-8;
+
+// Crack-face pairs of the nonlinear stepper within one step: held (1) or open, the multipliers,
+// the pairs opened for pulling in this step and those latched closed after overlapping again.
+struct PairState {
+  std::vector<char> closed;
+  Eigen::VectorXd multipliers;
+  std::vector<char> pulled_open, latched;
+};
+
 // Nonlinear layers: Newton at every sub-step, adaptive step length.
 class NonlinearStepper : public Stepper {
  public:
+  // pairs: the ring crack's faces (cracked twin), kept apart when `close_pairs` is set.
   NonlinearStepper(AxisymmetricModel& model, const AxisymmetricNeedle& needle,
-                   const InsertionOptions& options)
+                   const InsertionOptions& options, FacePairs pairs = {}, bool close_pairs = false)
       : model_(model),
         needle_(needle),
         newton_(options.newton),
         candidates_(reachable_surface_nodes(model.mesh(), needle, options.depth_m)),
         interval_(options.depth_m / options.output_steps),
         step_(interval_),
-        min_step_(1e-5 * options.depth_m) {
+        min_step_(1e-5 * options.depth_m),
+        pairs_(std::move(pairs)) {
     current_.displacement = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(model.dof_count()));
     current_.reaction = current_.displacement;
+    close_pairs_ = close_pairs && !pairs_.empty();
+    if (close_pairs_) {
+      model_.set_face_pairs(pairs_);
+      pairs_state_.closed.assign(pairs_.size(), 0);
+      pairs_state_.multipliers = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs_.size()));
+    }
+  }
+
+  int closed_pairs() const override {
+    return static_cast<int>(std::count(pairs_state_.closed.begin(), pairs_state_.closed.end(), 1));
   }
 
   InsertionStep advance_to(double target) override {
@@ -390,18 +415,34 @@ class NonlinearStepper : public Stepper {
       step_ = std::min(step_, target - depth_);
       const double next = depth_ + step_;
       ContactState trial_state = state_;
+      PairState trial_pairs = pairs_state_;
+      trial_pairs.pulled_open.assign(pairs_.size(), 0);
+      trial_pairs.latched.assign(pairs_.size(), 0);
       int trial_iterations = 0;
       std::string failure;
       Equilibrium trial;
       try {
         boundary_conditions(mesh, trial_state, next, dofs_, values_);
+        if (close_pairs_) model_.set_pair_state(trial_pairs.closed, trial_pairs.multipliers);
         trial = model_.solve(dofs_, values_, predictor(next), newton_);
         trial_iterations += trial.newton_iterations;
-        for (int round = 0; round < 50; ++round) {
-          if (capture_new_nodes(needle_, candidates_, mesh, depth_, current_.displacement, next,
-                                trial.displacement, trial_state) == 0)
+        const int rounds =
+            50 + (close_pairs_ ? kMaxCrackRounds + 4 * static_cast<int>(pairs_.size()) : 0);
+        for (int round = 0;; ++round) {
+          bool changed =
+              capture_new_nodes(needle_, candidates_, mesh, depth_, current_.displacement, next,
+                                trial.displacement, trial_state) > 0;
+          if (close_pairs_)
+            changed = update_pairs(trial.displacement, next, round, trial_pairs) || changed;
+          if (!changed) break;
+          if (round + 1 >= rounds) {
+            // Captures alone may stop short (as before); open crack faces may not.
+            if (close_pairs_)
+              throw SolverError("crack-face contact did not settle at depth " + format_depth(next));
             break;
+          }
           boundary_conditions(mesh, trial_state, next, dofs_, values_);
+          if (close_pairs_) model_.set_pair_state(trial_pairs.closed, trial_pairs.multipliers);
           trial = model_.solve(dofs_, values_, trial.displacement, newton_);
           trial_iterations += trial.newton_iterations;
         }
@@ -420,6 +461,7 @@ class NonlinearStepper : public Stepper {
       depth_ = next;
       current_ = std::move(trial);
       state_ = std::move(trial_state);
+      pairs_state_ = std::move(trial_pairs);
       iterations += trial_iterations;
       if (trial_iterations <= 6) step_ = std::min(step_ * 1.5, interval_);
     }
@@ -443,6 +485,56 @@ class NonlinearStepper : public Stepper {
     return start;
   }
 
+  // One round of the crack-face active set on the solution u at `depth`, with the state the solve
+  // used: closed pairs that pull (t > 0) open, all at once for the first kCrackBlockRounds rounds
+  // and then the one pulled hardest; when none pulls, each closed pair's multiplier takes its
+  // force (Uzawa) and open pairs that overlap close. True when another solve is needed: a pair
+  // changed, or a closed pair still overlaps or gapes by more than the tolerance.
+  bool update_pairs(const Eigen::VectorXd& u, double depth, int round, PairState& state) const {
+    std::vector<char>& closed = state.closed;
+    Eigen::VectorXd& multipliers = state.multipliers;
+    const double tolerance = kNonlinearGapTolerance * std::max(depth, 1e-12);
+    const Eigen::VectorXd t = model_.pair_forces(u);
+    Eigen::VectorXd gaps(static_cast<Eigen::Index>(pairs_.size()));
+    for (std::size_t p = 0; p < pairs_.size(); ++p)
+      gaps[static_cast<Eigen::Index>(p)] = u[2 * pairs_[p][1]] - u[2 * pairs_[p][0]];
+    std::size_t worst = pairs_.size();
+    for (std::size_t p = 0; p < pairs_.size(); ++p) {
+      const auto i = static_cast<Eigen::Index>(p);
+      if (closed[p] && !state.latched[p] && t[i] > 0.0 &&
+          (worst == pairs_.size() || t[i] > t[worst]))
+        worst = p;
+    }
+    if (worst < pairs_.size()) {
+      for (std::size_t p = 0; p < pairs_.size(); ++p) {
+        const auto i = static_cast<Eigen::Index>(p);
+        if (closed[p] && !state.latched[p] && t[i] > 0.0 &&
+            (round < kCrackBlockRounds || p == worst)) {
+          closed[p] = 0;
+          multipliers[i] = 0.0;
+          state.pulled_open[p] = 1;
+        }
+      }
+      return true;
+    }
+    bool again = false;
+    for (std::size_t p = 0; p < pairs_.size(); ++p) {
+      const auto i = static_cast<Eigen::Index>(p);
+      if (closed[p]) {
+        multipliers[i] = t[i];
+        again = again || std::abs(gaps[i]) > tolerance;
+      } else if (gaps[i] < -tolerance) {
+        closed[p] = 1;
+        multipliers[i] = 0.0;
+        // Pulls when closed, overlaps when open: no complementary state exists for this pair
+        // in this step (node-to-node under large sliding); it stays closed, pulling a little.
+        if (state.pulled_open[p]) state.latched[p] = 1;
+        again = true;
+      }
+    }
+    return again;
+  }
+
   AxisymmetricModel& model_;
   AxisymmetricNeedle needle_;
   NewtonOptions newton_;
@@ -451,6 +543,9 @@ class NonlinearStepper : public Stepper {
   double depth_ = 0.0;
   ContactState state_;
   Equilibrium current_;
+  FacePairs pairs_;
+  bool close_pairs_ = false;
+  PairState pairs_state_;
   std::vector<std::uint32_t> dofs_;
   Eigen::VectorXd values_;
   Eigen::VectorXd last_increment_;
@@ -689,7 +784,8 @@ std::unique_ptr<Stepper> make_stepper(AxisymmetricModel& model, const Axisymmetr
   if (model.is_linear())
     return std::make_unique<LinearStepper>(model, needle, options, keep_field, pairs,
                                            options.crack_face_contact);
-  return std::make_unique<NonlinearStepper>(model, needle, options);
+  return std::make_unique<NonlinearStepper>(model, needle, options, pairs,
+                                            options.crack_face_contact);
 }
 
 }  // namespace

@@ -120,6 +120,13 @@ struct AxisymmetricModel::Impl {
   bool has_factor = false;                 // the solver holds a usable factorisation
   std::vector<char> factored_constraints;  // constrained dofs of that factorisation
   int factorizations = 0;
+  // Crack-face pairs {inner, outer} held by an augmented Lagrangian when closed
+  // (AxisymmetricModel::set_face_pairs): penalty, state and multiplier per pair, and the value
+  // slots of (inner_r, inner_r), (outer_r, outer_r), (inner_r, outer_r), (outer_r, inner_r).
+  std::vector<std::array<std::uint32_t, 2>> face_pairs;
+  Eigen::VectorXd pair_penalty, pair_multiplier;
+  std::vector<char> pair_closed;
+  std::vector<std::array<int, 4>> pair_slots;
 
   void precompute_geometry();
   void build_pattern();

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <iostream>
 #include <string>
@@ -104,6 +105,65 @@ TEST(AxisymmetricModel, TangentMatchesFiniteDifferenceOfInternalForce) {
   const Eigen::VectorXd analytic = K * v;
   // Central difference on a smooth force: truncation ~ (h |v|/L)^2, far below 1e-6.
   EXPECT_LT((numeric - analytic).norm(), 1e-6 * analytic.norm());
+}
+
+// A ring crack's face pairs (docs/model.md, "Crack faces in contact"): a closed pair adds
+// t = lambda + k g to the outer node's radial force and -t to the inner one, an open pair nothing,
+// the tangent stays the derivative of the force, and the strain energy leaves the pairs out.
+TEST(AxisymmetricModel, ClosedFacePairsPushTheirNodesApartAndOpenOnesCarryNothing) {
+  const MaterialParameters m = material(MaterialModel::NeoHookean, 1e5, 0.45);
+  AxisymmetricMeshOptions o;
+  o.radius_m = 1e-3;
+  o.h_m = 1e-4;
+  o.fine_radius_m = 5e-4;
+  o.fine_depth_m = 5e-4;
+  o.radial_breaks_m = {2e-4};
+  o.depth_breaks_m = {2e-4};
+  std::vector<std::array<std::uint32_t, 2>> pairs;
+  AxisymmetricModel fe(crack_axisymmetric_mesh(make_axisymmetric_mesh(one_layer(1e-3, m), o), 2e-4,
+                                               2e-4, nullptr, &pairs),
+                       {m});
+  ASSERT_EQ(pairs.size(), 4u);
+  EXPECT_THROW(fe.set_face_pairs({{0, static_cast<std::uint32_t>(fe.mesh().nodes.size())}}),
+               InputError);
+  fe.set_face_pairs(pairs);
+  const Eigen::VectorXd k = fe.pair_penalties();
+  ASSERT_EQ(k.size(), 4);
+  EXPECT_GT(k.minCoeff(), 0.0);
+  // Random displacements of 5 % of the 100 um elements: no element inverts.
+  Eigen::VectorXd u = Eigen::VectorXd::Random(fe.dof_count()) * 5e-6;
+  double open_energy = 0.0;
+  const Eigen::VectorXd open = fe.internal_force(u, &open_energy, nullptr);
+  EXPECT_EQ(fe.pair_forces(u).norm(), 0.0);  // every pair starts open
+  std::vector<char> closed = {1, 0, 1, 1};
+  Eigen::VectorXd lambda(4);
+  lambda << -1e-3, -5e-3, 0.0, -2e-3;  // the open pair's multiplier is ignored
+  fe.set_pair_state(closed, lambda);
+  double closed_energy = 0.0;
+  Eigen::SparseMatrix<double> K;
+  const Eigen::VectorXd held = fe.internal_force(u, &closed_energy, &K);
+  const Eigen::VectorXd t = fe.pair_forces(u);
+  EXPECT_EQ(closed_energy, open_energy);
+  for (std::size_t p = 0; p < pairs.size(); ++p) {
+    const auto i = static_cast<Eigen::Index>(p);
+    const double g = u[2 * pairs[p][1]] - u[2 * pairs[p][0]];
+    const double expected = closed[p] ? lambda[i] + k[i] * g : 0.0;
+    EXPECT_NEAR(t[i], expected, 1e-12 * lambda.cwiseAbs().maxCoeff());
+    EXPECT_NEAR(held[2 * pairs[p][1]] - open[2 * pairs[p][1]], t[i], 1e-12);
+    EXPECT_NEAR(held[2 * pairs[p][0]] - open[2 * pairs[p][0]], -t[i], 1e-12);
+  }
+  // Only the pairs' radial dofs changed.
+  Eigen::VectorXd rest = held - open;
+  for (const auto& pair : pairs) rest[2 * pair[0]] = rest[2 * pair[1]] = 0.0;
+  EXPECT_EQ(rest.norm(), 0.0);
+  const Eigen::VectorXd v = Eigen::VectorXd::Random(fe.dof_count()) * 2.5e-6;
+  const double h = 1e-4;
+  const Eigen::VectorXd numeric = (fe.internal_force(u + h * v, nullptr, nullptr) -
+                                   fe.internal_force(u - h * v, nullptr, nullptr)) /
+                                  (2 * h);
+  // As TangentMatchesFiniteDifferenceOfInternalForce: the pairs' force is linear in u.
+  EXPECT_LT((numeric - K * v).norm(), 1e-6 * (K * v).norm());
+  EXPECT_THROW(fe.set_pair_state({1, 0}, Eigen::VectorXd::Zero(2)), InputError);
 }
 
 // Flat punch radius a on a thick layer, sticking (bonded) contact.

@@ -86,6 +86,11 @@ AxisymmetricMesh crack_axisymmetric_mesh(
     const AxisymmetricMesh& mesh, double radius_m, double depth_m, double* area_m2,
     std::vector<std::array<std::uint32_t, 2>>* face_pairs = nullptr);
 
+/// The crack-face penalty relative to a pair's own radial stiffness: each multiplier update
+/// leaves about 1 / kFacePenalty of an overlap, and the factor adds about that much to the
+/// stiffness's condition number.
+inline constexpr double kFacePenalty = 1e3;
+
 /// Result of one equilibrium solve.
 struct Equilibrium {
   Eigen::VectorXd displacement;  ///< 2 per node: u_r, u_z
@@ -145,6 +150,22 @@ class AxisymmetricModel {
   Eigen::VectorXd internal_force(const Eigen::VectorXd& u, double* strain_energy_J,
                                  Eigen::SparseMatrix<double>* tangent) const;
 
+  /// Crack-face node pairs {inner, outer} (crack_axisymmetric_mesh) that set_pair_state may hold
+  /// in frictionless contact, u_r(outer) = u_r(inner), by an augmented Lagrangian: a closed pair
+  /// adds the radial force t = lambda + k g (g = u_r(outer) - u_r(inner)) to the outer node and
+  /// -t to the inner one, k = kFacePenalty x the pair's mean radial stiffness at u = 0. Adds the
+  /// pairs' couplings to the stiffness pattern; every pair starts open. Used on nonlinear layers
+  /// (the linear path holds pairs exactly on its condensed surface). Throws InputError on a node
+  /// outside the mesh.
+  void set_face_pairs(std::vector<std::array<std::uint32_t, 2>> pairs);
+  /// Which pairs are closed (1) and their multipliers lambda (N, full ring; < 0 pushes the faces
+  /// apart). Open pairs carry no force.
+  void set_pair_state(std::vector<char> closed, Eigen::VectorXd multipliers);
+  /// t = lambda + k g of every closed pair at u, 0 for an open one (N, full ring).
+  Eigen::VectorXd pair_forces(const Eigen::VectorXd& u) const;
+  /// k of every pair (N/m, full ring).
+  Eigen::VectorXd pair_penalties() const;
+
   /// Equilibrium with u[dof] = value on `prescribed_dofs`, zero external force elsewhere,
   /// Newton from `start`. Throws SolverError when Newton does not converge.
   Equilibrium solve(const std::vector<std::uint32_t>& prescribed_dofs,
@@ -193,9 +214,9 @@ struct InsertionOptions {
   /// radius (ring_crack_radius of the needle) reaching at least this depth; a second, cracked
   /// model runs in lock-step with the intact one.
   double crack_depth_m = 0.0;
-  /// The ring crack's faces in frictionless node-to-node contact (linear layers with sticking
-  /// contact; otherwise the faces stay free and only their overlap is reported); false leaves
-  /// them free.
+  /// The ring crack's faces in frictionless node-to-node contact with sticking needle contact
+  /// (exact on linear layers, an augmented Lagrangian on nonlinear ones; with frictionless needle
+  /// contact the faces stay free and only their overlap is reported); false leaves them free.
   bool crack_face_contact = true;
   /// Called after each output step; returning false stops the insertion there.
   std::function<bool(const InsertionStep&)> on_step;
