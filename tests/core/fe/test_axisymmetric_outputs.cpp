@@ -363,7 +363,12 @@ TEST(AxisymmetricCrack, NeoHookeanRingCrackFacesDoNotPassThroughEachOther) {
   EXPECT_GT(last[0].crack_face_overlap_m, 0.1 * depth);
   EXPECT_EQ(last[0].crack_face_contacts, 0);
   EXPECT_LE(last[1].crack_face_overlap_m, 1e-8 * depth);
-  EXPECT_GT(last[1].crack_face_contacts, 0);
+  // Every pair but the mouth's (open: the faces part there by 1.5 um) is held, and G falls by a
+  // third: the measured values (docs/validation.md), 1e-3 relative for
+  // the round-off of a Newton solve converged to 1e-8.
+  EXPECT_EQ(last[1].crack_face_contacts, 7);
+  EXPECT_NEAR(last[1].energy_release_rate_J_per_m2 / last[0].energy_release_rate_J_per_m2, 0.6617,
+              1e-3);
   EXPECT_EQ(last[1].force_N, last[0].force_N);
   EXPECT_GT(last[1].energy_release_rate_J_per_m2, 0.0);
   EXPECT_LT(last[1].energy_release_rate_J_per_m2, last[0].energy_release_rate_J_per_m2);

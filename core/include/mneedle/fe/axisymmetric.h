@@ -151,15 +151,16 @@ class AxisymmetricModel {
                                  Eigen::SparseMatrix<double>* tangent) const;
 
   /// Crack-face node pairs {inner, outer} (crack_axisymmetric_mesh) that set_pair_state may hold
-  /// in frictionless contact, u_r(outer) = u_r(inner), by an augmented Lagrangian: a closed pair
-  /// adds the radial force t = lambda + k g (g = u_r(outer) - u_r(inner)) to the outer node and
-  /// -t to the inner one, k = kFacePenalty x the pair's mean radial stiffness at u = 0. Adds the
-  /// pairs' couplings to the stiffness pattern; every pair starts open. Used on nonlinear layers
-  /// (the linear path holds pairs exactly on its condensed surface). Throws InputError on a node
-  /// outside the mesh.
+  /// in frictionless contact, u_r(outer) = u_r(inner), by an augmented Lagrangian: the energy
+  /// lambda g + k g^2 / 2 (g = u_r(outer) - u_r(inner)) of a closed pair adds t = lambda + k g to
+  /// the outer node's internal force and -t to the inner one's (the pair pushes the outer node by
+  /// -t: outward when t < 0), k = kFacePenalty x the pair's mean radial stiffness at u = 0. Adds
+  /// the pairs' couplings to the stiffness pattern; every pair starts open. Used on nonlinear
+  /// layers (the linear path holds pairs exactly on its condensed surface). Throws InputError on a
+  /// node outside the mesh.
   void set_face_pairs(std::vector<std::array<std::uint32_t, 2>> pairs);
-  /// Which pairs are closed (1) and their multipliers lambda (N, full ring; < 0 pushes the faces
-  /// apart). Open pairs carry no force.
+  /// Which pairs are closed (1) and their multipliers lambda (N, full ring; a compressed pair has
+  /// lambda < 0). Open pairs carry no force.
   void set_pair_state(std::vector<char> closed, Eigen::VectorXd multipliers);
   /// t = lambda + k g of every closed pair at u, 0 for an open one (N, full ring).
   Eigen::VectorXd pair_forces(const Eigen::VectorXd& u) const;
