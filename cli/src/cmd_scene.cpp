@@ -160,6 +160,7 @@ Json scene_to_json(const Scene& s) {
                 {"outputs", outputs},
                 {"criterion", to_string(s.model.criterion)},
                 {"contact", to_string(s.model.contact)},
+                {"crack_faces", to_string(s.model.crack_faces)},
                 {"mesh_refinement", optional_json(s.model.mesh_refinement)}}},
               {"loads", loads_json(s)},
               {"requirements",

@@ -197,6 +197,7 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
     o.stress_average_length_m = plan.threshold->average_length_m;
   if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
     o.crack_depth_m = crack_depth;
+  o.crack_face_contact = options.crack_face_contact;
   CrossingWatch watch(needles.size(), plan);
   int step_index = 0;
   o.on_step = [&](const fe::Step3d& step) {
@@ -286,6 +287,7 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
     p.stress_average_length_m = plan.threshold->average_length_m;
   if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
     p.crack_depth_m = crack_depth;
+  p.crack_face_contact = options.crack_face_contact;
   CrossingWatch watch(1, plan);
   int step_index = 0;
   p.on_step = [&](const fe::InsertionStep& step) {
@@ -297,7 +299,21 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
   fe::InsertionResult r;
   {
     const StageTimer timer(plan.seconds, &RunSeconds::axisymmetric_fe_s);
-    r = fe::simulate_axisymmetric(p);
+    try {
+      r = fe::simulate_axisymmetric(p);
+    } catch (const SolverError& e) {
+      // On nonlinear layers the held crack faces can stop Newton first (docs/model.md, "Crack
+      // faces in contact"): say how to run without them.
+      const bool nonlinear = std::any_of(p.layers.begin(), p.layers.end(), [](const auto& l) {
+        return l.material.model != MaterialModel::Linear;
+      });
+      if (p.crack_depth_m > 0.0 && p.crack_face_contact && nonlinear)
+        throw SolverError(
+            std::string(e.what()) +
+            " ([model] crack_faces = \"free\" lets the crack's faces pass through each "
+            "other instead, G then too high)");
+      throw;
+    }
   }
   PreResult out;
   out.needles.resize(1);
@@ -784,6 +800,7 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
   InsertionRunOptions options = requested;
   if (!options.overrides.refinement_levels)
     options.overrides.refinement_levels = scene.model.mesh_refinement;
+  options.crack_face_contact = scene.model.crack_faces == CrackFaces::Contact;
   check_needle_placement(scene, needles);
   // The pre-puncture model climbs the horizon ladder (docs/model.md, "Pre-puncture horizon"):
   // rung k is built for 100 um x 2^k whatever depth was asked, and the first rung on which every

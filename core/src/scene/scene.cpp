@@ -762,6 +762,9 @@ ModelOptions read_model(std::optional<Table> t, const Tissue& tissue) {
   m.contact = t->optional_choice<Contact>("contact", {{"sticking", Contact::Sticking},
                                                       {"frictionless", Contact::Frictionless}})
                   .value_or(m.contact);
+  m.crack_faces = t->optional_choice<CrackFaces>("crack_faces", {{"contact", CrackFaces::Contact},
+                                                                 {"free", CrackFaces::Free}})
+                      .value_or(m.crack_faces);
   m.mesh_refinement = t->optional_count("mesh_refinement", 0, kMaxMeshRefinement);
   t->finish();
   return m;
@@ -980,6 +983,16 @@ std::string_view to_string(PunctureCriterion c) {
       return "stress";
     case PunctureCriterion::Penetration:
       return "penetration";
+  }
+  return "?";
+}
+
+std::string_view to_string(CrackFaces c) {
+  switch (c) {
+    case CrackFaces::Contact:
+      return "contact";
+    case CrackFaces::Free:
+      return "free";
   }
   return "?";
 }

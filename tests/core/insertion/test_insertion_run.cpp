@@ -522,6 +522,26 @@ TEST(ScenePlanner, SceneMeshRefinementReachesThe3dMeshAndAnOverrideWins) {
   ASSERT_GT(b.needles.front().curve.back().force_N, 0.0);
 }
 
+// [model] crack_faces reaches the energy criterion's cracked twin: held faces keep apart (the
+// linear path's round-off), free ones pass through each other under the punch (docs/model.md,
+// "Crack faces in contact") and release more energy.
+TEST(ScenePlanner, SceneCrackFacesReachTheCrackedTwin) {
+  const std::string text = scene_text("", kFracture, kOnePunch, "[\"puncture\", \"force_curve\"]",
+                                      "[\"3000 um\", \"3000 um\", \"1150 um\"]", "100 um") +
+                           "criterion = \"energy\"\n";
+  const Scene held = parse_scene(text, "punch.toml");
+  const Scene free = parse_scene(text + "crack_faces = \"free\"\n", "punch.toml");
+  InsertionRunOptions energy = fast();  // the commands take the criterion from the scene
+  energy.criterion = PunctureCriterion::Energy;
+  const RunPoint a = run_insertion(held, {punch("punch", 115e-6)}, energy).needles[0].curve.back();
+  const RunPoint b = run_insertion(free, {punch("punch", 115e-6)}, energy).needles[0].curve.back();
+  ASSERT_EQ(a.depth_m, b.depth_m);
+  EXPECT_LE(a.crack_face_overlap_m,
+            1e-13);  // as RingCrackFacesUnderAPunchDoNotPassThroughEachOther
+  EXPECT_GT(b.crack_face_overlap_m, 1e-6);
+  EXPECT_GT(b.energy_release_rate_J_per_m2, a.energy_release_rate_J_per_m2);
+}
+
 // The domain cut of a 3-D run is measured on the needle's body of revolution; for a bevel in
 // neo-Hookean silicone that proxy's Newton stalls (docs/validation.md, "Is the linear tissue why
 // our forces are ≈ 3× below paper A's?"). The run must not end there: the cut is left unmeasured

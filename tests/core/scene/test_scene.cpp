@@ -130,6 +130,14 @@ TEST(Scene, OptionalTablesTakeTheirDefaults) {
   EXPECT_DOUBLE_EQ(s.requirements.safety_factor, 1.5);
   EXPECT_TRUE(s.materials.empty());
   EXPECT_FALSE(s.model.mesh_refinement);  // the fidelity's default
+  EXPECT_EQ(s.model.crack_faces, mneedle::CrackFaces::Contact);
+}
+
+TEST(Scene, CrackFacesMayBeLeftFree) {
+  const Scene s =
+      parse(with("fidelity = \"standard\"", "fidelity = \"standard\"\ncrack_faces = \"free\""));
+  EXPECT_EQ(s.model.crack_faces, mneedle::CrackFaces::Free);
+  EXPECT_EQ(mneedle::to_string(s.model.crack_faces), "free");
 }
 
 TEST(Scene, MeshRefinementIsAWholeNumberOfHalvings) {
@@ -354,6 +362,12 @@ TEST(SceneErrors, MeshRefinementOutsideZeroToSixOrNotAWholeNumber) {
                {"test.toml:31:", "model.mesh_refinement", "expected a whole number"});
   expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\nmesh_refinement = \"2\""),
                {"test.toml:31:", "model.mesh_refinement", "expected a whole number"});
+}
+
+TEST(SceneErrors, CrackFacesOtherThanContactOrFree) {
+  expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\ncrack_faces = \"open\""),
+               {"test.toml:31:", "model.crack_faces", "unknown value 'open'",
+                "expected one of: contact, free"});
 }
 
 TEST(SceneErrors, WrongDimension) {

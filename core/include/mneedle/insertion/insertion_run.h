@@ -41,6 +41,9 @@ struct InsertionRunOptions {
   fe::FidelityOverrides overrides;
   Contact contact = Contact::Sticking;
   PunctureCriterion criterion = PunctureCriterion::Pressure;
+  /// The energy criterion's crack faces in contact: run_insertion sets it from the scene's
+  /// [model] crack_faces, so every command runs the scene's choice.
+  bool crack_face_contact = true;
   PreModel model = PreModel::Auto;
   bool allow_reductions = true;  ///< half models, layer merging
   /// Largest relative force change a measured reduction may cause; empty: from the fidelity

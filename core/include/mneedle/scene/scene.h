@@ -113,6 +113,9 @@ enum class Fidelity { Fast, Standard, Fine };
 enum class Output { Puncture, ForceCurve, Fields };
 enum class PunctureCriterion { Pressure, Energy, Stress, Penetration };
 enum class Contact { Sticking, Frictionless };
+/// The energy criterion's crack faces: in frictionless contact, or free to pass through each
+/// other (for comparison, or where held faces stop Newton; docs/model.md "Crack faces in contact").
+enum class CrackFaces { Contact, Free };
 
 /// Largest `[model] mesh_refinement` (each level halves the element size along the path).
 inline constexpr int kMaxMeshRefinement = 6;
@@ -122,6 +125,7 @@ struct ModelOptions {
   std::vector<Output> outputs{Output::Puncture, Output::ForceCurve};
   PunctureCriterion criterion = PunctureCriterion::Pressure;
   Contact contact = Contact::Sticking;
+  CrackFaces crack_faces = CrackFaces::Contact;
   /// 3-D TET10 tissue mesh: halvings of its grid along the needles' paths (docs/model.md,
   /// "Tissue block and mesh"); empty: the fidelity's default (2 at fine, 0 below).
   std::optional<int> mesh_refinement;
@@ -189,6 +193,7 @@ std::string_view to_string(Fidelity f);           ///< "fast", "standard", "fine
 std::string_view to_string(Output o);             ///< "puncture", "force_curve", "fields"
 std::string_view to_string(PunctureCriterion c);  ///< "pressure", "energy", "stress", "penetration"
 std::string_view to_string(Contact c);            ///< "sticking", "frictionless"
+std::string_view to_string(CrackFaces c);         ///< "contact", "free"
 std::string_view to_string(FrictionLaw f);        ///< "coulomb", "linear_growth", "none"
 
 }  // namespace mneedle
