@@ -193,8 +193,10 @@ std::vector<std::string> energy_warnings(const InsertionRun& run, const Scene& s
     if (overlap > 1e-9)
       out.push_back(scene.source_name + ": needle '" + n.name + "': the crack's faces pass " +
                     "through each other by up to " + format_quantity(overlap, Dimension::Length) +
-                    " (their contact is modelled with sticking needle contact, in 3-D for linear "
-                    "tissue only), " +
+                    (scene.model.crack_faces == CrackFaces::Free
+                         ? std::string(" ([model] crack_faces = \"free\" leaves them free), ")
+                         : std::string(" (their contact is modelled with sticking needle contact, "
+                                       "in 3-D for linear tissue only), ")) +
                     "so G is too high (docs/model.md, \"Crack faces in contact\")");
   }
   return out;

@@ -234,7 +234,7 @@ void print_summary(std::ostream& out, const Scene& s) {
   out << "model: fidelity " << to_string(s.model.fidelity) << ", outputs";
   for (const auto o : s.model.outputs) out << " " << to_string(o);
   out << ", criterion " << to_string(s.model.criterion) << ", contact "
-      << to_string(s.model.contact) << "\n";
+      << to_string(s.model.contact) << ", crack faces " << to_string(s.model.crack_faces) << "\n";
   out << "loads: S " << s.loads.scale << ", K "
       << (s.loads.stiffness ? q(*s.loads.stiffness, Dimension::Pressure)
                             : std::string("from the layer modulus"))

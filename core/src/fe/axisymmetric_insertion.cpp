@@ -472,10 +472,12 @@ class NonlinearStepper : public Stepper {
       pairs_state_ = std::move(trial_pairs);
       // Grow the step when no single solve was hard (the re-solves of captures and crack faces
       // each converge in a few iterations and do not say the step was too long).
-      const int largest_solve = current_.newton_iterations;
+      // Without crack faces the rule is the sum over the step's solves, as before the faces were
+      // held, so that an intact run's sub-steps (hence its captures) do not move.
+      const int effort = close_pairs_ ? current_.newton_iterations : trial_iterations;
       current_.newton_iterations = 0;
       iterations += trial_iterations;
-      if (largest_solve <= 6) step_ = std::min(step_ * 1.5, interval_);
+      if (effort <= 6) step_ = std::min(step_ * 1.5, interval_);
     }
     const double force = needle_force(state_, current_.reaction);
     const double area = contact_area(mesh, needle_, state_, current_.displacement);
@@ -865,10 +867,10 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
       } catch (const SolverError& e) {
         // Name the twin: its failure ends the run, and on nonlinear layers the held crack faces
         // are the likely cause (docs/model.md, "Crack faces in contact").
-        throw SolverError(std::string("the energy criterion's cracked twin (ring crack ") +
-                          format_depth(options.crack_depth_m) + " deep, faces " +
-                          (options.crack_face_contact ? "in contact" : "free") +
-                          ") failed: " + e.what());
+        throw CrackedTwinError(std::string("the energy criterion's cracked twin (ring crack ") +
+                               format_depth(options.crack_depth_m) + " deep, faces " +
+                               (options.crack_face_contact ? "in contact" : "free") +
+                               ") failed: " + e.what());
       }
       step.crack_area_m2 = crack_area;
       step.energy_release_rate_J_per_m2 =

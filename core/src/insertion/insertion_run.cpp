@@ -301,13 +301,13 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
     const StageTimer timer(plan.seconds, &RunSeconds::axisymmetric_fe_s);
     try {
       r = fe::simulate_axisymmetric(p);
-    } catch (const SolverError& e) {
+    } catch (const fe::CrackedTwinError& e) {
       // On nonlinear layers the held crack faces can stop Newton first (docs/model.md, "Crack
       // faces in contact"): say how to run without them.
       const bool nonlinear = std::any_of(p.layers.begin(), p.layers.end(), [](const auto& l) {
         return l.material.model != MaterialModel::Linear;
       });
-      if (p.crack_depth_m > 0.0 && p.crack_face_contact && nonlinear)
+      if (p.crack_face_contact && nonlinear)
         throw SolverError(
             std::string(e.what()) +
             " ([model] crack_faces = \"free\" lets the crack's faces pass through each "

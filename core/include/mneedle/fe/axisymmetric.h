@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "mneedle/base/error.h"
 #include "mneedle/fe/fidelity.h"
 #include "mneedle/fe/material.h"
 
@@ -176,6 +177,13 @@ class AxisymmetricModel {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+/// The energy criterion's cracked twin failed where the intact model had solved; the message
+/// names the twin and its crack.
+class CrackedTwinError : public SolverError {
+ public:
+  using SolverError::SolverError;
 };
 
 /// One converged depth of an insertion.
