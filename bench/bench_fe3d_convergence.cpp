@@ -1,10 +1,10 @@
 // Convergence studies of the 3-D model through its public API (docs/validation.md, "Convergence
 // studies of the 3-D model"; docs/performance.md, "Convergence-study cost"). Run on demand, never
 // from ctest:
-//   bench_fe3d_convergence [punch] [punch_coarsest] [frictionless] [skin] [stress] [crack] [held]
-//   (none: all)
+//   bench_fe3d_convergence [punch] [punch_coarsest] [punch_refined] [frictionless] [skin] [stress]
+//   [crack] [held]   (none: all but punch_coarsest and punch_refined)
 // Prints one table per study; each run's time is the process CPU time (the machine is shared),
-// punch and punch_coarsest print wall time too.
+// punch, punch_coarsest and punch_refined print wall time too.
 #include <Eigen/Core>
 #include <algorithm>
 #include <chrono>

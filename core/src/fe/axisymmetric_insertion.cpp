@@ -420,6 +420,7 @@ class NonlinearStepper : public Stepper {
       trial_pairs.pulled_open.assign(pairs_.size(), 0);
       trial_pairs.latched.assign(pairs_.size(), 0);
       int trial_iterations = 0;
+      int largest_solve = 0;  // Newton iterations of the step's hardest single solve
       std::string failure;
       Equilibrium trial;
       try {
@@ -429,7 +430,7 @@ class NonlinearStepper : public Stepper {
         trial_iterations += trial.newton_iterations;
         const int rounds =
             50 + (close_pairs_ ? kMaxCrackRounds + 4 * static_cast<int>(pairs_.size()) : 0);
-        int largest_solve = trial.newton_iterations;
+        largest_solve = trial.newton_iterations;
         for (int round = 0;; ++round) {
           const bool captured =
               capture_new_nodes(needle_, candidates_, mesh, depth_, current_.displacement, next,
@@ -453,7 +454,6 @@ class NonlinearStepper : public Stepper {
           trial_iterations += trial.newton_iterations;
           largest_solve = std::max(largest_solve, trial.newton_iterations);
         }
-        trial.newton_iterations = largest_solve;
       } catch (const SolverError& e) {
         failure = e.what();
       }
@@ -474,8 +474,7 @@ class NonlinearStepper : public Stepper {
       // each converge in a few iterations and do not say the step was too long).
       // Without crack faces the rule is the sum over the step's solves, as before the faces were
       // held, so that an intact run's sub-steps (hence its captures) do not move.
-      const int effort = close_pairs_ ? current_.newton_iterations : trial_iterations;
-      current_.newton_iterations = 0;
+      const int effort = close_pairs_ ? largest_solve : trial_iterations;
       iterations += trial_iterations;
       if (effort <= 6) step_ = std::min(step_ * 1.5, interval_);
     }
