@@ -6,10 +6,15 @@
 // Run on demand, never from ctest (finer: several minutes and several GB per needle):
 //   bench_puncture_convergence [--criterion penetration|pressure|energy|stress]
 //       [--no-finer] [--finest] [--refine N] [--tissue silicone|skin] [--frictionless]
-//       [sharp_bevel] [blunt_bevel] [cylinder]   (none: sharp_bevel)
+//       [--level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]]... [sharp_bevel] [blunt_bevel]
+//       [cylinder]   (none: sharp_bevel)
 // --refine N: every level's grid built 2^N coarser and bisected back along the needle's path
 // (refinement_levels; 0 is the plain tensor grid; default: 2 at fine and beyond, 0 below);
 // --finest: a level beyond finer (10.5 spacings per radius, growth 1.2).
+// --level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS] (repeatable): run these levels instead of
+// the fidelities, each the given fidelity with its tip size, growth and refinement_levels replaced
+// (a sweep of the choices behind a fidelity level, docs/validation.md "The penetration
+// criterion").
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -48,6 +53,18 @@ struct Options {
   std::string tissue = "silicone";  // paper_a_<tissue>_<needle>.toml
   std::optional<Contact> contact;   // empty: the scene's
   std::vector<std::string> needles;
+  // --level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]: levels of one's own instead of the
+  // fidelities (a fidelity's steps and layers through the top, with node spacings per needle radius
+  // at the tip, growth ratio and refinement_levels replaced), for sweeps of the mesh choices behind
+  // a fidelity level.
+  struct Custom {
+    std::string label;
+    fe::Fidelity base = fe::Fidelity::Fine;
+    double spacings = 0.0, growth = 0.0;
+    int refine = 0;
+    int steps = 0;  // depth steps per horizon rung; 0: the fidelity's
+  };
+  std::vector<Custom> custom;
 };
 
 struct Level {
@@ -78,6 +95,30 @@ Options parse(int argc, char** argv) {
       o.refine = std::atoi(argv[++i]);
     } else if (a == "--tissue" && i + 1 < argc) {
       o.tissue = argv[++i];
+    } else if (a == "--level" && i + 1 < argc) {
+      const std::string spec = argv[++i];
+      Options::Custom c;
+      const auto eq = spec.find('=');
+      char tail = 0;
+      char fidelity[16] = {};
+      const int fields =
+          eq == std::string::npos
+              ? 0
+              : std::sscanf(spec.c_str() + eq + 1, "%15[a-z],%lf,%lf,%d,%d%c", fidelity,
+                            &c.spacings, &c.growth, &c.refine, &c.steps, &tail);
+      const bool parsed = (fields == 4 || fields == 5) && c.steps >= 0;
+      const std::string f = fidelity;
+      if (!parsed || (f != "fast" && f != "standard" && f != "fine") || !(c.spacings > 0.0) ||
+          !(c.growth >= 1.0) || c.refine < 0) {
+        std::cerr << "bench_puncture_convergence: --level wants "
+                     "LABEL=fast|standard|fine,SPACINGS,GROWTH,REFINE[,STEPS] (spacings > 0, "
+                     "growth >= 1, refine >= 0, steps >= 1), got '"
+                  << spec << "'\n";
+        std::exit(2);
+      }
+      c.base = fe::parse_fidelity(f);
+      c.label = spec.substr(0, eq);
+      o.custom.push_back(c);
     } else if (a == "--finest") {
       o.finest = true;
     } else if (a == "--frictionless") {
@@ -100,8 +141,10 @@ Options parse(int argc, char** argv) {
       o.needles.push_back(a);
     } else {
       std::cerr << "usage: bench_puncture_convergence [--criterion C] [--no-finer] [--finest] "
-                   "[--refine N] [--tissue silicone|skin] [--frictionless] [sharp_bevel] "
-                   "[blunt_bevel] [cylinder]\n";
+                   "[--refine N] [--tissue silicone|skin] [--frictionless] "
+                   "[--level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]]... [sharp_bevel] "
+                   "[blunt_bevel] "
+                   "[cylinder]\n";
       std::exit(a == "--help" || a == "-h" ? 0 : 2);
     }
   }
@@ -126,6 +169,22 @@ std::vector<Level> levels(const Scene& scene, const PreparedNeedle& needle, cons
     r.overrides.refinement_levels = o.refine;
     return r;
   };
+  if (!o.custom.empty()) {
+    const double block = std::max(scene.tissue.size[0], scene.tissue.size[1]);
+    const double radius = needle_radius(needle);
+    for (const Options::Custom& c : o.custom) {
+      // The base fidelity's steps and cells through the top; the tip size (as spacings per
+      // radius: the fine level's size scaled), the growth and the refinement are the sweep's.
+      Level l{c.label, base(c.base)};
+      l.run.overrides.tip_size_m =
+          fe::mesh_sizing(fe::Fidelity::Fine, 2, radius, block).fine_size * 5.5 / c.spacings;
+      l.run.overrides.growth = c.growth;
+      l.run.overrides.refinement_levels = c.refine;
+      if (c.steps > 0) l.run.overrides.steps = c.steps;
+      out.push_back(l);
+    }
+    return out;
+  }
   out.push_back({"fast", base(fe::Fidelity::Fast)});
   out.push_back({"standard", base(fe::Fidelity::Standard)});
   out.push_back({"fine", base(fe::Fidelity::Fine)});

@@ -52,20 +52,21 @@ constexpr double kFrictionlessPunchHighest = 1.30;
 
 // a = 90 um on a mesh graded for the punch: its half-integer node spacing keeps the grid lines'
 // nodes off the rim, so the captured footprint does not hinge on round-off (docs/validation.md,
-// "Rigid flat punch, bonded (sticking), vs Hayes et al. (1972)").
-void check_bonded_punch(int order, double tolerance) {
+// "Rigid flat punch, bonded (sticking), vs Hayes et al. (1972)"). Checks what holds on any mesh
+// and returns F / F_Hayes.
+double bonded_punch_over_hayes(int order, Fidelity fidelity, double footprint) {
   const double E = 1e5, nu = 0.45, a = 90e-6, h = 225e-6, d = 2e-6;
   const TissueBlockSpec block = homogeneous_block(MaterialModel::Linear, E, nu, 675e-6, h);
-  const TetMesh mesh = punch_mesh(block, a, d, order, Fidelity::Standard);
+  const TetMesh mesh = punch_mesh(block, a, d, order, fidelity);
   Indentation3d run(mesh, {{"punch", cylinder_needle(a, 1e-3), 0.0, 0.0}}, 2 * d);
   const Step3d step = run.advance_to(d);
   const double expected = 2 * a * E / (1 - nu * nu) * kHayesNu045Ratio04 * d;
-  ASSERT_EQ(step.needles.size(), 1U);
-  EXPECT_NEAR(step.needles[0].force_N / expected, 1.0, tolerance) << "order " << order;
-  // Rim faces count by the fraction of their nodes held: 0.972 of pi a^2 at both orders on this
-  // grid. A ring of nodes more or fewer is a strip about 2 pi a x (spacing / 2), over half of
-  // pi a^2, so 3 % either way catches any change of the captured footprint.
-  EXPECT_NEAR(step.needles[0].contact_area_m2 / (std::numbers::pi * a * a), 0.972, 0.03);
+  EXPECT_EQ(step.needles.size(), 1U);
+  if (step.needles.size() != 1U) return 0.0;
+  // Rim faces count by the fraction of their nodes held (`footprint` of pi a^2 on this grid). A
+  // ring of nodes more or fewer is a strip about 2 pi a x (spacing / 2), over half of pi a^2, so
+  // 3 % either way catches any change of the captured footprint.
+  EXPECT_NEAR(step.needles[0].contact_area_m2 / (std::numbers::pi * a * a), footprint, 0.03);
   EXPECT_LT(std::abs(step.needles[0].lateral_force_N[0]), 0.01 * step.needles[0].force_N);
   // Linear material and a flat punch: force proportional to depth, one factorisation.
   const Step3d deeper = run.advance_to(2 * d);
@@ -74,14 +75,22 @@ void check_bonded_punch(int order, double tolerance) {
   // Every captured node moved straight down by the depth: energy = F d / 2.
   EXPECT_NEAR(deeper.strain_energy_J, 0.5 * deeper.needles[0].force_N * 2 * d,
               1e-9 * deeper.strain_energy_J);
+  return step.needles[0].force_N / expected;
 }
 
+// TET10 at fine against Hayes (measured 1.022; a displacement solution lies above the exact one),
+// and standard within 5 % of fine, the objective-value bound of a fidelity level
+// (docs/validation.md): measured 1.0525, +3.0 % (standard resolves the rim as fine does, 5.5 node
+// spacings per radius, on a coarser far field).
 TEST(Indentation3d, BondedFlatPunchOnQuadraticTetsMatchesHayesLayerSolution) {
-  check_bonded_punch(2, 0.05);  // measured 0.983 (docs/validation.md)
+  const double fine = bonded_punch_over_hayes(2, Fidelity::Fine, 0.954);
+  EXPECT_NEAR(fine, 1.0, 0.05);
+  const double standard = bonded_punch_over_hayes(2, Fidelity::Standard, 0.954);
+  EXPECT_NEAR(standard / fine, 1.0, 0.05);
 }
 
 TEST(Indentation3d, BondedFlatPunchOnLinearTetsMatchesHayesLayerSolution) {
-  check_bonded_punch(1, 0.15);
+  EXPECT_NEAR(bonded_punch_over_hayes(1, Fidelity::Standard, 0.972), 1.0, 0.15);
 }
 
 TEST(Indentation3d, StVenantKirchhoffPunchReducesToLinearAtSmallDepth) {
