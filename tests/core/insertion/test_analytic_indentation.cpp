@@ -214,6 +214,32 @@ TEST(AnalyticIndentation, StlFlatCylinderIndentsLikeTheFlatPunchItIs) {
   }
 }
 
+// Paper A's hollow sharp bevel (OD 230 um, bore 90 um, 30 deg) in its silicone, 0.1 to 2 mm:
+// the section only grows with depth, so the force is positive and never falls. Before the
+// round-off guard above the slicer's creeping radius gave -665 N past 1 mm.
+TEST(AnalyticIndentation, HollowSharpBevelForceRisesWithDepthToTwoMillimetres) {
+  test::ShapeOptions o;
+  o.bore = 45e-6;
+  o.length = 2500e-6;
+  const auto needle = equivalent_axisymmetric_needle(test::sharp_bevel(o, pi / 6), 2000e-6);
+  std::vector<double> depths;
+  for (int k = 1; k <= 20; ++k) depths.push_back(100e-6 * k);
+  const auto steps = analytic_indentation(half_space(0.2e6, 0.49), needle, depths);
+  ASSERT_EQ(steps.size(), depths.size());
+  double previous = 0.0;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    EXPECT_TRUE(std::isfinite(steps[k].force_N)) << depths[k];
+    EXPECT_GT(steps[k].force_N, previous) << depths[k];
+    previous = steps[k].force_N;
+  }
+  // Past the heel (398 um) the equivalent needle is the full annulus' solid of equal area, a
+  // flat punch of radius sqrt(R^2 - r_b^2) = 105.8 um: the force then grows linearly with depth,
+  // 2 E* a per metre (Boussinesq), to round-off of the slicing (1e-3).
+  const double a = std::sqrt(115e-6 * 115e-6 - 45e-6 * 45e-6);
+  const double slope = (steps[19].force_N - steps[9].force_N) / (depths[19] - depths[9]);
+  EXPECT_NEAR(slope / (2 * reduced(0.2e6, 0.49) * a), 1.0, 1e-3);
+}
+
 TEST(AnalyticIndentation, RejectsBadInput) {
   const auto punch = fe::AxisymmetricNeedle::flat_punch(100e-6);
   const Tissue ok = half_space(1e5, 0.3);
