@@ -5,7 +5,7 @@
 // radius at the tip and a growth of 1.25 instead of 1.35).
 // Run on demand, never from ctest (finer: several minutes and several GB per needle):
 //   bench_puncture_convergence [--criterion penetration|pressure|energy|stress]
-//       [--no-finer] [--finest] [--refine N] [--tissue silicone|skin] [--frictionless]
+//       [--no-finer] [--finest] [--refine N] [--tissue silicone|skin] [--frictionless] [--model3d]
 //       [--level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]]... [sharp_bevel] [blunt_bevel]
 //       [cylinder]   (none: sharp_bevel)
 // --refine N: every level's grid built 2^N coarser and bisected back along the needle's path
@@ -52,6 +52,7 @@ struct Options {
   bool finest = false;
   std::string tissue = "silicone";  // paper_a_<tissue>_<needle>.toml
   std::optional<Contact> contact;   // empty: the scene's
+  bool full3d = false;              // --model3d: the 3-D model even where the planner would not
   std::vector<std::string> needles;
   // --level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]: levels of one's own instead of the
   // fidelities (a fidelity's steps and layers through the top, with node spacings per needle radius
@@ -121,6 +122,8 @@ Options parse(int argc, char** argv) {
       o.custom.push_back(c);
     } else if (a == "--finest") {
       o.finest = true;
+    } else if (a == "--model3d") {
+      o.full3d = true;
     } else if (a == "--frictionless") {
       o.contact = Contact::Frictionless;
     } else if (a == "--criterion" && i + 1 < argc) {
@@ -141,7 +144,7 @@ Options parse(int argc, char** argv) {
       o.needles.push_back(a);
     } else {
       std::cerr << "usage: bench_puncture_convergence [--criterion C] [--no-finer] [--finest] "
-                   "[--refine N] [--tissue silicone|skin] [--frictionless] "
+                   "[--refine N] [--tissue silicone|skin] [--frictionless] [--model3d] "
                    "[--level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]]... [sharp_bevel] "
                    "[blunt_bevel] "
                    "[cylinder]\n";
@@ -167,6 +170,7 @@ std::vector<Level> levels(const Scene& scene, const PreparedNeedle& needle, cons
     r.contact = o.contact.value_or(scene.model.contact);
     r.criterion = o.criterion;
     r.overrides.refinement_levels = o.refine;
+    if (o.full3d) r.model = PreModel::Full3d;
     return r;
   };
   if (!o.custom.empty()) {

@@ -78,14 +78,15 @@ double bonded_punch_over_hayes(int order, Fidelity fidelity, double footprint) {
   return step.needles[0].force_N / expected;
 }
 
-// TET10 at fine against Hayes (measured 1.022; a displacement solution lies above the exact one),
-// and standard within 5 % of fine, the objective-value bound of a fidelity level
-// (docs/validation.md): measured 1.0525, +3.0 % (standard resolves the rim as fine does, 5.5 node
-// spacings per radius, on a coarser far field).
+// TET10 against Hayes at standard and fine (measured 0.977 and 1.022: the rim falls between
+// nodes, so the captured footprint, 1.003 and 0.954 of pi a^2, decides the sign), and standard
+// within 5 % of fine, the objective-value bound of a fidelity level (docs/validation.md): standard
+// resolves the rim as fine does (5.5 node spacings per radius) on a coarser far field.
 TEST(Indentation3d, BondedFlatPunchOnQuadraticTetsMatchesHayesLayerSolution) {
   const double fine = bonded_punch_over_hayes(2, Fidelity::Fine, 0.954);
   EXPECT_NEAR(fine, 1.0, 0.05);
-  const double standard = bonded_punch_over_hayes(2, Fidelity::Standard, 0.954);
+  const double standard = bonded_punch_over_hayes(2, Fidelity::Standard, 1.003);
+  EXPECT_NEAR(standard, 1.0, 0.05);
   EXPECT_NEAR(standard / fine, 1.0, 0.05);
 }
 
