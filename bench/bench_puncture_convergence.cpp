@@ -9,10 +9,13 @@
 //       [--level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]]... [sharp_bevel] [blunt_bevel]
 //       [cylinder]   (none: sharp_bevel)
 // --refine N: every level's grid built 2^N coarser and bisected back along the needle's path
-// (refinement_levels; 0 is the plain tensor grid; default: 2 at fine and beyond, 0 below);
+// (refinement_levels; 0 is the plain tensor grid; default: the level's, docs/model.md "Tissue
+// block and mesh"); --model3d: the 3-D model even where the planner would run the axisymmetric one;
 // --finest: a level beyond finer (10.5 spacings per radius, growth 1.2).
 // --level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS] (repeatable): run these levels instead of
-// the fidelities, each the given fidelity with its tip size, growth and refinement_levels replaced
+// the fidelities (errors are against the last one listed; --refine does not apply; SPACINGS are
+// TET10 node spacings per radius), each the given fidelity with its tip size, growth,
+// refinement_levels and, given STEPS, its depth steps per horizon rung replaced
 // (a sweep of the choices behind a fidelity level, docs/validation.md "The penetration
 // criterion").
 #include <algorithm>
@@ -100,20 +103,22 @@ Options parse(int argc, char** argv) {
       const std::string spec = argv[++i];
       Options::Custom c;
       const auto eq = spec.find('=');
-      char tail = 0;
+      // FIDELITY,SPACINGS,GROWTH,REFINE then, optionally, ",STEPS": every character consumed.
       char fidelity[16] = {};
-      const int fields =
-          eq == std::string::npos
-              ? 0
-              : std::sscanf(spec.c_str() + eq + 1, "%15[a-z],%lf,%lf,%d,%d%c", fidelity,
-                            &c.spacings, &c.growth, &c.refine, &c.steps, &tail);
-      const bool parsed = (fields == 4 || fields == 5) && c.steps >= 0;
+      int used = -1, more = -1;
+      const char* rest = eq == std::string::npos ? "" : spec.c_str() + eq + 1;
+      bool parsed = std::sscanf(rest, "%15[a-z],%lf,%lf,%d%n", fidelity, &c.spacings, &c.growth,
+                                &c.refine, &used) == 4 &&
+                    used > 0;
+      if (parsed && rest[used] != '\0')
+        parsed = std::sscanf(rest + used, ",%d%n", &c.steps, &more) == 1 && more > 0 &&
+                 rest[used + more] == '\0' && c.steps >= 1;
       const std::string f = fidelity;
       if (!parsed || (f != "fast" && f != "standard" && f != "fine") || !(c.spacings > 0.0) ||
           !(c.growth >= 1.0) || c.refine < 0) {
         std::cerr << "bench_puncture_convergence: --level wants "
                      "LABEL=fast|standard|fine,SPACINGS,GROWTH,REFINE[,STEPS] (spacings > 0, "
-                     "growth >= 1, refine >= 0, steps >= 1), got '"
+                     "growth >= 1, refine >= 0, steps >= 1 when given), got '"
                   << spec << "'\n";
         std::exit(2);
       }

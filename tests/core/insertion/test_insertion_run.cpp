@@ -639,7 +639,8 @@ TEST(ScenePlanner, AxisymmetricModelAgreesWithThe3dBlockWithinTheFastTolerance) 
   EXPECT_TRUE(axi.axisymmetric);
   EXPECT_FALSE(block.axisymmetric);
   // Cylinder of equal cross-section area against the square block, each at fast fidelity:
-  // measured 4.3 % apart at 50 um (3.4 % at standard), within the 5 % fast tolerance.
+  // measured 4.3 % apart at 50 um (3.4 % at the former standard level), within the 5 % fast
+  // tolerance.
   for (std::size_t i = 0; i < axi.needles[0].curve.size(); ++i) {
     const double fa = axi.needles[0].curve[i].force_N;
     const double fb = block.needles[0].curve[i].force_N;
