@@ -215,8 +215,9 @@ TEST(AnalyticIndentation, StlFlatCylinderIndentsLikeTheFlatPunchItIs) {
 }
 
 // Paper A's hollow sharp bevel (OD 230 um, bore 90 um, 30 deg) in its silicone, 0.1 to 2 mm:
-// the section only grows with depth, so the force is positive and never falls. Before the
-// round-off guard above the slicer's creeping radius gave -665 N past 1 mm.
+// the section only grows with depth, so the force is positive and never falls, and past the heel
+// it grows as a flat punch's. docs/validation.md had recorded -665 N past 1 mm; without the
+// round-off guard above this test's slope check fails.
 TEST(AnalyticIndentation, HollowSharpBevelForceRisesWithDepthToTwoMillimetres) {
   test::ShapeOptions o;
   o.bore = 45e-6;
