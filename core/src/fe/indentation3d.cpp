@@ -8,8 +8,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <optional>
 #include <sstream>
+#include <unordered_map>
 
 #include "fe/contact3d.h"
 #include "fe/field_output3d.h"
@@ -48,6 +50,12 @@ std::string micrometres(double metres) {
 }
 
 constexpr int kMaxCaptureRounds = 60;
+// Captures in depth order (advance_linear): a node's entry depth is bisected to
+// kCaptureBisection x the needle's radius; the nodes entering within kCaptureGroup x the radius
+// after the first are captured with it (1.15 um for paper A's needles: 0.25 and 4 um gave the
+// same puncture depth to 0.1 um; docs/model.md, "Contact with the rigid needle (sticking)").
+constexpr double kCaptureBisection = 1e-5;
+constexpr double kCaptureGroup = 1e-2;
 constexpr int kMaxNewtonIterations = 40;
 constexpr int kMaxLineSearchHalvings = 6;
 constexpr int kMaxStepCuts = 12;
@@ -86,6 +94,14 @@ struct Indentation3d::Impl {
   std::vector<int> ring_index;  // node -> index in ring or -1
   std::vector<CapturedNode> captured;
   std::vector<int> captured_by;  // node -> needle or -1
+  // Compliance columns of nodes a capture search found inside a needle but not yet captured.
+  struct CachedColumns {
+    Eigen::Matrix<double, Eigen::Dynamic, 3> surface;  // surface rows (candidates, then ring)
+    Eigen::Matrix<double, Eigen::Dynamic, 3> gaps;     // crack-face pairs' gaps
+  };
+  std::unordered_map<int, CachedColumns> column_cache;
+  // The smallest needle radius up to the final depth: the length scale of the capture search.
+  double capture_radius = std::numeric_limits<double>::infinity();
   std::vector<char> fixed_dof;
   SparseSolver solver{3};  // x, y, z per node: ordered by node
   Eigen::SparseMatrix<double> stiffness;
@@ -171,6 +187,7 @@ struct Indentation3d::Impl {
       shapes.emplace_back(needles[n].mesh);
       // Margin: surface nodes move sideways a little before the needle reaches them.
       reach.push_back(1.1 * shapes.back().max_radius_up_to(max_depth) + 1e-9);
+      capture_radius = std::min(capture_radius, shapes.back().max_radius_up_to(max_depth));
     }
     for (const auto& face : mesh.top_faces)
       for (int node : face) {
@@ -260,26 +277,54 @@ struct Indentation3d::Impl {
     linear_factorized = true;
   }
 
-  void append_compliance_columns(const std::vector<CapturedNode>& found) {
-    const Eigen::Index old_columns = compliance.cols();
+  // K⁻¹ at unit loads on the nodes' three dofs, kept at the surface rows (and the pairs' gaps):
+  // one multi-right-hand-side solve for every node not cached yet. K does not change on the
+  // linear path, so a node's columns stay valid until it is captured, however many capture
+  // events later (reading the factor once for many columns is what makes the solve cheap).
+  void cache_compliance_columns(const std::vector<CapturedNode>& nodes) {
+    std::vector<int> missing;
+    for (const CapturedNode& c : nodes)
+      if (!column_cache.count(c.node) &&
+          std::find(missing.begin(), missing.end(), c.node) == missing.end())
+        missing.push_back(c.node);
+    if (missing.empty()) return;
     Eigen::MatrixXd unit =
-        Eigen::MatrixXd::Zero(model.dof_count(), 3 * static_cast<Eigen::Index>(found.size()));
-    for (std::size_t i = 0; i < found.size(); ++i)
+        Eigen::MatrixXd::Zero(model.dof_count(), 3 * static_cast<Eigen::Index>(missing.size()));
+    for (std::size_t i = 0; i < missing.size(); ++i)
       for (int j = 0; j < 3; ++j)
-        unit(3 * found[i].node + j, 3 * static_cast<Eigen::Index>(i) + j) = 1.0;
+        unit(3 * missing[i] + j, 3 * static_cast<Eigen::Index>(i) + j) = 1.0;
     const Eigen::MatrixXd columns = solver.solve_many(unit);
-    compliance.conservativeResize(surface_rows(), old_columns + columns.cols());
-    for (std::size_t c = 0; c < candidates.size() + ring.size(); ++c) {
-      const int node = c < candidates.size() ? candidates[c] : ring[c - candidates.size()];
-      for (int j = 0; j < 3; ++j)
-        compliance.block(3 * static_cast<Eigen::Index>(c) + j, old_columns, 1, columns.cols()) =
-            columns.row(3 * node + j);
+    for (std::size_t i = 0; i < missing.size(); ++i) {
+      CachedColumns& cached = column_cache[missing[i]];
+      cached.surface.resize(surface_rows(), 3);
+      for (std::size_t c = 0; c < candidates.size() + ring.size(); ++c) {
+        const int node = c < candidates.size() ? candidates[c] : ring[c - candidates.size()];
+        cached.surface.middleRows<3>(3 * static_cast<Eigen::Index>(c)) =
+            columns.block<3, 3>(3 * node, 3 * static_cast<Eigen::Index>(i));
+      }
+      if (!crack_contact()) continue;
+      cached.gaps.resize(static_cast<Eigen::Index>(pairs.size()), 3);
+      for (std::size_t p = 0; p < pairs.size(); ++p)
+        for (int j = 0; j < 3; ++j)
+          cached.gaps(static_cast<Eigen::Index>(p), j) =
+              gap_of(p, columns.col(3 * static_cast<Eigen::Index>(i) + j));
     }
-    if (!crack_contact()) return;
-    capture_gaps.conservativeResize(static_cast<Eigen::Index>(pairs.size()), compliance.cols());
-    for (std::size_t p = 0; p < pairs.size(); ++p)
-      for (Eigen::Index k = 0; k < columns.cols(); ++k)
-        capture_gaps(static_cast<Eigen::Index>(p), old_columns + k) = gap_of(p, columns.col(k));
+  }
+
+  void append_compliance_columns(const std::vector<CapturedNode>& found) {
+    cache_compliance_columns(found);
+    const Eigen::Index old_columns = compliance.cols();
+    const auto added = 3 * static_cast<Eigen::Index>(found.size());
+    compliance.conservativeResize(surface_rows(), old_columns + added);
+    if (crack_contact())
+      capture_gaps.conservativeResize(static_cast<Eigen::Index>(pairs.size()), old_columns + added);
+    for (std::size_t i = 0; i < found.size(); ++i) {
+      const auto it = column_cache.find(found[i].node);
+      const Eigen::Index at = old_columns + 3 * static_cast<Eigen::Index>(i);
+      compliance.middleCols<3>(at) = it->second.surface;
+      if (crack_contact()) capture_gaps.middleCols<3>(at) = it->second.gaps;
+      column_cache.erase(it);
+    }
   }
 
   // K⁻¹ columns of the opening loads of pairs that have none yet.
@@ -422,6 +467,79 @@ struct Indentation3d::Impl {
 
   int advance_linear(double at_depth) {
     if (!linear_factorized) factorize_linear();
+    if (leader) return advance_linear_as_leader_does(at_depth);
+    const auto start = Clock::now();
+    // Sticking contact holds a node from the depth where the needle reaches it, so the captured
+    // set must grow in that order, not at the ends of output steps: taken at a step's end, every
+    // node found inside in a solve that did not hold the ones reached before it is held, and in
+    // skin the force fell with the step length (docs/model.md, "Contact with the rigid needle
+    // (sticking)"). With the set fixed the condensed solution is affine in depth, so between two
+    // depths every node's path is a segment: the first entry on it is found by bisection, the
+    // nodes entering within kCaptureGroup of it are captured there, and the rest of the step is
+    // solved again.
+    double from = depth;
+    Eigen::VectorXd us_from = candidate_displacement();
+    int solves = 0;
+    const auto limit = static_cast<int>(candidates.size()) + kMaxCaptureRounds;
+    for (int event = 0; event < limit; ++event) {
+      solve_linear_contact(at_depth);
+      ++solves;
+      const Eigen::VectorXd us_to = candidate_displacement();
+      const auto position = [&](int node, double t) -> Eigen::Vector3d {
+        const Eigen::Index row = 3 * candidate_index[static_cast<std::size_t>(node)];
+        return mesh.nodes[static_cast<std::size_t>(node)] + (1.0 - t) * us_from.segment<3>(row) +
+               t * us_to.segment<3>(row);
+      };
+      const auto found = find_new_captures(at_depth, [&](int node) -> Eigen::Vector3d {
+        return us_to.segment<3>(3 * candidate_index[static_cast<std::size_t>(node)]);
+      });
+      if (found.empty()) {
+        timing.contact_s += seconds_since(start);
+        return solves;
+      }
+      cache_compliance_columns(found);
+      const double span = at_depth - from;
+      std::vector<double> entry(found.size(), 1.0);
+      double first = 1.0;
+      for (std::size_t i = 0; i < found.size(); ++i) {
+        const auto inside = [&](double t) {
+          const Eigen::Vector3d local =
+              position(found[i].node, t) - tip(found[i].needle, from + t * span);
+          return shapes[static_cast<std::size_t>(found[i].needle)].touches(local);
+        };
+        double lo = 0.0, hi = 1.0;
+        if (inside(0.0)) hi = 0.0;
+        for (int halving = 0;
+             halving < 60 && hi - lo > 0.0 && (hi - lo) * span > kCaptureBisection * capture_radius;
+             ++halving) {
+          const double mid = 0.5 * (lo + hi);
+          (inside(mid) ? hi : lo) = mid;
+        }
+        entry[i] = hi;
+        first = std::min(first, hi);
+      }
+      const double group =
+          std::min(1.0, first + kCaptureGroup * capture_radius / std::max(span, 1e-300));
+      std::vector<CapturedNode> now;
+      for (std::size_t i = 0; i < found.size(); ++i) {
+        if (entry[i] > group) continue;
+        const int needle = found[i].needle;
+        const Eigen::Vector3d local =
+            position(found[i].node, group) - tip(needle, from + group * span);
+        now.push_back({found[i].node, needle,
+                       shapes[static_cast<std::size_t>(needle)].lower_surface_below(local)});
+      }
+      // Continuity: at the event's depth the new nodes are where the needle holds them.
+      us_from = (1.0 - group) * us_from + group * us_to;
+      from += group * span;
+      append_compliance_columns(now);
+      add_captures(now);
+    }
+    throw SolverError("3-D solve: contact set did not settle at depth " + micrometres(at_depth));
+  }
+
+  // A cracked twin copies its leader's captures at the leader's depths.
+  int advance_linear_as_leader_does(double at_depth) {
     const auto start = Clock::now();
     int solves = 0;
     for (int round = 0; round < kMaxCaptureRounds; ++round) {
