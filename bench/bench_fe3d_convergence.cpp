@@ -73,7 +73,7 @@ struct Sample {
 
 Sample simulate(const TissueBlockSpec& block, const Needle3d& needle, int order, double tip_size,
                 ContactMode contact, int steps, int through_top = 0, double crack_depth = 0.0,
-                double average_length = 0.0, int refinement_levels = 0, double growth = 0.0) {
+                double average_length = 0.0, int refinement_levels = 0, double growth = 1.6) {
   Simulation3dOptions options;
   options.depth = kDepth;
   options.contact = contact;
@@ -82,8 +82,10 @@ Sample simulate(const TissueBlockSpec& block, const Needle3d& needle, int order,
   options.overrides.tip_size_m = tip_size;
   options.overrides.steps = steps;
   if (through_top > 0) options.overrides.elements_through_top = through_top;
-  if (refinement_levels > 0) options.overrides.refinement_levels = refinement_levels;
-  if (growth > 0) options.overrides.growth = growth;
+  // The studies' grid is pinned (the tensor grid at growth 1.6, the standard level's grading until
+  // 2026-12-05) so that a change of a fidelity level's defaults does not move them unseen.
+  options.overrides.refinement_levels = refinement_levels;
+  options.overrides.growth = growth;
   options.crack_depth_m = crack_depth;
   options.stress_average_length_m = average_length;
   const double cpu_start = cpu_seconds();
