@@ -320,6 +320,7 @@ struct Indentation3d::Impl {
       capture_gaps.conservativeResize(static_cast<Eigen::Index>(pairs.size()), old_columns + added);
     for (std::size_t i = 0; i < found.size(); ++i) {
       const auto it = column_cache.find(found[i].node);
+      assert(it != column_cache.end() && "a node captured twice in one call");
       const Eigen::Index at = old_columns + 3 * static_cast<Eigen::Index>(i);
       compliance.middleCols<3>(at) = it->second.surface;
       if (crack_contact()) capture_gaps.middleCols<3>(at) = it->second.gaps;
@@ -467,7 +468,10 @@ struct Indentation3d::Impl {
 
   int advance_linear(double at_depth) {
     if (!linear_factorized) factorize_linear();
-    if (leader) return advance_linear_as_leader_does(at_depth);
+    // A cracked twin copies its leader's captures; with crack faces in contact the active set
+    // may change inside a step, so the solution is only piecewise affine in depth: both keep
+    // the capture rounds at the step's end.
+    if (leader || crack_contact()) return capture_at_step_end(at_depth);
     const auto start = Clock::now();
     // Sticking contact holds a node from the depth where the needle reaches it, so the captured
     // set must grow in that order, not at the ends of output steps: taken at a step's end, every
@@ -518,28 +522,35 @@ struct Indentation3d::Impl {
         entry[i] = hi;
         first = std::min(first, hi);
       }
-      const double group =
-          std::min(1.0, first + kCaptureGroup * capture_radius / std::max(span, 1e-300));
+      // The event is the first entry; the nodes entering within the group length after it are
+      // taken with it, each anchored on the face below (or nearest to) where it is then.
+      const double group = first + kCaptureGroup * capture_radius / std::max(span, 1e-300);
       std::vector<CapturedNode> now;
       for (std::size_t i = 0; i < found.size(); ++i) {
         if (entry[i] > group) continue;
         const int needle = found[i].needle;
         const Eigen::Vector3d local =
-            position(found[i].node, group) - tip(needle, from + group * span);
+            position(found[i].node, first) - tip(needle, from + first * span);
         now.push_back({found[i].node, needle,
                        shapes[static_cast<std::size_t>(needle)].lower_surface_below(local)});
       }
-      // Continuity: at the event's depth the new nodes are where the needle holds them.
-      us_from = (1.0 - group) * us_from + group * us_to;
-      from += group * span;
+      from += first * span;
       append_compliance_columns(now);
       add_captures(now);
+      // The rest of the step starts from the solution at the event's depth with the new nodes
+      // held (their anchors lie on the face, up to the group length from where the segment had
+      // them): one more condensed solve, no factorisation.
+      solve_linear_contact(from);
+      ++solves;
+      us_from = candidate_displacement();
     }
     throw SolverError("3-D solve: contact set did not settle at depth " + micrometres(at_depth));
   }
 
-  // A cracked twin copies its leader's captures at the leader's depths.
-  int advance_linear_as_leader_does(double at_depth) {
+  // Captures at the step's end, repeated until none is inside: a cracked twin (the leader's
+  // captured set and anchors at each output depth, which is all the linear solution depends on)
+  // and a run with crack faces in contact.
+  int capture_at_step_end(double at_depth) {
     const auto start = Clock::now();
     int solves = 0;
     for (int round = 0; round < kMaxCaptureRounds; ++round) {
@@ -1250,7 +1261,7 @@ void Indentation3d::hold_contact_of(const Indentation3d& leader, std::vector<int
 }
 
 void Indentation3d::set_crack_faces(std::vector<CrackFacePair> pairs, bool contact) {
-  if (impl_->depth > 0.0 || impl_->compliance.cols() > 0)
+  if (impl_->depth > 0.0 || impl_->compliance.cols() > 0 || !impl_->column_cache.empty())
     throw InputError("3-D indentation: crack-face contact must be set before the first depth");
   const auto nodes = static_cast<int>(impl_->mesh.nodes.size());
   for (const CrackFacePair& pair : pairs) {
