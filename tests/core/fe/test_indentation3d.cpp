@@ -331,6 +331,24 @@ TEST(Indentation3d, BevelTipNodeCarriesForceFromTheStepThatCapturesIt) {
   EXPECT_NEAR(f2 / f1, 2.0, 1e-4);
 }
 
+// The half model of one needle pressed to `depth` in two output steps and in `many`: the runs'
+// needle steps at the two depths they share (depth / 2 and depth), coarse first.
+std::vector<std::pair<NeedleStep3d, NeedleStep3d>> two_steps_against_many(
+    const TissueBlockSpec& block, const Needle3d& needle, double depth, int many) {
+  Simulation3dOptions options = small_options();
+  options.depth = depth;
+  options.half_model = true;
+  options.steps = 2;
+  const Simulation3dResult coarse = simulate_3d(block, {needle}, options);
+  options.steps = many;
+  const Simulation3dResult fine = simulate_3d(block, {needle}, options);
+  EXPECT_EQ(coarse.steps.size(), 2U);
+  EXPECT_EQ(fine.steps.size(), static_cast<std::size_t>(many));
+  return {
+      {coarse.steps[0].needles[0], fine.steps[static_cast<std::size_t>(many / 2 - 1)].needles[0]},
+      {coarse.steps[1].needles[0], fine.steps.back().needles[0]}};
+}
+
 // Sticking contact captures nodes in the order the needle reaches them, so the output steps
 // only choose where the curve is sampled (docs/model.md, "Contact with the rigid needle
 // (sticking)"). The case that showed it: a stiff top layer (1 GPa, as skin's stratum corneum)
@@ -341,26 +359,15 @@ TEST(Indentation3d, BevelTipNodeCarriesForceFromTheStepThatCapturesIt) {
 TEST(Indentation3d, StickingForceDoesNotDependOnTheDepthStepsUnderAStiffTopLayer) {
   mneedle::fe::TissueBlockSpec block = small_skin();
   block.layers[0].material.E = 1e9;
-  const std::vector<Needle3d> needles{
-      {"bevel", bevel_needle(60e-6, std::numbers::pi / 6, 1e-3), 0.0, 0.0}};
-  Simulation3dOptions options = small_options();
-  options.depth = 60e-6;
-  options.half_model = true;
-  options.steps = 2;
-  const Simulation3dResult coarse = simulate_3d(block, needles, options);
-  options.steps = 6;
-  const Simulation3dResult fine = simulate_3d(block, needles, options);
-  ASSERT_EQ(coarse.steps.size(), 2U);
-  ASSERT_EQ(fine.steps.size(), 6U);
-  // The same depths, 30 and 60 um: the tip node is taken at first contact in both runs and
-  // nothing else is reached, so the same captures and the same condensed solve: 1e-6 is far above
-  // its round-off and far below the former 4-10 %.
-  for (std::size_t k = 0; k < 2; ++k) {
-    const NeedleStep3d& c = coarse.steps[k].needles[0];
-    const NeedleStep3d& f = fine.steps[3 * k + 2].needles[0];
-    ASSERT_GT(f.force_N, 0.0);
-    EXPECT_EQ(c.captured_nodes, f.captured_nodes) << "depth " << coarse.steps[k].depth_m;
-    EXPECT_NEAR(c.force_N / f.force_N, 1.0, 1e-6) << "depth " << coarse.steps[k].depth_m;
+  const auto pairs = two_steps_against_many(
+      block, {"bevel", bevel_needle(60e-6, std::numbers::pi / 6, 1e-3), 0.0, 0.0}, 60e-6, 6);
+  // The tip node is taken at first contact in both runs and nothing else is reached, so the same
+  // captures and the same condensed solve: 1e-6 is far above its round-off and far below the
+  // former 4-10 %.
+  for (const auto& [coarse, fine] : pairs) {
+    ASSERT_GT(fine.force_N, 0.0);
+    EXPECT_EQ(coarse.captured_nodes, fine.captured_nodes);
+    EXPECT_NEAR(coarse.force_N / fine.force_N, 1.0, 1e-6);
   }
 }
 
@@ -368,26 +375,16 @@ TEST(Indentation3d, StickingForceDoesNotDependOnTheDepthStepsUnderAStiffTopLayer
 // after ring of surface nodes as it goes down, most of them between output depths, so the
 // entry depths found by bisection decide the answer.
 TEST(Indentation3d, ConeCapturesInsideTheStepsAtTheDepthsTheyAreReached) {
-  const TissueBlockSpec block =
-      homogeneous_block(MaterialModel::Linear, 0.1e6, 0.45, 400e-6, 300e-6);
-  const std::vector<Needle3d> needles{
-      {"cone", cone_needle(std::numbers::pi / 3, 100e-6, 1e-3), 0.0, 0.0}};
-  Simulation3dOptions options = small_options();
-  options.depth = 120e-6;
-  options.half_model = true;
-  options.steps = 2;
-  const Simulation3dResult coarse = simulate_3d(block, needles, options);
-  options.steps = 12;
-  const Simulation3dResult fine = simulate_3d(block, needles, options);
-  ASSERT_GT(fine.steps.back().needles[0].captured_nodes, 3);
-  for (std::size_t k = 0; k < 2; ++k) {
-    const NeedleStep3d& c = coarse.steps[k].needles[0];
-    const NeedleStep3d& f = fine.steps[6 * k + 5].needles[0];
-    EXPECT_EQ(c.captured_nodes, f.captured_nodes) << "depth " << coarse.steps[k].depth_m;
+  const auto pairs = two_steps_against_many(
+      homogeneous_block(MaterialModel::Linear, 0.1e6, 0.45, 400e-6, 300e-6),
+      {"cone", cone_needle(std::numbers::pi / 3, 100e-6, 1e-3), 0.0, 0.0}, 120e-6, 12);
+  ASSERT_GT(pairs.back().second.captured_nodes, 3);
+  for (const auto& [coarse, fine] : pairs) {
+    EXPECT_EQ(coarse.captured_nodes, fine.captured_nodes);
     // Entry depths are bisected to 1e-5 of the radius: the forces agree to about that (measured
     // 8e-8). Captured at the steps' ends instead, 2 steps held 13 nodes at 60 um against 6 and
     // read +1.6 % at 120 um.
-    EXPECT_NEAR(c.force_N / f.force_N, 1.0, 1e-5) << "depth " << coarse.steps[k].depth_m;
+    EXPECT_NEAR(coarse.force_N / fine.force_N, 1.0, 1e-5);
   }
 }
 
