@@ -71,9 +71,20 @@ struct Sample {
   double crack_area = 0.0;
 };
 
+// The studies' grid, pinned (the tensor grid at growth 1.6, the standard level's grading until
+// 2026-12-05) so that a change of a fidelity level's defaults does not move them unseen; a study
+// that sweeps the grading passes its own.
+constexpr double kStudiesGrowth = 1.6;
+void pin_studies_grid(FidelityOverrides& overrides, int refinement_levels = 0,
+                      double growth = kStudiesGrowth) {
+  overrides.refinement_levels = refinement_levels;
+  overrides.growth = growth;
+}
+
 Sample simulate(const TissueBlockSpec& block, const Needle3d& needle, int order, double tip_size,
                 ContactMode contact, int steps, int through_top = 0, double crack_depth = 0.0,
-                double average_length = 0.0, int refinement_levels = 0, double growth = 1.6) {
+                double average_length = 0.0, int refinement_levels = 0,
+                double growth = kStudiesGrowth) {
   Simulation3dOptions options;
   options.depth = kDepth;
   options.contact = contact;
@@ -82,10 +93,7 @@ Sample simulate(const TissueBlockSpec& block, const Needle3d& needle, int order,
   options.overrides.tip_size_m = tip_size;
   options.overrides.steps = steps;
   if (through_top > 0) options.overrides.elements_through_top = through_top;
-  // The studies' grid is pinned (the tensor grid at growth 1.6, the standard level's grading until
-  // 2026-12-05) so that a change of a fidelity level's defaults does not move them unseen.
-  options.overrides.refinement_levels = refinement_levels;
-  options.overrides.growth = growth;
+  pin_studies_grid(options.overrides, refinement_levels, growth);
   options.crack_depth_m = crack_depth;
   options.stress_average_length_m = average_length;
   const double cpu_start = cpu_seconds();
@@ -251,6 +259,7 @@ void stress_study() {
       block.order = order;
       block.insertion_depth = kDepth;
       block.overrides.tip_size_m = tip;
+      pin_studies_grid(block.overrides);
       block.half_y = true;
       const double cpu_start = cpu_seconds();
       const TetMesh mesh = generate_tissue_mesh(block);
@@ -311,6 +320,7 @@ void held_contact_line(int order, double tip, double crack) {
   block.order = order;
   block.insertion_depth = kDepth;
   block.overrides.tip_size_m = tip;
+  pin_studies_grid(block.overrides);
   block.half_y = true;
   const double cpu_start = cpu_seconds();
   const TetMesh mesh = generate_tissue_mesh(block);

@@ -52,8 +52,8 @@ std::string micrometres(double metres) {
 constexpr int kMaxCaptureRounds = 60;
 // Captures in depth order (advance_linear): a node's entry depth is bisected to
 // kCaptureBisection x the needle's radius; the nodes entering within kCaptureGroup x the radius
-// after the first are captured with it (1.15 um for paper A's needles: 0.25 and 4 um gave the
-// same puncture depth to 0.1 um; docs/model.md, "Contact with the rigid needle (sticking)").
+// after the first are captured with it (1.15 um for paper A's needles; docs/model.md, "Contact
+// with the rigid needle (sticking)", has what the group length changed).
 constexpr double kCaptureBisection = 1e-5;
 constexpr double kCaptureGroup = 1e-2;
 constexpr int kMaxNewtonIterations = 40;

@@ -350,12 +350,12 @@ std::vector<std::pair<NeedleStep3d, NeedleStep3d>> two_steps_against_many(
 }
 
 // Sticking contact captures nodes in the order the needle reaches them, so the output steps
-// only choose where the curve is sampled (docs/model.md, "Contact with the rigid needle
-// (sticking)"). The case that showed it: a stiff top layer (1 GPa, as skin's stratum corneum)
-// under a bevel. Captured only at the ends of the steps, the 30 um first step took a second node
-// of the undeformed surface under the face, which six steps never take, and the force read 9.8 %
-// (30 um) and 4.4 % (60 um) low; in paper A's skin the force at 100 um read 56 % low at 20 um
-// steps.
+// only choose where the curve is sampled, to within the grouping length of 0.01 R
+// (docs/model.md, "Contact with the rigid needle (sticking)"). The case that showed it: a stiff
+// top layer (1 GPa, as skin's stratum corneum) under a bevel. Captured only at the ends of the
+// steps, the 30 um first step took a second node of the undeformed surface under the face, which
+// six steps never take, and the force read 9.8 % (30 um) and 4.4 % (60 um) low; in paper A's skin
+// the force at 100 um read 56 % low at 20 um steps.
 TEST(Indentation3d, StickingForceDoesNotDependOnTheDepthStepsUnderAStiffTopLayer) {
   mneedle::fe::TissueBlockSpec block = small_skin();
   block.layers[0].material.E = 1e9;
@@ -381,9 +381,10 @@ TEST(Indentation3d, ConeCapturesInsideTheStepsAtTheDepthsTheyAreReached) {
   ASSERT_GT(pairs.back().second.captured_nodes, 3);
   for (const auto& [coarse, fine] : pairs) {
     EXPECT_EQ(coarse.captured_nodes, fine.captured_nodes);
-    // Entry depths are bisected to 1e-5 of the radius: the forces agree to about that (measured
-    // 8e-8). Captured at the steps' ends instead, 2 steps held 13 nodes at 60 um against 6 and
-    // read +1.6 % at 120 um.
+    // Entry depths are bisected to 1e-5 of the radius and no capture group here straddles an
+    // output depth of the 12-step run (a group would put the runs up to 0.01 R apart): the
+    // forces agree to about the bisection length (measured 8e-8). Captured at the steps' ends
+    // instead, 2 steps held 13 nodes at 60 um against 6 and read +1.6 % at 120 um.
     EXPECT_NEAR(coarse.force_N / fine.force_N, 1.0, 1e-5);
   }
 }

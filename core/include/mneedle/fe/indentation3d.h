@@ -45,7 +45,9 @@ struct Step3d {
   double depth_m = 0.0;
   std::vector<NeedleStep3d> needles;
   double strain_energy_J = 0.0;
-  int newton_iterations = 0;  ///< linear solves of the step (when linear: 1, and 2 per capture)
+  /// Linear solves of the step: when linear, 1 and 2 per capture event (1 per capture round where
+  /// captures are taken at the step's end: a cracked twin, crack faces in contact).
+  int newton_iterations = 0;
   /// Crack faces (a run with set_crack_faces): the deepest one face has passed through
   /// the other at a node pair (m, >= 0; 0 when none or no crack) and the pairs in contact.
   double crack_face_overlap_m = 0.0;
@@ -92,9 +94,9 @@ struct InpExport {
 /// Repeated solves on one mesh: advance_to() a growing sequence of depths.
 /// Linear materials: the stiffness is factorised once; contact is solved on the captured
 /// surface nodes through their condensed compliance (columns of K⁻¹ computed as nodes are
-/// found inside a needle), capturing them in depth order. Nonlinear materials: Newton–Raphson with line search and adaptive depth steps, one
-/// symbolic analysis for the whole insertion. Errors: SolverError naming the depth and the cause.
-/// The run keeps its own copy of the mesh.
+/// found inside a needle), capturing them in depth order. Nonlinear materials: Newton–Raphson
+/// with line search and adaptive depth steps, one symbolic analysis for the whole insertion.
+/// Errors: SolverError naming the depth and the cause. The run keeps its own copy of the mesh.
 class Indentation3d {
  public:
   /// max_depth bounds the needle travel (m): it fixes the candidate contact nodes.
