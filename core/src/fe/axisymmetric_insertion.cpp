@@ -25,6 +25,25 @@ using namespace axi;
 
 namespace {
 
+// Largest outer radius of the needle's profile up to `height` above its tip (m), the profile
+// linear between its points.
+double outline_radius_up_to(const AxisymmetricNeedle& needle, double height) {
+  double r = 0.0;
+  for (std::size_t i = 0; i < needle.heights_m.size(); ++i) {
+    if (needle.heights_m[i] <= height) {
+      r = std::max(r, needle.radii_m[i]);
+      continue;
+    }
+    if (i > 0) {
+      const double h0 = needle.heights_m[i - 1], h1 = needle.heights_m[i];
+      const double t = (height - h0) / (h1 - h0);
+      r = std::max(r, needle.radii_m[i - 1] + t * (needle.radii_m[i] - needle.radii_m[i - 1]));
+    }
+    break;
+  }
+  return r;
+}
+
 // A captured surface node: where and at which depth the needle reached it (sticking contact).
 struct Capture {
   Eigen::Vector2d point;
@@ -880,9 +899,12 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
     }
     if (keep_field) {
       const Eigen::VectorXd u = intact->displacement();
+      // The stress criterion's probe searches the top layer within the needle's outline at
+      // this depth plus two averaging lengths (docs/model.md, "Criteria", stress).
       if (options.stress_average_length_m > 0.0)
-        step.tip_stress_Pa = model.averaged_max_principal_stress(
-            u, Eigen::Vector2d::Zero(), options.stress_average_length_m, 0);
+        step.tip_stress_Pa = model.peak_averaged_max_principal_stress(
+            u, outline_radius_up_to(needle, depth) + 2.0 * options.stress_average_length_m,
+            options.stress_average_length_m, 0);
       if (!options.vtu_directory.empty()) {
         const std::filesystem::path dir(options.vtu_directory);
         const std::string file = "step_" + std::to_string(k) + ".vtu",

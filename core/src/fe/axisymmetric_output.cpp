@@ -120,6 +120,60 @@ double AxisymmetricModel::averaged_max_principal_stress(const Eigen::VectorXd& u
   return volume > 0.0 ? weighted / volume : 0.0;
 }
 
+double AxisymmetricModel::peak_averaged_max_principal_stress(const Eigen::VectorXd& u,
+                                                             double search_radius_m,
+                                                             double length_m, int layer) const {
+  if (!(length_m > 0.0)) throw InputError("stress average: length must be > 0 m");
+  if (!(search_radius_m >= 0.0)) throw InputError("stress average: search radius must be >= 0 m");
+  const Impl& m = *impl_;
+  static const std::vector<Eigen::Vector2d> kSub = sub_centroids(4);
+  struct SubPoint {
+    Eigen::Vector2d x;
+    double weight, stress;
+  };
+  std::vector<SubPoint> points;
+  std::vector<char> centre(m.mesh.nodes.size(), 0);
+  const Material& material = m.materials[layer];
+  for (std::size_t e = 0; e < m.mesh.elements.size(); ++e) {
+    if (m.mesh.element_layer[e] != layer) continue;
+    const auto& nodes = m.mesh.elements[e];
+    double r_min = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) r_min = std::min(r_min, m.mesh.nodes[nodes[a]].x());
+    if (r_min > search_radius_m + length_m) continue;
+    for (const Eigen::Vector2d& c : kSub) {
+      const PointData p = point_data(m.mesh, nodes, c.x(), c.y(), 1.0 / kSub.size());
+      Eigen::Vector2d X = Eigen::Vector2d::Zero();
+      for (int a = 0; a < kNodes; ++a) X += p.N[a] * m.mesh.nodes[nodes[a]];
+      const Eigen::Matrix3d F = deformation_gradient(p, u, nodes);
+      points.push_back({X, p.w, max_principal(cauchy_stress(material, F, nullptr))});
+    }
+    for (std::uint32_t n : nodes)
+      if (m.mesh.nodes[n].x() <= search_radius_m) centre[n] = 1;
+  }
+  // Sub-points sorted by r: each centre scans the band |r - r_c| <= length_m.
+  std::sort(points.begin(), points.end(),
+            [](const SubPoint& a, const SubPoint& b) { return a.x.x() < b.x.x(); });
+  double best = 0.0;
+  bool found = false;
+  for (std::size_t n = 0; n < centre.size(); ++n) {
+    if (!centre[n]) continue;
+    const Eigen::Vector2d& c = m.mesh.nodes[n];
+    auto it = std::lower_bound(points.begin(), points.end(), c.x() - length_m,
+                               [](const SubPoint& p, double r) { return p.x.x() < r; });
+    double weighted = 0.0, volume = 0.0;
+    for (; it != points.end() && it->x.x() <= c.x() + length_m; ++it) {
+      if ((it->x - c).squaredNorm() > length_m * length_m) continue;
+      weighted += it->weight * it->stress;
+      volume += it->weight;
+    }
+    if (!(volume > 0.0)) continue;
+    const double mean = weighted / volume;
+    if (!found || mean > best) best = mean;
+    found = true;
+  }
+  return best;
+}
+
 VtuFile axi::needle_profile_vtu(const AxisymmetricNeedle& needle, double depth_m) {
   VtuFile f;
   f.points_m.emplace_back(0.0, 0.0, -depth_m);  // the tip on the axis

@@ -1479,15 +1479,31 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
     create_output_folder(options.vtu_directory, "--vtu");
     clear_step_files(options.vtu_directory);
   }
+  // The stress criterion's probe searches the top layer within the needle's outline at the
+  // tip's depth plus two averaging lengths (docs/model.md, "Criteria", stress).
+  std::optional<PeakStressProbe> stress_probe;
+  std::vector<NeedleShape> probe_shapes;
+  const double stress_length = options.stress_average_length_m;
+  const auto search_radii = [&](double depth) {
+    std::vector<double> radii;
+    for (const NeedleShape& shape : probe_shapes)
+      radii.push_back(shape.max_radius_up_to(depth) + 2.0 * stress_length);
+    return radii;
+  };
+  if (stress_length > 0.0) {
+    std::vector<Eigen::Vector2d> axes;
+    for (const Needle3d& needle : needles) {
+      probe_shapes.emplace_back(needle.mesh);
+      axes.emplace_back(needle.x, needle.y);
+    }
+    stress_probe.emplace(mesh, std::move(axes), search_radii(options.depth), stress_length, 0);
+  }
   for (int k = 1; k <= steps; ++k) {
     const double depth = options.depth * k / steps;
     Step3d step = run.advance_to(depth);
-    if (options.stress_average_length_m > 0.0) {
-      const Eigen::VectorXd u = run.displacement();
-      for (std::size_t n = 0; n < needles.size(); ++n)
-        step.needles[n].tip_stress_Pa = averaged_max_principal_stress(
-            mesh, u, Eigen::Vector3d(first_contact[n].x(), first_contact[n].y(), 0.0),
-            options.stress_average_length_m, 0);
+    if (stress_probe) {
+      const std::vector<double> peak = stress_probe->peak(run.displacement(), search_radii(depth));
+      for (std::size_t n = 0; n < needles.size(); ++n) step.needles[n].tip_stress_Pa = peak[n];
     }
     if (cracked_run) {
       const Step3d opened = cracked_run->advance_to(depth);

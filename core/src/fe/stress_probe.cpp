@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <unordered_map>
 #include <vector>
 
 #include "mneedle/base/error.h"
@@ -127,7 +128,187 @@ void integrate(const ElementField& field, const std::array<Barycentric, 4>& sub,
   sum->volume += volume;
 }
 
+// Material of `layer` as the solid model evaluates it: small strain only when every layer is
+// linear, and a linear layer in a nonlinear model is its St Venant-Kirchhoff extension.
+Material layer_material(const TetMesh& mesh, int layer, bool* all_linear) {
+  *all_linear = true;
+  for (const TissueLayer& l : mesh.layers)
+    *all_linear = *all_linear && l.material.model == MaterialModel::Linear;
+  MaterialParameters parameters = mesh.layers[static_cast<std::size_t>(layer)].material;
+  if (!*all_linear && parameters.model == MaterialModel::Linear)
+    parameters.model = MaterialModel::StVenantKirchhoff;
+  return Material(parameters);
+}
+
+// The element's field (corners, inverse Jacobian, displacement) at `u`.
+ElementField element_field(const TetMesh& mesh, const Eigen::VectorXd& u, std::size_t e,
+                           const Material& material, bool linear_kinematics) {
+  const auto& element = mesh.elements[e];
+  ElementField field;
+  for (int i = 0; i < 4; ++i)
+    field.corners[static_cast<std::size_t>(i)] = mesh.nodes[static_cast<std::size_t>(element[i])];
+  Eigen::Matrix3d jacobian;
+  for (int i = 0; i < 3; ++i) jacobian.col(i) = field.corners[i + 1] - field.corners[0];
+  field.inverse_jacobian = jacobian.inverse();  // dX/dL_i = X_i - X_0 for L1..L3
+  const int n = mesh.nodes_per_element();
+  field.displacement.resize(n, 3);
+  for (int a = 0; a < n; ++a)
+    field.displacement.row(a) =
+        u.segment<3>(3 * static_cast<Eigen::Index>(element[static_cast<std::size_t>(a)]))
+            .transpose();
+  field.material = &material;
+  field.linear_kinematics = linear_kinematics;
+  return field;
+}
+
+// Barycentric centroids of the 8^levels equal sub-tetrahedra of the reference element (the
+// eight-way split halves every edge; its children have equal volume).
+std::vector<Barycentric> sub_centroids(int levels) {
+  std::vector<std::array<Barycentric, 4>> pieces = {{Barycentric(1, 0, 0, 0),
+                                                     Barycentric(0, 1, 0, 0),
+                                                     Barycentric(0, 0, 1, 0),
+                                                     Barycentric(0, 0, 0, 1)}};
+  for (int level = 0; level < levels; ++level) {
+    std::vector<std::array<Barycentric, 4>> next;
+    for (const auto& sub : pieces) {
+      const auto m = [&](int a, int b) { return Barycentric(0.5 * (sub[a] + sub[b])); };
+      const Barycentric m01 = m(0, 1), m02 = m(0, 2), m03 = m(0, 3), m12 = m(1, 2), m13 = m(1, 3),
+                        m23 = m(2, 3);
+      next.insert(next.end(), {{sub[0], m01, m02, m03},
+                               {m01, sub[1], m12, m13},
+                               {m02, m12, sub[2], m23},
+                               {m03, m13, m23, sub[3]},
+                               {m01, m02, m03, m13},
+                               {m01, m02, m12, m13},
+                               {m02, m03, m13, m23},
+                               {m02, m12, m13, m23}});
+    }
+    pieces = std::move(next);
+  }
+  std::vector<Barycentric> out;
+  for (const auto& sub : pieces) out.push_back(0.25 * (sub[0] + sub[1] + sub[2] + sub[3]));
+  return out;
+}
+
+const std::vector<Barycentric>& probe_subdivision() {
+  static const std::vector<Barycentric> centroids = sub_centroids(2);
+  return centroids;
+}
+
+using Cell = std::array<long long, 3>;
+
+Cell cell_of(const Eigen::Vector3d& x, double size) {
+  return {static_cast<long long>(std::floor(x.x() / size)),
+          static_cast<long long>(std::floor(x.y() / size)),
+          static_cast<long long>(std::floor(x.z() / size))};
+}
+
+// 21 bits per axis, offset to be non-negative: a block spans far fewer than 2^20 averaging
+// lengths (the scene's checks bound both).
+long long cell_key(const Cell& c) {
+  constexpr long long kOffset = 1LL << 20, kMask = (1LL << 21) - 1;
+  return (((c[0] + kOffset) & kMask) << 42) | (((c[1] + kOffset) & kMask) << 21) |
+         ((c[2] + kOffset) & kMask);
+}
+
 }  // namespace
+
+PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2d> sites_xy,
+                                 std::vector<double> search_radius_m, double length_m, int layer)
+    : mesh_(&mesh), length_(length_m), layer_(layer), site_count_(sites_xy.size()) {
+  if (!(length_m > 0.0) || !std::isfinite(length_m))
+    throw InputError("stress probe: averaging length must be positive and finite");
+  if (layer < 0 || layer >= static_cast<int>(mesh.layers.size()))
+    throw InputError("stress probe: layer index out of range");
+  if (search_radius_m.size() != sites_xy.size())
+    throw InputError("stress probe: one search radius per site");
+  for (double r : search_radius_m)
+    if (!(r >= 0.0) || !std::isfinite(r))
+      throw InputError("stress probe: search radius must be >= 0 and finite");
+  const std::vector<Barycentric>& subs = probe_subdivision();
+  std::vector<char> candidate_node(mesh.nodes.size(), 0);
+  const int n = mesh.nodes_per_element();
+  for (std::size_t e = 0; e < mesh.elements.size(); ++e) {
+    if (mesh.element_layer[e] != layer) continue;
+    const auto& element = mesh.elements[e];
+    std::array<Eigen::Vector3d, 4> corners;
+    for (int i = 0; i < 4; ++i)
+      corners[static_cast<std::size_t>(i)] = mesh.nodes[static_cast<std::size_t>(element[i])];
+    const Eigen::Vector3d mid = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+    double reach = 0.0;
+    for (const auto& q : corners) reach = std::max(reach, (q - mid).norm());
+    bool near = false;
+    for (std::size_t s = 0; s < sites_xy.size(); ++s)
+      near = near ||
+             (mid.head<2>() - sites_xy[s]).norm() - reach <= search_radius_m[s] + length_m;
+    if (!near) continue;
+    elements_.push_back(static_cast<int>(e));
+    const double volume = tet_volume(corners) / static_cast<double>(subs.size());
+    for (std::size_t k = 0; k < subs.size(); ++k) {
+      const Barycentric& l = subs[k];
+      const Eigen::Vector3d x =
+          l(0) * corners[0] + l(1) * corners[1] + l(2) * corners[2] + l(3) * corners[3];
+      points_.push_back({x, volume, static_cast<int>(e), static_cast<int>(k)});
+    }
+    for (int a = 0; a < n; ++a) candidate_node[static_cast<std::size_t>(element[a])] = 1;
+  }
+  for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
+    if (!candidate_node[i]) continue;
+    for (std::size_t s = 0; s < sites_xy.size(); ++s)
+      if ((mesh.nodes[i].head<2>() - sites_xy[s]).norm() <= search_radius_m[s])
+        candidates_.push_back({mesh.nodes[i], static_cast<int>(s),
+                               (mesh.nodes[i].head<2>() - sites_xy[s]).norm()});
+  }
+  for (std::size_t i = 0; i < points_.size(); ++i)
+    buckets_[cell_key(cell_of(points_[i].x, length_m))].push_back(static_cast<int>(i));
+}
+
+std::vector<double> PeakStressProbe::peak(const Eigen::VectorXd& u,
+                                          const std::vector<double>& search_radius_m) const {
+  const TetMesh& mesh = *mesh_;
+  if (u.size() != 3 * static_cast<Eigen::Index>(mesh.nodes.size()))
+    throw InputError("stress probe: displacement size does not match the mesh");
+  if (search_radius_m.size() != site_count_)
+    throw InputError("stress probe: one search radius per site");
+  bool all_linear = true;
+  const Material material = layer_material(mesh, layer_, &all_linear);
+  const std::vector<Barycentric>& subs = probe_subdivision();
+  // The stress at every sub-point, element by element (points_ is grouped by element).
+  std::vector<double> stress(points_.size(), 0.0);
+  std::size_t i = 0;
+  for (int e : elements_) {
+    const ElementField field =
+        element_field(mesh, u, static_cast<std::size_t>(e), material, all_linear);
+    for (; i < points_.size() && points_[i].element == e; ++i)
+      stress[i] = field.max_principal(subs[static_cast<std::size_t>(points_[i].sub)]);
+  }
+  std::vector<double> best(site_count_, 0.0);
+  std::vector<char> found(site_count_, 0);
+  const double reach2 = length_ * length_;
+  for (const Candidate& c : candidates_) {
+    if (c.distance > search_radius_m[static_cast<std::size_t>(c.site)]) continue;
+    double stress_volume = 0.0, volume = 0.0;
+    const Cell home = cell_of(c.x, length_);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto bucket = buckets_.find(cell_key({home[0] + dx, home[1] + dy, home[2] + dz}));
+          if (bucket == buckets_.end()) continue;
+          for (int p : bucket->second) {
+            const SubPoint& q = points_[static_cast<std::size_t>(p)];
+            if ((q.x - c.x).squaredNorm() > reach2) continue;
+            stress_volume += q.volume * stress[static_cast<std::size_t>(p)];
+            volume += q.volume;
+          }
+        }
+    if (!(volume > 0.0)) continue;
+    const double mean = stress_volume / volume;
+    const auto s = static_cast<std::size_t>(c.site);
+    if (!found[s] || mean > best[s]) best[s] = mean;
+    found[s] = 1;
+  }
+  return best;
+}
 
 double averaged_max_principal_stress(const TetMesh& mesh, const Eigen::VectorXd& u,
                                      const Eigen::Vector3d& point_m, double length_m, int layer) {
@@ -137,43 +318,23 @@ double averaged_max_principal_stress(const TetMesh& mesh, const Eigen::VectorXd&
     throw InputError("stress probe: layer index out of range");
   if (u.size() != 3 * static_cast<Eigen::Index>(mesh.nodes.size()))
     throw InputError("stress probe: displacement size does not match the mesh");
-  // Same kinematics as the solid model: small strain only when every layer is linear, and a
-  // linear layer in a nonlinear model is its St Venant-Kirchhoff extension.
   bool all_linear = true;
-  for (const TissueLayer& l : mesh.layers)
-    all_linear = all_linear && l.material.model == MaterialModel::Linear;
-  MaterialParameters parameters = mesh.layers[static_cast<std::size_t>(layer)].material;
-  if (!all_linear && parameters.model == MaterialModel::Linear)
-    parameters.model = MaterialModel::StVenantKirchhoff;
-  const Material material(parameters);
-
-  const int n = mesh.nodes_per_element();
+  const Material material = layer_material(mesh, layer, &all_linear);
   const std::array<Barycentric, 4> whole = {Barycentric(1, 0, 0, 0), Barycentric(0, 1, 0, 0),
                                             Barycentric(0, 0, 1, 0), Barycentric(0, 0, 0, 1)};
   Accumulator sum;
   for (std::size_t e = 0; e < mesh.elements.size(); ++e) {
     if (mesh.element_layer[e] != layer) continue;
     const auto& element = mesh.elements[e];
-    ElementField field;
-    for (int i = 0; i < 4; ++i)
-      field.corners[static_cast<std::size_t>(i)] = mesh.nodes[static_cast<std::size_t>(element[i])];
     // Cheap rejection before any per-element work.
-    const Eigen::Vector3d mid =
-        0.25 * (field.corners[0] + field.corners[1] + field.corners[2] + field.corners[3]);
+    std::array<Eigen::Vector3d, 4> corners;
+    for (int i = 0; i < 4; ++i)
+      corners[static_cast<std::size_t>(i)] = mesh.nodes[static_cast<std::size_t>(element[i])];
+    const Eigen::Vector3d mid = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
     double reach = 0.0;
-    for (const auto& q : field.corners) reach = std::max(reach, (q - mid).norm());
+    for (const auto& q : corners) reach = std::max(reach, (q - mid).norm());
     if ((mid - point_m).norm() - reach > length_m) continue;
-    Eigen::Matrix3d jacobian;
-    for (int i = 0; i < 3; ++i) jacobian.col(i) = field.corners[i + 1] - field.corners[0];
-    field.inverse_jacobian = jacobian.inverse();  // dX/dL_i = X_i - X_0 for L1..L3
-    field.displacement.resize(n, 3);
-    for (int a = 0; a < n; ++a)
-      field.displacement.row(a) =
-          u.segment<3>(3 * static_cast<Eigen::Index>(element[static_cast<std::size_t>(a)]))
-              .transpose();
-    field.material = &material;
-    field.linear_kinematics = all_linear;
-    integrate(field, whole, point_m, length_m, 0, &sum);
+    integrate(element_field(mesh, u, e, material, all_linear), whole, point_m, length_m, 0, &sum);
   }
   return sum.volume > 0.0 ? sum.stress_volume / sum.volume : 0.0;
 }

@@ -138,6 +138,13 @@ class AxisymmetricModel {
   /// Returns 0 when no part of the layer is within reach.
   double averaged_max_principal_stress(const Eigen::VectorXd& u, const Eigen::Vector2d& point_m,
                                        double length_m, int layer) const;
+  /// The stress criterion's measure (docs/model.md, "Criteria", stress): the largest, over
+  /// centres at the nodes of `layer` with r <= search_radius_m, of the mean above (the volume
+  /// method of the theory of critical distances). Each element within reach is split into 16
+  /// equal sub-triangles carrying the stress at their centroids; a sub-triangle belongs to a
+  /// centre's reach when its centroid does. Returns 0 when no centre is within reach.
+  double peak_averaged_max_principal_stress(const Eigen::VectorXd& u, double search_radius_m,
+                                            double length_m, int layer) const;
   /// Binary VTU (ParaView): the (r, z) mesh as quadratic triangles in the plane y = 0 (x = r,
   /// z = z), point data displacement_m (u_r, 0, u_z), cell data von_mises_Pa,
   /// principal_stress_Pa (largest first, σ_θθ among them), energy_density_J_per_m3 and layer;

@@ -4,6 +4,8 @@
 // pointwise stress is singular.
 
 #include <Eigen/Core>
+#include <unordered_map>
+#include <vector>
 
 #include "mneedle/fe/tissue_mesh.h"
 
@@ -14,5 +16,50 @@ namespace mneedle::fe {
 /// m). Returns 0 when no part of the layer is within reach.
 double averaged_max_principal_stress(const TetMesh& mesh, const Eigen::VectorXd& u,
                                      const Eigen::Vector3d& point_m, double length_m, int layer);
+
+/// The stress criterion's measure (docs/model.md, "Criteria", stress): per site, the largest
+/// over centres of the layer's maximum principal stress averaged over the part of `layer` within
+/// `length_m` of the centre (the volume method of the theory of critical distances). The centres
+/// are the layer's nodes within a search radius (horizontal distance) of the site, so the probe
+/// finds the tensile peak wherever the layer has it (under a point load on a stiff layer, its
+/// underside), not only at one chosen point. Built once per mesh for the largest search radius
+/// of each site; peak() per displacement, with the radii of that moment.
+/// Each element near a site is split into 64 equal sub-tetrahedra, each carrying the stress at
+/// its centroid; a sub-tetrahedron belongs to a ball when its centroid does (docs/model.md says
+/// what that costs in accuracy).
+class PeakStressProbe {
+ public:
+  /// `sites_xy` (m, reference) with the largest search radius of each. Throws InputError on a
+  /// bad length, radius or layer.
+  PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2d> sites_xy,
+                  std::vector<double> search_radius_m, double length_m, int layer);
+
+  /// Per site: the peak averaged maximum principal stress (Pa) at nodal displacement `u`
+  /// (3 per node, m) over the centres within `search_radius_m` of it (each at most the
+  /// constructor's); 0 where no centre lies within reach.
+  std::vector<double> peak(const Eigen::VectorXd& u, const std::vector<double>& search_radius_m) const;
+
+ private:
+  struct SubPoint {
+    Eigen::Vector3d x;  // reference position of the sub-tetrahedron's centroid
+    double volume;
+    int element;
+    int sub;  // index into the subdivision's centroids
+  };
+  struct Candidate {
+    Eigen::Vector3d x;
+    int site;
+    double distance;  // horizontal, to the site
+  };
+  const TetMesh* mesh_;
+  double length_;
+  int layer_;
+  std::size_t site_count_;
+  std::vector<int> elements_;  // the layer's elements within reach of a site
+  std::vector<SubPoint> points_;
+  std::vector<Candidate> candidates_;
+  // Sub-points bucketed on a grid of cell size length_m: cell key -> point indices.
+  std::unordered_map<long long, std::vector<int>> buckets_;
+};
 
 }  // namespace mneedle::fe
