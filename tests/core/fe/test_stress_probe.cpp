@@ -160,9 +160,9 @@ TEST_P(StressProbeOrder, PeakOfAUniformStressIsThatStress) {
 // sigma_xx = E k x (nu = 0, u_x = k x^2 / 2): the peak sits at the centre farthest along +x within
 // the search radius, and its value is about E k x there. The mean over the sub-tetrahedra whose
 // centroids fall within the ball is not exactly the centre value: the set is not symmetric about
-// the centre. Its offset is at most a sub-tetrahedron's reach (a quarter of an element, here
-// <= 25 um) against the ball's 100 um, so within 10 % of the value at a centre 0.25 mm out, and
-// the peak must grow with the search radius and stay below E k (x_max + reach).
+// the centre. Measured 0.3-0.6 % at the three radii; 2 % allowed, the offset of a set whose edge
+// is ragged by a quarter element (here up to 25 um) against the ball's 100 um. The peak must
+// also grow with the search radius.
 TEST(StressProbe, PeakFindsTheLargestMeanWithinTheSearchRadius) {
   const double E = 1e6, k = 2.0, length = 0.1e-3;
   const TetMesh mesh = two_layer_block(2, 0.0);
@@ -181,7 +181,7 @@ TEST(StressProbe, PeakFindsTheLargestMeanWithinTheSearchRadius) {
       }
     }
     const double peak = probe.peak(u, {radius})[0];
-    EXPECT_NEAR(peak, E * k * farthest, 0.1 * E * k * farthest) << "radius " << radius;
+    EXPECT_NEAR(peak, E * k * farthest, 0.02 * E * k * farthest) << "radius " << radius;
     EXPECT_GT(peak, previous);
     previous = peak;
   }
