@@ -22,7 +22,9 @@ using mneedle::test::mneedle_binary;
 using mneedle::test::run_mneedle;
 
 const std::string kRoot = MNEEDLE_SOURCE_ROOT;
-const std::string kSkin = kRoot + "/designs/scenes/human_skin.toml";
+// The skin scene with the pressure criterion: these runs use the closed-form pre-puncture model,
+// which has no stress field for the scene's own stress criterion.
+const std::string kSkin = mneedle::test::skin_scene_with_criterion("pressure");
 // Homogeneous silicone where the sharp bevel's F / A_sec rises with depth: the pressure criterion
 // fires at a resolved depth (in skin it fires at first contact or not at all).
 const std::string kSilicone = kRoot + "/designs/scenes/optimize_silicone.toml";

@@ -164,10 +164,9 @@ ElementField element_field(const TetMesh& mesh, const Eigen::VectorXd& u, std::s
 // Barycentric centroids of the 8^levels equal sub-tetrahedra of the reference element (the
 // eight-way split halves every edge; its children have equal volume).
 std::vector<Barycentric> sub_centroids(int levels) {
-  std::vector<std::array<Barycentric, 4>> pieces = {{Barycentric(1, 0, 0, 0),
-                                                     Barycentric(0, 1, 0, 0),
-                                                     Barycentric(0, 0, 1, 0),
-                                                     Barycentric(0, 0, 0, 1)}};
+  std::vector<std::array<Barycentric, 4>> pieces = {
+      {Barycentric(1, 0, 0, 0), Barycentric(0, 1, 0, 0), Barycentric(0, 0, 1, 0),
+       Barycentric(0, 0, 0, 1)}};
   for (int level = 0; level < levels; ++level) {
     std::vector<std::array<Barycentric, 4>> next;
     for (const auto& sub : pieces) {
@@ -239,8 +238,7 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
     for (const auto& q : corners) reach = std::max(reach, (q - mid).norm());
     bool near = false;
     for (std::size_t s = 0; s < sites_xy.size(); ++s)
-      near = near ||
-             (mid.head<2>() - sites_xy[s]).norm() - reach <= search_radius_m[s] + length_m;
+      near = near || (mid.head<2>() - sites_xy[s]).norm() - reach <= search_radius_m[s] + length_m;
     if (!near) continue;
     elements_.push_back(static_cast<int>(e));
     const double volume = tet_volume(corners) / static_cast<double>(subs.size());
@@ -256,8 +254,8 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
     if (!candidate_node[i]) continue;
     for (std::size_t s = 0; s < sites_xy.size(); ++s)
       if ((mesh.nodes[i].head<2>() - sites_xy[s]).norm() <= search_radius_m[s])
-        candidates_.push_back({mesh.nodes[i], static_cast<int>(s),
-                               (mesh.nodes[i].head<2>() - sites_xy[s]).norm()});
+        candidates_.push_back(
+            {mesh.nodes[i], static_cast<int>(s), (mesh.nodes[i].head<2>() - sites_xy[s]).norm()});
   }
   for (std::size_t i = 0; i < points_.size(); ++i)
     buckets_[cell_key(cell_of(points_[i].x, length_m))].push_back(static_cast<int>(i));

@@ -217,12 +217,10 @@ TEST(AxisymmetricPeakStress, PeakIsTheLargestCentreMeanWithinTheRadius) {
     if (mesh.element_layer[e] != 0) continue;
     for (std::uint32_t n : mesh.elements[e])
       if (mesh.nodes[n].x() <= radius)
-        largest = std::max(largest,
-                           fe.averaged_max_principal_stress(u, mesh.nodes[n], length, 0));
+        largest = std::max(largest, fe.averaged_max_principal_stress(u, mesh.nodes[n], length, 0));
   }
   ASSERT_GT(largest, 0.0);
-  EXPECT_NEAR(fe.peak_averaged_max_principal_stress(u, radius, length, 0), largest,
-              0.02 * largest);
+  EXPECT_NEAR(fe.peak_averaged_max_principal_stress(u, radius, length, 0), largest, 0.02 * largest);
 }
 
 // A cone on paper A's stiff stratum corneum: the bent plate's averaged stress is tensile and

@@ -149,8 +149,8 @@ TEST_P(StressProbeOrder, PeakOfAUniformStressIsThatStress) {
       interpolate(mesh, [&](const Eigen::Vector3d& x) { return Eigen::Vector3d(gradient * x); });
   const Eigen::Matrix3d strain = 0.5 * (gradient + gradient.transpose());
   const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
-  const double expected = max_principal(lambda * strain.trace() * Eigen::Matrix3d::Identity() +
-                                        2 * mu * strain);
+  const double expected =
+      max_principal(lambda * strain.trace() * Eigen::Matrix3d::Identity() + 2 * mu * strain);
   const PeakStressProbe probe(mesh, {{0.0, 0.0}}, {0.1e-3}, 0.05e-3, 0);
   const std::vector<double> peak = probe.peak(u, {0.1e-3});
   ASSERT_EQ(peak.size(), 1u);
@@ -208,8 +208,8 @@ TEST(StressProbe, PeakUnderAPointLoadOnAStiffLayerIsATensionProportionalToTheLoa
   EXPECT_GT(peak, 0.0);
   // The plate's bending stress under a point load grows with the load: the peak per newton is
   // the same at both steps to the linear model's round-off (the captured set is one node).
-  const double first = result.steps.front().needles[0].tip_stress_Pa /
-                       result.steps.front().needles[0].force_N;
+  const double first =
+      result.steps.front().needles[0].tip_stress_Pa / result.steps.front().needles[0].force_N;
   EXPECT_NEAR(peak / force, first, 1e-6 * first);
 }
 

@@ -37,7 +37,8 @@ class PeakStressProbe {
   /// Per site: the peak averaged maximum principal stress (Pa) at nodal displacement `u`
   /// (3 per node, m) over the centres within `search_radius_m` of it (each at most the
   /// constructor's); 0 where no centre lies within reach.
-  std::vector<double> peak(const Eigen::VectorXd& u, const std::vector<double>& search_radius_m) const;
+  std::vector<double> peak(const Eigen::VectorXd& u,
+                           const std::vector<double>& search_radius_m) const;
 
  private:
   struct SubPoint {
