@@ -228,11 +228,37 @@ std::vector<std::string> penetration_warnings(const InsertionRun& run, const Sce
   return out;
 }
 
+// The stress probe averages over balls of radius L centred at the top layer's nodes; where L is
+// far below the elements no sub-point falls in any ball and the measure reads 0 at every step,
+// so the criterion can never fire (docs/model.md, "Criteria", stress).
+std::vector<std::string> stress_warnings(const InsertionRun& run, const Scene& scene) {
+  std::vector<std::string> out;
+  if (run.criterion != PunctureCriterion::Stress || scene.tissue.layers.empty()) return out;
+  const TissueLayer& top = scene.tissue.layers.front();
+  for (const NeedleRun& n : run.needles) {
+    bool loaded = false, read = false;
+    for (const RunPoint& p : n.curve) {
+      if (p.stage != Stage::Pre) continue;
+      loaded = loaded || p.force_N > 0.0;
+      read = read || p.tip_stress_Pa != 0.0;
+    }
+    if (loaded && !read)
+      out.push_back(scene.source_name + ": tissue.layers[0] '" + top.name +
+                    "': the averaged stress read 0 at every step under needle '" + n.name +
+                    "': its strength_length (" +
+                    format_quantity(top.strength ? top.strength->length : 0.0, Dimension::Length) +
+                    ") is far below the mesh's elements, so the stress criterion cannot fire "
+                    "(docs/model.md, \"Criteria\", stress)");
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<std::string> criterion_warnings(const InsertionRun& run, const Scene& scene) {
   std::vector<std::string> out = penetration_warnings(run, scene);
   for (std::string& w : energy_warnings(run, scene)) out.push_back(std::move(w));
+  for (std::string& w : stress_warnings(run, scene)) out.push_back(std::move(w));
   return out;
 }
 

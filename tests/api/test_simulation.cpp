@@ -130,5 +130,34 @@ TEST(Simulation, OverlappingCrackFacesAreOneWarningNamingTheNeedle) {
   EXPECT_TRUE(criterion_warnings(run, scene).empty());
 }
 
+// A stress probe that read 0 at every loaded step (its strength length below the mesh: the
+// silicone scenes' 0.15 um) is one warning naming the scene, the layer and the length; one
+// nonzero reading, or no load at all, says nothing.
+TEST(Simulation, StressThatReadZeroUnderLoadIsOneWarningNamingTheLength) {
+  Scene scene;
+  scene.source_name = "phantom.toml";
+  TissueLayer top;
+  top.name = "silicone";
+  top.strength = LayerStrength{3.3e6, 0.15e-6};
+  scene.tissue.layers.push_back(top);
+  InsertionRun run;
+  run.criterion = PunctureCriterion::Stress;
+  NeedleRun needle;
+  needle.name = "cylinder";
+  RunPoint point;
+  point.stage = Stage::Pre;
+  needle.curve.push_back(point);  // no load yet
+  run.needles.push_back(needle);
+  EXPECT_TRUE(criterion_warnings(run, scene).empty());
+  run.needles[0].curve[0].force_N = 1e-3;
+  const std::vector<std::string> warnings = criterion_warnings(run, scene);
+  ASSERT_EQ(warnings.size(), 1u);
+  for (const char* part : {"phantom.toml", "'silicone'", "'cylinder'", "150 nm"})
+    EXPECT_NE(warnings[0].find(part), std::string::npos) << warnings[0];
+  EXPECT_EQ(warnings[0].find('\n'), std::string::npos);
+  run.needles[0].curve[0].tip_stress_Pa = 1.0;
+  EXPECT_TRUE(criterion_warnings(run, scene).empty());
+}
+
 }  // namespace
 }  // namespace mneedle
