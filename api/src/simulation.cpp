@@ -73,6 +73,7 @@ nlohmann::json seconds_by_stage_json(const RunSeconds& t) {
           {"assembly_s", t.assembly_s},
           {"factorization_s", t.factorization_s},
           {"contact_s", t.contact_s},
+          {"stress_s", t.stress_s},
           {"factorizations", t.factorizations},
           {"fe_runs", t.fe_runs}};
 }

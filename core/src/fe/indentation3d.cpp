@@ -98,7 +98,12 @@ struct Indentation3d::Impl {
   struct CachedColumns {
     Eigen::Matrix<double, Eigen::Dynamic, 3> surface;  // surface rows (candidates, then ring)
     Eigen::Matrix<double, Eigen::Dynamic, 3> gaps;     // crack-face pairs' gaps
+    Eigen::Matrix<double, Eigen::Dynamic, 3> watched;  // watched nodes' rows
   };
+  // Nodes whose displacement is read every step, and their rows of the captured nodes' columns
+  // (watch_nodes): u there is watched_compliance * multipliers on the linear sticking path.
+  std::vector<int> watched;
+  Eigen::MatrixXd watched_compliance;
   std::unordered_map<int, CachedColumns> column_cache;
   // The smallest needle radius up to the final depth: the length scale of the capture search.
   double capture_radius = std::numeric_limits<double>::infinity();
@@ -296,6 +301,10 @@ struct Indentation3d::Impl {
     const Eigen::MatrixXd columns = solver.solve_many(unit);
     for (std::size_t i = 0; i < missing.size(); ++i) {
       CachedColumns& cached = column_cache[missing[i]];
+      cached.watched.resize(3 * static_cast<Eigen::Index>(watched.size()), 3);
+      for (std::size_t w = 0; w < watched.size(); ++w)
+        cached.watched.middleRows<3>(3 * static_cast<Eigen::Index>(w)) =
+            columns.block<3, 3>(3 * watched[w], 3 * static_cast<Eigen::Index>(i));
       cached.surface.resize(surface_rows(), 3);
       for (std::size_t c = 0; c < candidates.size() + ring.size(); ++c) {
         const int node = c < candidates.size() ? candidates[c] : ring[c - candidates.size()];
@@ -316,6 +325,8 @@ struct Indentation3d::Impl {
     const Eigen::Index old_columns = compliance.cols();
     const auto added = 3 * static_cast<Eigen::Index>(found.size());
     compliance.conservativeResize(surface_rows(), old_columns + added);
+    watched_compliance.conservativeResize(3 * static_cast<Eigen::Index>(watched.size()),
+                                          old_columns + added);
     if (crack_contact())
       capture_gaps.conservativeResize(static_cast<Eigen::Index>(pairs.size()), old_columns + added);
     for (std::size_t i = 0; i < found.size(); ++i) {
@@ -323,6 +334,7 @@ struct Indentation3d::Impl {
       assert(it != column_cache.end() && "a node captured twice in one call");
       const Eigen::Index at = old_columns + 3 * static_cast<Eigen::Index>(i);
       compliance.middleCols<3>(at) = it->second.surface;
+      watched_compliance.middleCols<3>(at) = it->second.watched;
       if (crack_contact()) capture_gaps.middleCols<3>(at) = it->second.gaps;
       column_cache.erase(it);
     }
@@ -1304,6 +1316,33 @@ Eigen::VectorXd Indentation3d::displacement() const {
   return impl_->field();
 }
 
+void Indentation3d::watch_nodes(std::vector<int> nodes) {
+  if (impl_->depth > 0.0 || impl_->compliance.cols() > 0 || !impl_->column_cache.empty())
+    throw InputError("3-D indentation: watched nodes must be set before the first depth");
+  for (int node : nodes)
+    if (node < 0 || static_cast<std::size_t>(node) >= impl_->mesh.nodes.size())
+      throw InputError("3-D indentation: watched node out of range");
+  impl_->watched = std::move(nodes);
+}
+
+Eigen::VectorXd Indentation3d::watched_displacement() const {
+  const Impl& m = *impl_;
+  const auto rows = 3 * static_cast<Eigen::Index>(m.watched.size());
+  // The kept rows hold the captured nodes' columns only: crack-face loads, frictionless contact
+  // and the nonlinear path read the whole field.
+  if (m.model.is_linear() && !m.frictionless() && m.active_pairs.empty() &&
+      m.watched_compliance.rows() == rows &&
+      m.watched_compliance.cols() == 3 * static_cast<Eigen::Index>(m.captured.size())) {
+    if (m.captured.empty()) return Eigen::VectorXd::Zero(rows);
+    return m.watched_compliance * m.multipliers;
+  }
+  const Eigen::VectorXd u = m.field();
+  Eigen::VectorXd out(rows);
+  for (std::size_t w = 0; w < m.watched.size(); ++w)
+    out.segment<3>(3 * static_cast<Eigen::Index>(w)) = u.segment<3>(3 * m.watched[w]);
+  return out;
+}
+
 const Timing3d& Indentation3d::timing() const {
   return impl_->timing;
 }
@@ -1482,6 +1521,7 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   // The stress criterion's probe searches the top layer within the needle's outline at the
   // tip's depth plus two averaging lengths (docs/model.md, "Criteria", stress).
   std::optional<PeakStressProbe> stress_probe;
+  double stress_seconds = 0.0;
   std::vector<NeedleShape> probe_shapes;
   const double stress_length = options.stress_average_length_m;
   const auto search_radii = [&](double depth) {
@@ -1497,13 +1537,23 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
       axes.emplace_back(needle.x, needle.y);
     }
     stress_probe.emplace(mesh, std::move(axes), search_radii(options.depth), stress_length, 0);
+    // The probe reads a few hundred nodes: their rows of the compliance columns are kept, so no
+    // step solves for the whole field (docs/performance.md, "The stress criterion's cost").
+    run.watch_nodes(stress_probe->nodes());
   }
   for (int k = 1; k <= steps; ++k) {
     const double depth = options.depth * k / steps;
     Step3d step = run.advance_to(depth);
     if (stress_probe) {
-      const std::vector<double> peak = stress_probe->peak(run.displacement(), search_radii(depth));
+      const auto probe_start = Clock::now();
+      const Eigen::VectorXd watched = run.watched_displacement();
+      Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(mesh.nodes.size()));
+      const std::vector<int>& probed = stress_probe->nodes();
+      for (std::size_t w = 0; w < probed.size(); ++w)
+        u.segment<3>(3 * probed[w]) = watched.segment<3>(3 * static_cast<Eigen::Index>(w));
+      const std::vector<double> peak = stress_probe->peak(u, search_radii(depth));
       for (std::size_t n = 0; n < needles.size(); ++n) step.needles[n].tip_stress_Pa = peak[n];
+      stress_seconds += seconds_since(probe_start);
     }
     if (cracked_run) {
       const Step3d opened = cracked_run->advance_to(depth);
@@ -1535,6 +1585,7 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   }
   result.timing = run.timing();
   result.timing.meshing_s = meshing;
+  result.timing.stress_s = stress_seconds;
   result.timing.total_s = seconds_since(start);
   result.solver_backend = run.solver_backend();
   return result;

@@ -53,17 +53,20 @@ struct ElementField {
     return l(0) * corners[0] + l(1) * corners[1] + l(2) * corners[2] + l(3) * corners[3];
   }
 
-  // Largest eigenvalue of the Cauchy stress; the linear law's stress is already Cauchy.
-  double max_principal(const Barycentric& l) const {
+  // The Cauchy stress; the linear law's stress is already Cauchy.
+  Eigen::Matrix3d cauchy(const Barycentric& l) const {
     const Eigen::MatrixXd g =
         shape_gradients(static_cast<int>(displacement.rows()), l, inverse_jacobian);
     const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + displacement.transpose() * g;
     if (!linear_kinematics && !(F.determinant() > 0.0))
       throw SolverError("stress probe: inverted element (det F <= 0)");
     const Eigen::Matrix3d S = material->evaluate(F).S;
-    const Eigen::Matrix3d sigma =
-        linear_kinematics ? S : Eigen::Matrix3d(F * S * F.transpose() / F.determinant());
-    return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(sigma, Eigen::EigenvaluesOnly)
+    return linear_kinematics ? S : Eigen::Matrix3d(F * S * F.transpose() / F.determinant());
+  }
+
+  // Largest eigenvalue of the Cauchy stress.
+  double max_principal(const Barycentric& l) const {
+    return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cauchy(l), Eigen::EigenvaluesOnly)
         .eigenvalues()
         .maxCoeff();
   }
@@ -226,7 +229,6 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
       throw InputError("stress probe: search radius must be >= 0 and finite");
   const std::vector<Barycentric>& subs = probe_subdivision();
   std::vector<char> candidate_node(mesh.nodes.size(), 0);
-  const int n = mesh.nodes_per_element();
   for (std::size_t e = 0; e < mesh.elements.size(); ++e) {
     if (mesh.element_layer[e] != layer) continue;
     const auto& element = mesh.elements[e];
@@ -248,8 +250,15 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
           l(0) * corners[0] + l(1) * corners[1] + l(2) * corners[2] + l(3) * corners[3];
       points_.push_back({x, volume, static_cast<int>(e), static_cast<int>(k)});
     }
-    for (int a = 0; a < n; ++a) candidate_node[static_cast<std::size_t>(element[a])] = 1;
+    // Every node a centre, midside nodes too: with corners only the STL cone's peak read lower
+    // and its puncture on human_skin.toml moved from 108.1 to 120.7 um at fast.
+    for (int a = 0; a < mesh.nodes_per_element(); ++a) {
+      candidate_node[static_cast<std::size_t>(element[a])] = 1;
+      nodes_.push_back(element[a]);
+    }
   }
+  std::sort(nodes_.begin(), nodes_.end());
+  nodes_.erase(std::unique(nodes_.begin(), nodes_.end()), nodes_.end());
   for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
     if (!candidate_node[i]) continue;
     for (std::size_t s = 0; s < sites_xy.size(); ++s)
@@ -271,14 +280,34 @@ std::vector<double> PeakStressProbe::peak(const Eigen::VectorXd& u,
   bool all_linear = true;
   const Material material = layer_material(mesh, layer_, &all_linear);
   const std::vector<Barycentric>& subs = probe_subdivision();
-  // The stress at every sub-point, element by element (points_ is grouped by element).
+  // The stress at every sub-point, element by element (points_ is grouped by element). With
+  // small strain and a linear law the stress of a TET4 is constant and that of a TET10 linear in
+  // the element, so it is interpolated from the corners' (exact, and 16 times fewer material
+  // evaluations); otherwise it is evaluated at each sub-point.
   std::vector<double> stress(points_.size(), 0.0);
+  const Barycentric corner[4] = {Barycentric(1, 0, 0, 0), Barycentric(0, 1, 0, 0),
+                                 Barycentric(0, 0, 1, 0), Barycentric(0, 0, 0, 1)};
+  const auto largest = [](const Eigen::Matrix3d& sigma) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+    eigen.computeDirect(sigma, Eigen::EigenvaluesOnly);
+    return eigen.eigenvalues().maxCoeff();
+  };
   std::size_t i = 0;
   for (int e : elements_) {
     const ElementField field =
         element_field(mesh, u, static_cast<std::size_t>(e), material, all_linear);
-    for (; i < points_.size() && points_[i].element == e; ++i)
-      stress[i] = field.max_principal(subs[static_cast<std::size_t>(points_[i].sub)]);
+    if (all_linear) {
+      Eigen::Matrix3d at_corner[4];
+      for (int c = 0; c < 4; ++c) at_corner[c] = field.cauchy(corner[c]);
+      for (; i < points_.size() && points_[i].element == e; ++i) {
+        const Barycentric& l = subs[static_cast<std::size_t>(points_[i].sub)];
+        stress[i] = largest(l(0) * at_corner[0] + l(1) * at_corner[1] + l(2) * at_corner[2] +
+                            l(3) * at_corner[3]);
+      }
+    } else {
+      for (; i < points_.size() && points_[i].element == e; ++i)
+        stress[i] = field.max_principal(subs[static_cast<std::size_t>(points_[i].sub)]);
+    }
   }
   std::vector<double> best(site_count_, 0.0);
   std::vector<char> found(site_count_, 0);

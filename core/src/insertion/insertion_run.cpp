@@ -222,6 +222,7 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
     plan.seconds->assembly_s += r.timing.assembly_s;
     plan.seconds->factorization_s += r.timing.factorization_s;
     plan.seconds->contact_s += r.timing.contact_s;
+    plan.seconds->stress_s += r.timing.stress_s;
     plan.seconds->factorizations += r.timing.factorizations;
   }
   PreResult out;

@@ -191,6 +191,49 @@ TEST(Indentation3d, RejectsShrinkingDepthAndMissingNeedles) {
   EXPECT_THROW(run.advance_to(1e-6), mneedle::InputError);
 }
 
+// Watched nodes (the stress probe's): their displacement from the kept rows of the compliance
+// columns equals the whole field's rows to round-off (1e-10 of the largest) at every step with
+// sticking contact, and is read from the field with frictionless contact; watching is set before
+// the first depth or not at all.
+TEST(Indentation3d, WatchedDisplacementEqualsTheFieldsRows) {
+  const TetMesh mesh =
+      punch_mesh(homogeneous_block(MaterialModel::Linear, 1e5, 0.4, 400e-6, 300e-6), 100e-6, 20e-6,
+                 2, Fidelity::Fast);
+  std::vector<int> nodes;
+  for (std::size_t n = 0; n < mesh.nodes.size(); n += 7) nodes.push_back(static_cast<int>(n));
+  for (ContactMode contact : {ContactMode::Sticking, ContactMode::Frictionless}) {
+    Indentation3dOptions options;
+    options.contact = contact;
+    // A cone captures node after node with sticking contact; a punch touches at once with
+    // frictionless contact (a sharp tip between its contact points would touch nothing here).
+    const Needle3d needle =
+        contact == ContactMode::Sticking
+            ? Needle3d{"cone", cone_needle(std::numbers::pi / 6, 100e-6, 1e-3, 48), 0.0, 0.0}
+            : Needle3d{"punch", cylinder_needle(100e-6, 1e-3), 0.0, 0.0};
+    Indentation3d run(mesh, {needle}, 20e-6, options);
+    run.watch_nodes(nodes);
+    for (double depth : {5e-6, 12e-6, 20e-6}) {
+      run.advance_to(depth);
+      const Eigen::VectorXd u = run.displacement();
+      const Eigen::VectorXd watched = run.watched_displacement();
+      ASSERT_EQ(watched.size(), 3 * static_cast<Eigen::Index>(nodes.size()));
+      double largest = 0.0, difference = 0.0;
+      for (std::size_t w = 0; w < nodes.size(); ++w) {
+        const Eigen::Vector3d field = u.segment<3>(3 * nodes[w]);
+        largest = std::max(largest, field.norm());
+        difference = std::max(
+            difference, (watched.segment<3>(3 * static_cast<Eigen::Index>(w)) - field).norm());
+      }
+      EXPECT_GT(largest, 0.0) << "depth " << depth;
+      EXPECT_LE(difference, 1e-10 * largest) << "depth " << depth;
+    }
+    EXPECT_THROW(run.watch_nodes(nodes), mneedle::InputError);
+  }
+  Indentation3d fresh(mesh, {{"punch", cylinder_needle(100e-6, 1e-3), 0.0, 0.0}}, 20e-6);
+  EXPECT_THROW(fresh.watch_nodes({-1}), mneedle::InputError);
+  EXPECT_THROW(fresh.watch_nodes({static_cast<int>(mesh.nodes.size())}), mneedle::InputError);
+}
+
 TEST(Indentation3d, SimulateThreeDimensionalReportsMeshAndCurve) {
   TissueBlockSpec block;
   block.size_x = block.size_y = 1000e-6;

@@ -69,6 +69,7 @@ struct Timing3d {
   double assembly_s = 0.0;
   double factorization_s = 0.0;
   double contact_s = 0.0;  ///< capture searches, compliance columns and contact solves
+  double stress_s = 0.0;   ///< simulate_3d: the stress criterion's probe (PeakStressProbe)
   double total_s = 0.0;
   int factorizations = 0;
 };
@@ -129,6 +130,15 @@ class Indentation3d {
   void set_crack_faces(std::vector<CrackFacePair> pairs, bool contact);
   /// Nodal displacement (3 per node, m) at the last depth.
   Eigen::VectorXd displacement() const;
+  /// Nodes whose displacement is read at every step (the stress criterion's probe): on the
+  /// linear sticking path their rows of every compliance column are kept, so
+  /// watched_displacement() costs no solve. Call before the first advance_to; InputError for a
+  /// node out of range or a call after it.
+  void watch_nodes(std::vector<int> nodes);
+  /// Displacement (3 per watched node, in watch_nodes' order, m) at the last depth; equal to
+  /// displacement()'s rows to round-off, and taken from it where no rows are kept (frictionless
+  /// contact, nonlinear tissue, crack faces in contact).
+  Eigen::VectorXd watched_displacement() const;
   const Timing3d& timing() const;
   std::string solver_backend() const;
   /// Writes the problem of the last depth as a CalculiX/Abaqus deck (fe/inp_writer.h): mesh,

@@ -39,6 +39,9 @@ class PeakStressProbe {
   /// constructor's); 0 where no centre lies within reach.
   std::vector<double> peak(const Eigen::VectorXd& u,
                            const std::vector<double>& search_radius_m) const;
+  /// The nodes whose displacement peak() reads (those of the elements within reach), ascending:
+  /// the other entries of `u` may be anything.
+  const std::vector<int>& nodes() const { return nodes_; }
 
  private:
   struct SubPoint {
@@ -57,6 +60,7 @@ class PeakStressProbe {
   int layer_;
   std::size_t site_count_;
   std::vector<int> elements_;  // the layer's elements within reach of a site
+  std::vector<int> nodes_;     // their nodes, ascending
   std::vector<SubPoint> points_;
   std::vector<Candidate> candidates_;
   // Sub-points bucketed on a grid of cell size length_m: cell key -> point indices.

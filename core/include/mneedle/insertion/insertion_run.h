@@ -142,6 +142,7 @@ struct RunSeconds {
   double assembly_s = 0.0;         ///< of the 3-D runs: stiffness assembly
   double factorization_s = 0.0;    ///< of the 3-D runs: ordering and Cholesky factorisation
   double contact_s = 0.0;          ///< of the 3-D runs: capture, compliance columns, contact
+  double stress_s = 0.0;           ///< of the 3-D runs: the stress criterion's probe
   int factorizations = 0;          ///< of the 3-D runs
   int fe_runs = 0;                 ///< FE runs (3-D and axisymmetric) started
 };
