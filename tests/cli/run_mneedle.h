@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -64,7 +65,9 @@ inline std::string skin_scene_with_criterion(const std::string& criterion) {
   std::string scene = text.str();
   const std::string key = "\ncriterion = \"stress\"";
   const std::size_t at = scene.find(key);
-  if (at == std::string::npos) return source.string();  // the caller's assertions will say so
+  if (at == std::string::npos)
+    throw std::runtime_error("skin_scene_with_criterion: no criterion = \"stress\" in " +
+                             source.string());
   scene.replace(at, key.size(), "\ncriterion = \"" + criterion + "\"");
   const std::filesystem::path file =
       std::filesystem::temp_directory_path() /

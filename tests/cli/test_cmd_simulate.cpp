@@ -184,7 +184,7 @@ TEST(CmdSimulate, PaperAArrayRunsAsAQuarterModelAndReportsEveryNeedle) {
 // are deterministic, so a move is a change to explain.
 TEST(CmdSimulate, PaperASkinNeedlesPunctureInPaperAsOrderUnderTheStressCriterion) {
   const std::vector<std::pair<std::string, double>> needles = {
-      {"sharp_bevel", 63.8e-6}, {"blunt_bevel", 96.1e-6}, {"cylinder", 151.1e-6}};
+      {"sharp_bevel", 63.8e-6}, {"blunt_bevel", 96.1e-6}, {"cylinder", 140.9e-6}};
   for (const auto& [needle, depth] : needles) {
     const std::string file =
         std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/paper_a_skin_" + needle + ".toml";

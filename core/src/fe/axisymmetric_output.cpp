@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <string>
 
 #include "axisymmetric_internal.h"
@@ -42,6 +43,22 @@ std::vector<Eigen::Vector2d> sub_centroids(int n) {
       if (i + j < n - 1) out.emplace_back((i + 2.0 / 3.0) * h, (j + 2.0 / 3.0) * h);
     }
   return out;
+}
+
+// The fraction of the ring through reference point x = (r, z) that lies within `length` of the
+// 3-D point at (r_c, theta = 0, z_c): the ring's points at angle phi are r^2 + r_c^2 -
+// 2 r r_c cos(phi) + (z - z_c)^2 from it squared, so those with cos(phi) >= c are inside, a
+// fraction acos(c) / pi. Weighting a sub-triangle's 2 pi r dA by it makes the mean one over a
+// ball, as the 3-D probe's, where a disc in (r, z) would be a torus round the axis.
+double ring_fraction_in_ball(const Eigen::Vector2d& x, const Eigen::Vector2d& centre,
+                             double length) {
+  const double r = x.x(), rc = centre.x(), dz = x.y() - centre.y();
+  const double reach2 = length * length;
+  if (r <= 0.0 || rc <= 0.0) return r * r + rc * rc + dz * dz <= reach2 ? 1.0 : 0.0;
+  const double c = (r * r + rc * rc + dz * dz - reach2) / (2.0 * r * rc);
+  if (c >= 1.0) return 0.0;
+  if (c <= -1.0) return 1.0;
+  return std::acos(c) / std::numbers::pi;
 }
 
 }  // namespace
@@ -162,9 +179,10 @@ double AxisymmetricModel::peak_averaged_max_principal_stress(const Eigen::Vector
                                [](const SubPoint& p, double r) { return p.x.x() < r; });
     double weighted = 0.0, volume = 0.0;
     for (; it != points.end() && it->x.x() <= c.x() + length_m; ++it) {
-      if ((it->x - c).squaredNorm() > length_m * length_m) continue;
-      weighted += it->weight * it->stress;
-      volume += it->weight;
+      const double fraction = ring_fraction_in_ball(it->x, c, length_m);
+      if (fraction <= 0.0) continue;
+      weighted += fraction * it->weight * it->stress;
+      volume += fraction * it->weight;
     }
     if (!(volume > 0.0)) continue;
     const double mean = weighted / volume;

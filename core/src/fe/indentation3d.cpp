@@ -64,6 +64,9 @@ constexpr int kMaxStepCuts = 12;
 constexpr int kMaxUzawa = 50;
 constexpr double kUzawaTolerance = 1e-4;
 constexpr int kMaxContactNewton = 60;
+// Largest size of the watched nodes' rows of the compliance columns (Indentation3d::watch_nodes):
+// 256 MiB, a tenth of what the largest 3-D problems of docs/performance.md hold.
+constexpr double kWatchedRowsBudget = 256.0 * 1024 * 1024;
 // Crack-face contact: active-set rounds per solve; a pair closes when its faces overlap by more
 // than kCrackGapTolerance x the current depth (round-off of the condensed solve is ~1e-16 of it).
 constexpr int kMaxCrackRounds = 100;   // plus four per pair
@@ -104,6 +107,9 @@ struct Indentation3d::Impl {
   // (watch_nodes): u there is watched_compliance * multipliers on the linear sticking path.
   std::vector<int> watched;
   Eigen::MatrixXd watched_compliance;
+  // Set when the kept rows would outgrow kWatchedRowsBudget bytes (many watched nodes times
+  // many captured ones): from then on the watched displacement comes from the whole field.
+  bool watched_overflow = false;
   std::unordered_map<int, CachedColumns> column_cache;
   // The smallest needle radius up to the final depth: the length scale of the capture search.
   double capture_radius = std::numeric_limits<double>::infinity();
@@ -301,8 +307,9 @@ struct Indentation3d::Impl {
     const Eigen::MatrixXd columns = solver.solve_many(unit);
     for (std::size_t i = 0; i < missing.size(); ++i) {
       CachedColumns& cached = column_cache[missing[i]];
-      cached.watched.resize(3 * static_cast<Eigen::Index>(watched.size()), 3);
-      for (std::size_t w = 0; w < watched.size(); ++w)
+      cached.watched.resize(watched_overflow ? 0 : 3 * static_cast<Eigen::Index>(watched.size()),
+                            3);
+      for (std::size_t w = 0; w < watched.size() && !watched_overflow; ++w)
         cached.watched.middleRows<3>(3 * static_cast<Eigen::Index>(w)) =
             columns.block<3, 3>(3 * watched[w], 3 * static_cast<Eigen::Index>(i));
       cached.surface.resize(surface_rows(), 3);
@@ -325,8 +332,14 @@ struct Indentation3d::Impl {
     const Eigen::Index old_columns = compliance.cols();
     const auto added = 3 * static_cast<Eigen::Index>(found.size());
     compliance.conservativeResize(surface_rows(), old_columns + added);
-    watched_compliance.conservativeResize(3 * static_cast<Eigen::Index>(watched.size()),
-                                          old_columns + added);
+    const double watched_bytes =
+        8.0 * 3.0 * static_cast<double>(watched.size()) * static_cast<double>(old_columns + added);
+    if (watched_bytes > kWatchedRowsBudget) watched_overflow = true;
+    if (watched_overflow)
+      watched_compliance.resize(0, 0);
+    else
+      watched_compliance.conservativeResize(3 * static_cast<Eigen::Index>(watched.size()),
+                                            old_columns + added);
     if (crack_contact())
       capture_gaps.conservativeResize(static_cast<Eigen::Index>(pairs.size()), old_columns + added);
     for (std::size_t i = 0; i < found.size(); ++i) {
@@ -334,7 +347,7 @@ struct Indentation3d::Impl {
       assert(it != column_cache.end() && "a node captured twice in one call");
       const Eigen::Index at = old_columns + 3 * static_cast<Eigen::Index>(i);
       compliance.middleCols<3>(at) = it->second.surface;
-      watched_compliance.middleCols<3>(at) = it->second.watched;
+      if (!watched_overflow) watched_compliance.middleCols<3>(at) = it->second.watched;
       if (crack_contact()) capture_gaps.middleCols<3>(at) = it->second.gaps;
       column_cache.erase(it);
     }
@@ -1330,9 +1343,10 @@ Eigen::VectorXd Indentation3d::watched_displacement() const {
   const auto rows = 3 * static_cast<Eigen::Index>(m.watched.size());
   // The kept rows hold the captured nodes' columns only: crack-face loads, frictionless contact
   // and the nonlinear path read the whole field.
-  if (m.model.is_linear() && !m.frictionless() && m.active_pairs.empty() &&
+  if (m.model.is_linear() && !m.frictionless() && !m.watched_overflow && m.active_pairs.empty() &&
       m.watched_compliance.rows() == rows &&
-      m.watched_compliance.cols() == 3 * static_cast<Eigen::Index>(m.captured.size())) {
+      m.watched_compliance.cols() == 3 * static_cast<Eigen::Index>(m.captured.size()) &&
+      m.multipliers.size() == m.watched_compliance.cols()) {
     if (m.captured.empty()) return Eigen::VectorXd::Zero(rows);
     return m.watched_compliance * m.multipliers;
   }
@@ -1536,7 +1550,11 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
       probe_shapes.emplace_back(needle.mesh);
       axes.emplace_back(needle.x, needle.y);
     }
-    stress_probe.emplace(mesh, std::move(axes), search_radii(options.depth), stress_length, 0);
+    const std::vector<double> radii = search_radii(options.depth);
+    // Centres as deep as the tip can reach plus the search radius: the needle presses the layer
+    // no deeper than that (in reference coordinates), and a thick layer's probe stays small.
+    const double search_depth = options.depth + *std::max_element(radii.begin(), radii.end());
+    stress_probe.emplace(mesh, std::move(axes), radii, search_depth, stress_length, 0);
     // The probe reads a few hundred nodes: their rows of the compliance columns are kept, so no
     // step solves for the whole field (docs/performance.md, "The stress criterion's cost").
     run.watch_nodes(stress_probe->nodes());

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <unordered_map>
 #include <vector>
@@ -216,8 +217,13 @@ long long cell_key(const Cell& c) {
 }  // namespace
 
 PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2d> sites_xy,
-                                 std::vector<double> search_radius_m, double length_m, int layer)
-    : mesh_(&mesh), length_(length_m), layer_(layer), site_count_(sites_xy.size()) {
+                                 std::vector<double> search_radius_m, double search_depth_m,
+                                 double length_m, int layer)
+    : mesh_(&mesh),
+      length_(length_m),
+      layer_(layer),
+      site_count_(sites_xy.size()),
+      search_radius_(search_radius_m) {
   if (!(length_m > 0.0) || !std::isfinite(length_m))
     throw InputError("stress probe: averaging length must be positive and finite");
   if (layer < 0 || layer >= static_cast<int>(mesh.layers.size()))
@@ -227,6 +233,8 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
   for (double r : search_radius_m)
     if (!(r >= 0.0) || !std::isfinite(r))
       throw InputError("stress probe: search radius must be >= 0 and finite");
+  if (!(search_depth_m >= 0.0) || !std::isfinite(search_depth_m))
+    throw InputError("stress probe: search depth must be >= 0 and finite");
   const std::vector<Barycentric>& subs = probe_subdivision();
   std::vector<char> candidate_node(mesh.nodes.size(), 0);
   for (std::size_t e = 0; e < mesh.elements.size(); ++e) {
@@ -238,10 +246,15 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
     const Eigen::Vector3d mid = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
     double reach = 0.0;
     for (const auto& q : corners) reach = std::max(reach, (q - mid).norm());
-    bool near = false;
+    // Within reach of a centre: a ball of radius L about a node no farther than the search
+    // radius from a site and no deeper than the search depth (mirror images lie within L of
+    // the plane, so the meshed part holds every element they come from).
+    bool near = mid.z() + reach >= -(search_depth_m + length_m);
+    bool beside = false;
     for (std::size_t s = 0; s < sites_xy.size(); ++s)
-      near = near || (mid.head<2>() - sites_xy[s]).norm() - reach <= search_radius_m[s] + length_m;
-    if (!near) continue;
+      beside =
+          beside || (mid.head<2>() - sites_xy[s]).norm() - reach <= search_radius_m[s] + length_m;
+    if (!near || !beside) continue;
     elements_.push_back(static_cast<int>(e));
     const double volume = tet_volume(corners) / static_cast<double>(subs.size());
     for (std::size_t k = 0; k < subs.size(); ++k) {
@@ -260,14 +273,30 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
   std::sort(nodes_.begin(), nodes_.end());
   nodes_.erase(std::unique(nodes_.begin(), nodes_.end()), nodes_.end());
   for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
-    if (!candidate_node[i]) continue;
+    if (!candidate_node[i] || mesh.nodes[i].z() < -search_depth_m) continue;
     for (std::size_t s = 0; s < sites_xy.size(); ++s)
       if ((mesh.nodes[i].head<2>() - sites_xy[s]).norm() <= search_radius_m[s])
         candidates_.push_back(
             {mesh.nodes[i], static_cast<int>(s), (mesh.nodes[i].head<2>() - sites_xy[s]).norm()});
   }
+  // The balls of a half (quarter) model see the mirror image of the meshed part as the whole
+  // block's do: the sub-points within L of a symmetry plane are reflected across it.
   for (std::size_t i = 0; i < points_.size(); ++i)
-    buckets_[cell_key(cell_of(points_[i].x, length_m))].push_back(static_cast<int>(i));
+    images_.push_back({points_[i].x, points_[i].volume, static_cast<int>(i)});
+  for (int axis : {1, 0}) {
+    if (!(axis == 1 ? mesh.mirror_y0 : mesh.mirror_x0)) continue;
+    const std::size_t count = images_.size();
+    for (std::size_t i = 0; i < count; ++i) {
+      if (images_[i].x(axis) >= length_m) continue;
+      Image mirrored = images_[i];
+      mirrored.x(axis) = -mirrored.x(axis);
+      images_.push_back(mirrored);
+    }
+  }
+  // Cells a hair wider than L: a point at exactly L along an axis still lies in a neighbour.
+  cell_ = length_m * (1.0 + 1e-9);
+  for (std::size_t i = 0; i < images_.size(); ++i)
+    buckets_[cell_key(cell_of(images_[i].x, cell_))].push_back(static_cast<int>(i));
 }
 
 std::vector<double> PeakStressProbe::peak(const Eigen::VectorXd& u,
@@ -277,6 +306,9 @@ std::vector<double> PeakStressProbe::peak(const Eigen::VectorXd& u,
     throw InputError("stress probe: displacement size does not match the mesh");
   if (search_radius_m.size() != site_count_)
     throw InputError("stress probe: one search radius per site");
+  for (std::size_t s = 0; s < site_count_; ++s)
+    if (search_radius_m[s] > search_radius_[s] * (1.0 + 1e-12))
+      throw InputError("stress probe: a search radius beyond the one the probe was built for");
   bool all_linear = true;
   const Material material = layer_material(mesh, layer_, &all_linear);
   const std::vector<Barycentric>& subs = probe_subdivision();
@@ -309,22 +341,23 @@ std::vector<double> PeakStressProbe::peak(const Eigen::VectorXd& u,
         stress[i] = field.max_principal(subs[static_cast<std::size_t>(points_[i].sub)]);
     }
   }
+  assert(i == points_.size() && "the probe's sub-points are grouped by element");
   std::vector<double> best(site_count_, 0.0);
   std::vector<char> found(site_count_, 0);
   const double reach2 = length_ * length_;
   for (const Candidate& c : candidates_) {
     if (c.distance > search_radius_m[static_cast<std::size_t>(c.site)]) continue;
     double stress_volume = 0.0, volume = 0.0;
-    const Cell home = cell_of(c.x, length_);
+    const Cell home = cell_of(c.x, cell_);
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
           const auto bucket = buckets_.find(cell_key({home[0] + dx, home[1] + dy, home[2] + dz}));
           if (bucket == buckets_.end()) continue;
           for (int p : bucket->second) {
-            const SubPoint& q = points_[static_cast<std::size_t>(p)];
+            const Image& q = images_[static_cast<std::size_t>(p)];
             if ((q.x - c.x).squaredNorm() > reach2) continue;
-            stress_volume += q.volume * stress[static_cast<std::size_t>(p)];
+            stress_volume += q.volume * stress[static_cast<std::size_t>(q.source)];
             volume += q.volume;
           }
         }

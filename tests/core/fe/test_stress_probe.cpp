@@ -129,11 +129,11 @@ TEST(StressProbe, RejectsBadLengthAndLayer) {
   EXPECT_THROW(averaged_max_principal_stress(mesh, u, {0, 0, 0}, 1e-4, 2), mneedle::InputError);
   EXPECT_THROW(averaged_max_principal_stress(mesh, Eigen::VectorXd::Zero(3), {0, 0, 0}, 1e-4, 0),
                mneedle::InputError);
-  EXPECT_THROW(PeakStressProbe(mesh, {{0, 0}}, {1e-4}, 0.0, 0), mneedle::InputError);
-  EXPECT_THROW(PeakStressProbe(mesh, {{0, 0}}, {1e-4}, 1e-4, 2), mneedle::InputError);
-  EXPECT_THROW(PeakStressProbe(mesh, {{0, 0}}, {-1.0}, 1e-4, 0), mneedle::InputError);
-  EXPECT_THROW(PeakStressProbe(mesh, {{0, 0}}, {}, 1e-4, 0), mneedle::InputError);
-  const PeakStressProbe probe(mesh, {{0, 0}}, {1e-4}, 1e-4, 0);
+  EXPECT_THROW(PeakStressProbe(mesh, {{0, 0}}, {1e-4}, 1e-3, 0.0, 0), mneedle::InputError);
+  EXPECT_THROW(PeakStressProbe(mesh, {{0, 0}}, {1e-4}, 1e-3, 1e-4, 2), mneedle::InputError);
+  EXPECT_THROW(PeakStressProbe(mesh, {{0, 0}}, {-1.0}, 1e-3, 1e-4, 0), mneedle::InputError);
+  EXPECT_THROW(PeakStressProbe(mesh, {{0, 0}}, {}, 1e-3, 1e-4, 0), mneedle::InputError);
+  const PeakStressProbe probe(mesh, {{0, 0}}, {1e-4}, 1e-3, 1e-4, 0);
   EXPECT_THROW(probe.peak(u, {}), mneedle::InputError);
   EXPECT_THROW(probe.peak(Eigen::VectorXd::Zero(3), {1e-4}), mneedle::InputError);
 }
@@ -151,7 +151,7 @@ TEST_P(StressProbeOrder, PeakOfAUniformStressIsThatStress) {
   const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
   const double expected =
       max_principal(lambda * strain.trace() * Eigen::Matrix3d::Identity() + 2 * mu * strain);
-  const PeakStressProbe probe(mesh, {{0.0, 0.0}}, {0.1e-3}, 0.05e-3, 0);
+  const PeakStressProbe probe(mesh, {{0.0, 0.0}}, {0.1e-3}, 1e-3, 0.05e-3, 0);
   const std::vector<double> peak = probe.peak(u, {0.1e-3});
   ASSERT_EQ(peak.size(), 1u);
   EXPECT_NEAR(peak[0], expected, 1e-9 * std::abs(expected));
@@ -169,7 +169,7 @@ TEST(StressProbe, PeakFindsTheLargestMeanWithinTheSearchRadius) {
   const Eigen::VectorXd u = interpolate(mesh, [&](const Eigen::Vector3d& x) {
     return Eigen::Vector3d(0.5 * k * x.x() * x.x(), 0.0, 0.0);
   });
-  const PeakStressProbe probe(mesh, {{0.0, 0.0}}, {0.3e-3}, length, 0);
+  const PeakStressProbe probe(mesh, {{0.0, 0.0}}, {0.3e-3}, 1e-3, length, 0);
   double previous = 0.0;
   for (double radius : {0.1e-3, 0.2e-3, 0.3e-3}) {
     double farthest = 0.0;  // largest x of a top-layer node within the radius

@@ -134,15 +134,18 @@ class AxisymmetricModel {
   std::vector<double> von_mises(const Eigen::VectorXd& u) const;
   std::vector<double> energy_density(const Eigen::VectorXd& u) const;
   /// Volume-weighted (2 pi r dA, reference) mean of the maximum principal Cauchy stress (hoop
-  /// stress included) over the part of `layer` within length_m of point_m (reference (r, z)).
-  /// Returns 0 when no part of the layer is within reach.
+  /// stress included) over the part of `layer` within length_m of point_m in the (r, z) plane:
+  /// a ball for a point on the axis, a torus round the axis for one off it (the peak below
+  /// averages over a ball everywhere). Returns 0 when no part of the layer is within reach.
   double averaged_max_principal_stress(const Eigen::VectorXd& u, const Eigen::Vector2d& point_m,
                                        double length_m, int layer) const;
   /// The stress criterion's measure (docs/model.md, "Criteria", stress): the largest, over
-  /// centres at the nodes of `layer` with r <= search_radius_m, of the mean above (the volume
-  /// method of the theory of critical distances). Each element within reach is split into 16
-  /// equal sub-triangles carrying the stress at their centroids; a sub-triangle belongs to a
-  /// centre's reach when its centroid does. Returns 0 when no centre is within reach.
+  /// centres at the nodes of `layer` with r <= search_radius_m, of the mean of the maximum
+  /// principal stress over the part of `layer` within length_m of the centre in 3-D (a ball, as
+  /// the 3-D probe's; the volume method of the theory of critical distances). Each element
+  /// within reach is split into 16 equal sub-triangles carrying the stress at their centroids,
+  /// each weighted by 2 pi r dA times the fraction of its ring inside the ball. Returns 0 when no
+  /// centre is within reach.
   double peak_averaged_max_principal_stress(const Eigen::VectorXd& u, double search_radius_m,
                                             double length_m, int layer) const;
   /// Binary VTU (ParaView): the (r, z) mesh as quadratic triangles in the plane y = 0 (x = r,
@@ -202,9 +205,9 @@ struct InsertionStep {
   double strain_energy_J = 0.0;
   int newton_iterations = 0;  ///< summed over the sub-steps since the previous output
   int contact_nodes = 0;
-  /// Maximum principal Cauchy stress (hoop stress included) of the top layer (layer 0),
-  /// volume-weighted (2 pi r dA) over the part within stress_average_length_m of the surface
-  /// point on the axis (Pa; 0 when the option is off).
+  /// The stress criterion's measure: AxisymmetricModel::peak_averaged_max_principal_stress of
+  /// the top layer (layer 0) over centres within the needle's outline plus two
+  /// stress_average_length_m (Pa; 0 when the option is off).
   double tip_stress_Pa = 0.0;
   /// G = (U_intact - U_cracked) / crack_area_m2 at the same needle position, the cracked model
   /// advanced in lock-step (J/m^2; 0 when crack_depth_m is 0). The crack is a ring (cylindrical)

@@ -33,8 +33,9 @@ struct NeedleStep3d {
   double contact_area_m2 = 0.0;             ///< captured surface projected on the z = 0 plane
   double contact_pressure_Pa = 0.0;         ///< force_N / contact_area_m2 (0 without contact)
   int captured_nodes = 0;  ///< sticking: captured nodes; frictionless: nodes of touching faces
-  /// Mean maximum principal stress of the top layer within stress_average_length_m of the
-  /// needle's first contact point (Pa; 0 when the option is off).
+  /// The stress criterion's measure: the peak over the top layer near the needle of its maximum
+  /// principal stress averaged over stress_average_length_m (fe::PeakStressProbe; Pa; 0 when
+  /// the option is off).
   double tip_stress_Pa = 0.0;
   /// G = (U_intact - U_cracked) / total crack area over all needles (J/m^2; 0 when off).
   double energy_release_rate_J_per_m2 = 0.0;

@@ -29,14 +29,19 @@ double averaged_max_principal_stress(const TetMesh& mesh, const Eigen::VectorXd&
 /// what that costs in accuracy).
 class PeakStressProbe {
  public:
-  /// `sites_xy` (m, reference) with the largest search radius of each. Throws InputError on a
-  /// bad length, radius or layer.
+  /// `sites_xy` (m, reference) with the largest search radius of each; centres deeper than
+  /// `search_depth_m` below the surface are not searched (the stress that breaks the layer is
+  /// near the needle; the bound keeps the probe's nodes few in a thick layer). On a half or
+  /// quarter model (mesh.mirror_y0, mirror_x0) each ball also holds the mirror image of the
+  /// meshed part, as in the whole block. Throws InputError on a bad length, radius, depth or
+  /// layer.
   PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2d> sites_xy,
-                  std::vector<double> search_radius_m, double length_m, int layer);
+                  std::vector<double> search_radius_m, double search_depth_m, double length_m,
+                  int layer);
 
   /// Per site: the peak averaged maximum principal stress (Pa) at nodal displacement `u`
   /// (3 per node, m) over the centres within `search_radius_m` of it (each at most the
-  /// constructor's); 0 where no centre lies within reach.
+  /// constructor's: InputError otherwise); 0 where no centre lies within reach.
   std::vector<double> peak(const Eigen::VectorXd& u,
                            const std::vector<double>& search_radius_m) const;
   /// The nodes whose displacement peak() reads (those of the elements within reach), ascending:
@@ -50,6 +55,12 @@ class PeakStressProbe {
     int element;
     int sub;  // index into the subdivision's centroids
   };
+  // A sub-point or its mirror image across a symmetry plane of the mesh: where a ball looks.
+  struct Image {
+    Eigen::Vector3d x;
+    double volume;
+    int source;  // index into points_
+  };
   struct Candidate {
     Eigen::Vector3d x;
     int site;
@@ -62,9 +73,12 @@ class PeakStressProbe {
   std::vector<int> elements_;  // the layer's elements within reach of a site
   std::vector<int> nodes_;     // their nodes, ascending
   std::vector<SubPoint> points_;
+  std::vector<Image> images_;
+  std::vector<double> search_radius_;  // the constructor's, per site
   std::vector<Candidate> candidates_;
-  // Sub-points bucketed on a grid of cell size length_m: cell key -> point indices.
+  // Images bucketed on a grid of cell size just above length_m: cell key -> image indices.
   std::unordered_map<long long, std::vector<int>> buckets_;
+  double cell_ = 0.0;
 };
 
 }  // namespace mneedle::fe

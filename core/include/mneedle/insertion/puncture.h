@@ -35,7 +35,7 @@ PunctureThreshold puncture_threshold(const Scene& scene, PunctureCriterion crite
 struct CriterionSample {
   double depth_m = 0.0;
   double contact_pressure_Pa = 0.0;           ///< F / A_sec: force over the outline area at z = 0
-  double tip_stress_Pa = 0.0;                 ///< averaged max principal stress under the tip
+  double tip_stress_Pa = 0.0;                 ///< peak averaged max principal stress (Pa)
   double energy_release_rate_J_per_m2 = 0.0;  ///< G of a crack under the tip
   /// F / F_p: the force over the steady mode-I penetration force of the needle's section at
   /// the surface (penetration_force.h); dimensionless, the criterion fires at 1.
