@@ -1555,8 +1555,8 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
     // no deeper than that (in reference coordinates), and a thick layer's probe stays small.
     const double search_depth = options.depth + *std::max_element(radii.begin(), radii.end());
     stress_probe.emplace(mesh, std::move(axes), radii, search_depth, stress_length, 0);
-    // The probe reads a few hundred nodes: their rows of the compliance columns are kept, so no
-    // step solves for the whole field (docs/performance.md, "The stress criterion's cost").
+    // The probe reads its elements' nodes only: their rows of the compliance columns are kept, so
+    // no step solves for the whole field (docs/performance.md, "The stress criterion's cost").
     run.watch_nodes(stress_probe->nodes());
   }
   for (int k = 1; k <= steps; ++k) {
