@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "skin_scene.h"
+
 namespace mneedle::test {
 
 struct CommandRun {
@@ -52,28 +54,13 @@ inline CommandRun run_mneedle(const std::string& arguments) {
   return run_command("'" + mneedle_binary() + "' " + arguments);
 }
 
-/// A copy of the shipped skin scene (designs/scenes/human_skin.toml) with its puncture criterion
-/// replaced, in the temp folder (one per process and criterion). Tests that run the closed-form
-/// pre-puncture model on skin use it with "pressure": that model has no stress field for the
-/// scene's own stress criterion.
+/// write_skin_scene_with_criterion (skin_scene.h) into the temp folder, one file per process and
+/// criterion.
 inline std::string skin_scene_with_criterion(const std::string& criterion) {
-  const std::filesystem::path source =
-      std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/human_skin.toml";
-  std::ifstream in(source);
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string scene = text.str();
-  const std::string key = "\ncriterion = \"stress\"";
-  const std::size_t at = scene.find(key);
-  if (at == std::string::npos)
-    throw std::runtime_error("skin_scene_with_criterion: no criterion = \"stress\" in " +
-                             source.string());
-  scene.replace(at, key.size(), "\ncriterion = \"" + criterion + "\"");
-  const std::filesystem::path file =
-      std::filesystem::temp_directory_path() /
-      ("mneedle_skin_" + criterion + "_" + std::to_string(::getpid()) + ".toml");
-  std::ofstream(file) << scene;
-  return file.string();
+  return write_skin_scene_with_criterion(criterion, std::filesystem::temp_directory_path() /
+                                                        ("mneedle_skin_" + criterion + "_" +
+                                                         std::to_string(::getpid()) + ".toml"))
+      .string();
 }
 
 #ifdef MNEEDLE_MPIEXEC

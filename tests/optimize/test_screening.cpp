@@ -14,6 +14,7 @@
 
 #include "mneedle/base/error.h"
 #include "mneedle/blas_threads.h"
+#include "skin_scene.h"
 
 namespace {
 
@@ -39,17 +40,8 @@ class Screening : public ::testing::Test {
     // The closed-form model these tests run has no stress field for the skin scene's own stress
     // criterion: the screening machinery is checked on a copy with the pressure criterion (a
     // file, since uncertainty runs re-read it with drawn values).
-    {
-      std::ifstream in(kRoot + "/designs/scenes/human_skin.toml");
-      std::stringstream text;
-      text << in.rdbuf();
-      std::string scene = text.str();
-      const std::string key = "\ncriterion = \"stress\"";
-      ASSERT_NE(scene.find(key), std::string::npos);
-      scene.replace(scene.find(key), key.size(), "\ncriterion = \"pressure\"");
-      scene_file_ = dir_ / "human_skin_pressure.toml";
-      std::ofstream(scene_file_) << scene;
-    }
+    scene_file_ = mneedle::test::write_skin_scene_with_criterion("pressure",
+                                                                 dir_ / "human_skin_pressure.toml");
     scene_ = mneedle::load_scene(scene_file_);
     registry_ = mneedle::PluginRegistry::discover({MNEEDLE_PLUGIN_BUILD_DIR});
   }

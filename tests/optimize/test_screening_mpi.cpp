@@ -14,6 +14,7 @@
 
 #include "mneedle/base/error.h"
 #include "mneedle/blas_threads.h"
+#include "skin_scene.h"
 
 namespace {
 
@@ -97,17 +98,8 @@ TEST(MpiSession, OneRankWithoutALauncherScreensAsScreenDesignsDoes) {
          "[[designs]]\nname = \"bevel\"\nplugin = \"sharp_bevel\"\nbevel_angle = \"20 deg\"\n";
   // The skin scene with the pressure criterion: the closed-form model run here has no stress
   // field for the scene's own stress criterion, and every row would be the same error.
-  const fs::path scene_file = dir / "human_skin_pressure.toml";
-  {
-    std::ifstream in(kRoot + "/designs/scenes/human_skin.toml");
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string skin = text.str();
-    const std::string key = "\ncriterion = \"stress\"";
-    ASSERT_NE(skin.find(key), std::string::npos);
-    skin.replace(skin.find(key), key.size(), "\ncriterion = \"pressure\"");
-    std::ofstream(scene_file) << skin;
-  }
+  const fs::path scene_file =
+      mneedle::test::write_skin_scene_with_criterion("pressure", dir / "human_skin_pressure.toml");
   const mneedle::Scene scene = mneedle::load_scene(scene_file);
   const auto registry = mneedle::PluginRegistry::discover({MNEEDLE_PLUGIN_BUILD_DIR});
   const auto designs = mneedle::collect_designs({dir / "list.toml"}, 1e-3);

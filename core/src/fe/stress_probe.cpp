@@ -78,6 +78,24 @@ struct Accumulator {
   double volume = 0.0;         // m^3
 };
 
+// An element's corners, their centroid and the farthest corner's distance from it: the cheap
+// bound by which an element is left out of a ball before any per-element work.
+struct Bounds {
+  std::array<Eigen::Vector3d, 4> corners;
+  Eigen::Vector3d mid;
+  double reach = 0.0;
+};
+
+Bounds element_bounds(const TetMesh& mesh, std::size_t e) {
+  Bounds b;
+  for (int i = 0; i < 4; ++i)
+    b.corners[static_cast<std::size_t>(i)] =
+        mesh.nodes[static_cast<std::size_t>(mesh.elements[e][static_cast<std::size_t>(i)])];
+  b.mid = 0.25 * (b.corners[0] + b.corners[1] + b.corners[2] + b.corners[3]);
+  for (const auto& q : b.corners) b.reach = std::max(b.reach, (q - b.mid).norm());
+  return b;
+}
+
 double tet_volume(const std::array<Eigen::Vector3d, 4>& p) {
   return std::abs((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]))) / 6.0;
 }
@@ -240,12 +258,7 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
   for (std::size_t e = 0; e < mesh.elements.size(); ++e) {
     if (mesh.element_layer[e] != layer) continue;
     const auto& element = mesh.elements[e];
-    std::array<Eigen::Vector3d, 4> corners;
-    for (int i = 0; i < 4; ++i)
-      corners[static_cast<std::size_t>(i)] = mesh.nodes[static_cast<std::size_t>(element[i])];
-    const Eigen::Vector3d mid = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
-    double reach = 0.0;
-    for (const auto& q : corners) reach = std::max(reach, (q - mid).norm());
+    const auto [corners, mid, reach] = element_bounds(mesh, e);
     // Within reach of a centre: a ball of radius L about a node no farther than the search
     // radius from a site and no deeper than the search depth (mirror images lie within L of
     // the plane, so the meshed part holds every element they come from).
@@ -385,15 +398,8 @@ double averaged_max_principal_stress(const TetMesh& mesh, const Eigen::VectorXd&
   Accumulator sum;
   for (std::size_t e = 0; e < mesh.elements.size(); ++e) {
     if (mesh.element_layer[e] != layer) continue;
-    const auto& element = mesh.elements[e];
-    // Cheap rejection before any per-element work.
-    std::array<Eigen::Vector3d, 4> corners;
-    for (int i = 0; i < 4; ++i)
-      corners[static_cast<std::size_t>(i)] = mesh.nodes[static_cast<std::size_t>(element[i])];
-    const Eigen::Vector3d mid = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
-    double reach = 0.0;
-    for (const auto& q : corners) reach = std::max(reach, (q - mid).norm());
-    if ((mid - point_m).norm() - reach > length_m) continue;
+    const Bounds b = element_bounds(mesh, e);
+    if ((b.mid - point_m).norm() - b.reach > length_m) continue;
     integrate(element_field(mesh, u, e, material, all_linear), whole, point_m, length_m, 0, &sum);
   }
   return sum.volume > 0.0 ? sum.stress_volume / sum.volume : 0.0;
