@@ -24,6 +24,7 @@
 #include "mneedle/design_source.h"
 #include "mneedle/fe/tissue_mesh.h"
 #include "mneedle/geometry/cross_section.h"
+#include "mneedle/insertion/puncture.h"
 #include "mneedle/needle/mesh.h"
 #include "mneedle/needle/mesh_io.h"
 #include "mneedle/optimum_report.h"
@@ -355,7 +356,11 @@ double fixed_tip_size(const Problem& p, const std::vector<DesignVariable>& vars,
   }
   const double depth = p.scene.requirements.target_depth.value_or(p.scene.insertion.depth);
   const double block = std::max(p.scene.tissue.size[0], p.scene.tissue.size[1]);
-  return fe::mesh_sizing(p.evaluation.fidelity, 2, max_radius_up_to(n.mesh, depth), block)
+  // The stress criterion's length caps the tip element as in every run (docs/model.md,
+  // "Tissue block and mesh").
+  const double length = puncture_threshold(p.scene, p.scene.model.criterion).average_length_m;
+  return fe::mesh_sizing(p.evaluation.fidelity, 2, max_radius_up_to(n.mesh, depth), block, {},
+                         length)
       .fine_size;
 }
 

@@ -1487,6 +1487,7 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   block.order = options.overrides.order.value_or(options.order);
   block.insertion_depth = options.depth;
   block.overrides = options.overrides;
+  block.criterion_length = options.stress_average_length_m;
   block.half_x = options.mirror_x;
   block.half_y = options.half_model;
   if (options.overrides.domain_scale) {
@@ -1554,7 +1555,9 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
     // Centres as deep as the tip can reach plus the search radius: the needle presses the layer
     // no deeper than that (in reference coordinates), and a thick layer's probe stays small.
     const double search_depth = options.depth + *std::max_element(radii.begin(), radii.end());
+    const auto probe_start = Clock::now();
     stress_probe.emplace(mesh, std::move(axes), radii, search_depth, stress_length, 0);
+    stress_seconds += seconds_since(probe_start);
     // The probe reads its elements' nodes only: their rows of the compliance columns are kept, so
     // no step solves for the whole field (docs/performance.md, "The stress criterion's cost").
     run.watch_nodes(stress_probe->nodes());

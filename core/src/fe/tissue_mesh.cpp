@@ -36,6 +36,8 @@ void validate(const TissueBlockSpec& spec) {
       bad_spec("layers." + layer.name + ".thickness", "must be positive and finite");
   if (spec.order != 1 && spec.order != 2) bad_spec("order", "must be 1 or 2");
   if (!(spec.insertion_depth >= 0.0)) bad_spec("insertion_depth", "must be >= 0");
+  if (!(spec.criterion_length >= 0.0) || !std::isfinite(spec.criterion_length))
+    bad_spec("criterion_length", "must be >= 0 and finite");
   if (spec.overrides.refinement_levels &&
       (*spec.overrides.refinement_levels < 0 ||
        *spec.overrides.refinement_levels > kMaxRefinementLevels))
@@ -452,16 +454,22 @@ std::string to_string(Fidelity fidelity) {
   return "fine";
 }
 
-int default_refinement_levels(Fidelity fidelity, int order) {
+namespace {
+// The most node spacings per radius a criterion length can ask for: standard's (TET10).
+constexpr double kMostSpacingsForLength = 5.5;
+}  // namespace
+
+int default_refinement_levels(Fidelity fidelity, int order, double criterion_length) {
   // TET10 only: TET4 stiffens on the refined grid's coarser far field. Fast keeps the plain
   // grid: refined, its coarse far field put the bonded punch 12.6 % above Hayes, against 2.5 % on
-  // the grid (docs/model.md, "Tissue block and mesh").
+  // the grid; but a criterion length needs the thin top layer cut four times through near the
+  // needle, which only the refinement gives (docs/model.md, "Tissue block and mesh").
   if (order != 2) return 0;
-  return fidelity == Fidelity::Fast ? 0 : 2;
+  return fidelity == Fidelity::Fast && !(criterion_length > 0.0) ? 0 : 2;
 }
 
 MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, double block_size,
-                       const FidelityOverrides& overrides) {
+                       const FidelityOverrides& overrides, double criterion_length) {
   // Node spacings per needle radius at the site (a TET10 element spans two, a TET4 one), growth
   // ratio and elements through the top layer. Grid lines march out from the needle's axis, so
   // a whole number of spacings per radius would put nodes exactly on a flat punch's rim or a
@@ -477,10 +485,21 @@ MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, doubl
   // by up to 18 %. The growth is set by a flat face in skin against the skin run's time: the
   // blunt bevel's force 6 % above fine at 1.8 (11 % at 2.0; 4 % at 1.6, which took 1.07 s against
   // the 1 s target); docs/model.md, "Tissue block and mesh". TET4 keeps its former level.
-  const Level level = fidelity == Fidelity::Fast ? Level{2.5, 2.0, 1}
-                      : fidelity == Fidelity::Standard
-                          ? (order == 2 ? Level{5.5, 1.8, 1} : Level{3.5, 1.6, 1})
-                          : Level{5.5, 1.35, 2};
+  Level level = fidelity == Fidelity::Fast ? Level{2.5, 2.0, 1}
+                : fidelity == Fidelity::Standard
+                    ? (order == 2 ? Level{5.5, 1.8, 1} : Level{3.5, 1.6, 1})
+                    : Level{5.5, 1.35, 2};
+  // The stress criterion averages over L: a tip element wider than 5.5 L reads a stress field
+  // the mesh has not resolved (fast's 9.2 L put a sharp bevel's puncture in skin 54 % from
+  // fine's). The spacing stays a half-integer per radius, so the cap rounds up to the next one,
+  // and no level goes finer than standard's 5.5 for it: an L far below the needle (silicone's
+  // 0.15 um) would otherwise ask for millions of elements (docs/model.md, "Tissue block and
+  // mesh").
+  if (criterion_length > 0.0 && std::isfinite(criterion_length)) {
+    const double needed = 2.0 * needle_radius / (kTipElementsPerCriterionLength * criterion_length);
+    level.spacings_per_radius = std::max(
+        level.spacings_per_radius, std::min(std::ceil(needed - 0.5) + 0.5, kMostSpacingsForLength));
+  }
   const int refinement = order == 1 ? 2 : 1;
   MeshSizing sizing;
   sizing.fine_size = order * needle_radius / level.spacings_per_radius;
@@ -516,7 +535,7 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   if (radius == 0.0) radius = std::min(spec.size_x, spec.size_y) / 20.0;
   const MeshSizing sizing =
       mesh_sizing(spec.fidelity, spec.order, radius, std::max({spec.size_x, spec.size_y, total}),
-                  spec.overrides);
+                  spec.overrides, spec.criterion_length);
   std::vector<double> cx, cy, tip_x, tip_y;
   for (const NeedleSite& site : spec.sites) {
     cx.push_back(site.x);
@@ -530,7 +549,7 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   // With refinement levels the grid is built 2^levels coarser at the sites and bisected back
   // down to the fine size along the needles' paths only.
   const int levels = spec.overrides.refinement_levels.value_or(
-      default_refinement_levels(spec.fidelity, spec.order));
+      default_refinement_levels(spec.fidelity, spec.order, spec.criterion_length));
   MeshSizing base = sizing;
   if (levels > 0) {
     const std::vector<double> z_fine =

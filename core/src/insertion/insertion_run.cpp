@@ -166,7 +166,8 @@ void set_section(RunPoint& p, const SectionArea& area) {
 double tip_size_3d(const RunPlan& plan, const InsertionRunOptions& options) {
   if (options.overrides.tip_size_m) return *options.overrides.tip_size_m;
   return fe::mesh_sizing(options.fidelity, options.overrides.order.value_or(2),
-                         plan.needle_radius_m, std::max(plan.block_x_m, plan.block_y_m))
+                         plan.needle_radius_m, std::max(plan.block_x_m, plan.block_y_m), {},
+                         plan.threshold ? plan.threshold->average_length_m : 0.0)
       .fine_size;
 }
 

@@ -123,6 +123,31 @@ TEST(TissueMesh, ElementsAreFinestAtTheNeedleSite) {
   EXPECT_GT(far, 2.0 * near_site);
 }
 
+// The stress criterion's length L: no tip element wider than 5.5 L (TET10), the spacing a
+// half-integer per radius, and the grid refined twice so that the thin top layer is cut four
+// times through near the needle; never finer than standard's 5.5 spacings for it (docs/model.md,
+// "Tissue block and mesh"). Paper A's 115 um radius with L = 10 um: fast goes from 2.5 to 4.5
+// spacings; standard (5.5) is already fine enough.
+TEST(TissueMesh, CriterionLengthSetsTheTipElementAtEveryFidelityUpToStandards) {
+  const double radius = 115e-6, block = 3000e-6, length = 10e-6;
+  const MeshSizing fast = mesh_sizing(Fidelity::Fast, 2, radius, block, {}, length);
+  EXPECT_NEAR(fast.fine_size, 2.0 * radius / 4.5, 1e-15);
+  EXPECT_LE(fast.fine_size, kTipElementsPerCriterionLength * length);
+  EXPECT_NEAR(mesh_sizing(Fidelity::Fast, 2, radius, block).fine_size, 2.0 * radius / 2.5, 1e-15);
+  EXPECT_EQ(default_refinement_levels(Fidelity::Fast, 2, length), 2);
+  EXPECT_EQ(default_refinement_levels(Fidelity::Fast, 2), 0);
+  EXPECT_EQ(default_refinement_levels(Fidelity::Fast, 1, length), 0);  // TET4 is never refined
+  for (Fidelity fidelity : {Fidelity::Standard, Fidelity::Fine})
+    EXPECT_EQ(mesh_sizing(fidelity, 2, radius, block, {}, length).fine_size,
+              mesh_sizing(fidelity, 2, radius, block).fine_size);
+  // An L far below the needle (silicone's 0.15 um) stops at standard's tip.
+  EXPECT_NEAR(mesh_sizing(Fidelity::Fast, 2, radius, block, {}, 0.15e-6).fine_size,
+              2.0 * radius / 5.5, 1e-15);
+  // TET4: an element is one spacing, so the same spacing gives elements half as wide.
+  EXPECT_NEAR(mesh_sizing(Fidelity::Fast, 1, radius, block, {}, length).fine_size, radius / 4.5,
+              1e-15);
+}
+
 TEST(TissueMesh, ThinTopLayerGetsTheRequiredElementsThroughItsThickness) {
   for (Fidelity fidelity : {Fidelity::Fast, Fidelity::Standard, Fidelity::Fine}) {
     const TetMesh mesh = generate_tissue_mesh(paper_a_skin(fidelity, 2));
@@ -238,6 +263,9 @@ TEST(TissueMesh, RejectsBadSpecsWithInputError) {
   EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
   spec = paper_a_skin(Fidelity::Fast, 2);
   spec.sites[0].x = 2e-3;
+  EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
+  spec = paper_a_skin(Fidelity::Fast, 2);
+  spec.criterion_length = -1e-6;
   EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
   EXPECT_THROW(parse_fidelity("ultra"), mneedle::InputError);
   EXPECT_EQ(parse_fidelity("fine"), Fidelity::Fine);

@@ -4,7 +4,6 @@
 // pointwise stress is singular.
 
 #include <Eigen/Core>
-#include <unordered_map>
 #include <vector>
 
 #include "mneedle/fe/tissue_mesh.h"
@@ -25,8 +24,8 @@ double averaged_max_principal_stress(const TetMesh& mesh, const Eigen::VectorXd&
 /// underside), not only at one chosen point. Built once per mesh for the largest search radius
 /// of each site; peak() per displacement, with the radii of that moment.
 /// Each element near a site is split into 64 equal sub-tetrahedra, each carrying the stress at
-/// its centroid; a sub-tetrahedron belongs to a ball when its centroid does (docs/model.md says
-/// what that costs in accuracy).
+/// its centroid and weighed by its volume inside each ball (found once, at construction, by
+/// splitting the sub-tetrahedra the ball's surface cuts; docs/model.md, "Tip stress").
 class PeakStressProbe {
  public:
   /// `sites_xy` (m, reference) with the largest search radius of each; centres deeper than
@@ -47,6 +46,10 @@ class PeakStressProbe {
   /// The nodes whose displacement peak() reads (those of the elements within reach), ascending:
   /// the other entries of `u` may be anything.
   const std::vector<int>& nodes() const { return nodes_; }
+  /// The centres (reference positions, m) and the volume of the layer each one's ball holds
+  /// (m^3; 4/3 pi L^3 for a ball wholly inside the layer, to the weighting's error).
+  std::vector<Eigen::Vector3d> centres() const;
+  std::vector<double> ball_volumes() const;
 
  private:
   struct SubPoint {
@@ -54,12 +57,6 @@ class PeakStressProbe {
     double volume;
     int element;
     int sub;  // index into the subdivision's centroids
-  };
-  // A sub-point or its mirror image across a symmetry plane of the mesh: where a ball looks.
-  struct Image {
-    Eigen::Vector3d x;
-    double volume;
-    int source;  // index into points_
   };
   struct Candidate {
     Eigen::Vector3d x;
@@ -73,12 +70,13 @@ class PeakStressProbe {
   std::vector<int> elements_;  // the layer's elements within reach of a site
   std::vector<int> nodes_;     // their nodes, ascending
   std::vector<SubPoint> points_;
-  std::vector<Image> images_;
   std::vector<double> search_radius_;  // the constructor's, per site
   std::vector<Candidate> candidates_;
-  // Images bucketed on a grid of cell size just above length_m: cell key -> image indices.
-  std::unordered_map<long long, std::vector<int>> buckets_;
-  double cell_ = 0.0;
+  // Each candidate's ball (compressed rows): the sub-points it holds, with the volume of each
+  // (or of its mirror image) inside it; a sub-point may appear twice through its image.
+  std::vector<std::size_t> ball_start_;
+  std::vector<int> ball_source_;
+  std::vector<double> ball_volume_;
 };
 
 }  // namespace mneedle::fe

@@ -53,6 +53,9 @@ struct TissueBlockSpec {
   /// Each set field replaces the fidelity's choice (domain_scale, tolerance and steps are
   /// applied by simulate_3d, not here).
   FidelityOverrides overrides;
+  /// m; the length over which the puncture criterion averages near the sites (the stress
+  /// criterion's L; 0: none). Resolved at every fidelity: mesh_sizing, below.
+  double criterion_length = 0.0;
   /// Mesh only y >= 0 (mirror plane y = 0; the sites and off-axis tips must be symmetric about
   /// it as a set): the result is exactly the y >= 0 part of the full mesh, with mirror_y0 set.
   bool half_y = false;
@@ -69,12 +72,19 @@ struct MeshSizing {
   int elements_through_top = 1;  ///< elements through the (thin, stiff) top layer
 };
 /// Halvings of the grid along the needle's path by local bisection when overrides leave
-/// refinement_levels unset (docs/model.md, "Tissue block and mesh").
-int default_refinement_levels(Fidelity fidelity, int order);
+/// refinement_levels unset (docs/model.md, "Tissue block and mesh"); a criterion length
+/// (m, > 0) asks for at least two with 10-node elements.
+int default_refinement_levels(Fidelity fidelity, int order, double criterion_length = 0.0);
 
-/// Overrides honoured here: tip_size_m (fine_size), growth, elements_through_top.
+/// Widest tip element (TET10; half for TET4) per criterion length: docs/model.md, "Tissue block
+/// and mesh", "The stress criterion's length".
+inline constexpr double kTipElementsPerCriterionLength = 5.5;
+
+/// Overrides honoured here: tip_size_m (fine_size), growth, elements_through_top. A criterion
+/// length (m, > 0) caps the tip element at kTipElementsPerCriterionLength of it, rounded to
+/// the next half-integer node spacing per radius.
 MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, double block_size,
-                       const FidelityOverrides& overrides = {});
+                       const FidelityOverrides& overrides = {}, double criterion_length = 0.0);
 
 /// Tetrahedral mesh. 10-node node order: corners 0-3, then edges 01, 12, 20, 03, 13, 23
 /// (VTK_QUADRATIC_TETRA order); midside nodes are shared between neighbours.
