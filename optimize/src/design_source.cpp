@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <numbers>
 #include <sstream>
 
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
 #include "mneedle/geometry/holder.h"
+#include "mneedle/insertion/analytic_indentation.h"
 #include "mneedle/needle/mesh_io.h"
 #include "mneedle/needle/mesh_validation.h"
 #include "mneedle/needle/needle_frame.h"
@@ -185,6 +187,55 @@ bool maps_onto_itself(const TriangleMesh& mesh, const Vec3& mirror) {
 
 }  // namespace
 
+std::optional<fe::AxisymmetricNeedle> revolution_profile(const TriangleMesh& mesh) {
+  if (mesh.vertices.empty()) return std::nullopt;
+  const BoundingBox box = bounding_box(mesh);
+  const double length = box.max[2] - box.min[2];
+  double widest = 0.0;
+  for (const Vec3& v : mesh.vertices) widest = std::max(widest, std::hypot(v[0], v[1]));
+  if (!(length > 0.0) || !(widest > 0.0)) return std::nullopt;
+  // STL stores single precision: 1e-5 of the needle's size is far above its round-off and far
+  // below any feature a design has.
+  const double radius_tol = 1e-5 * std::max(widest, length), height_tol = radius_tol;
+  struct Polar {
+    double z, r, angle;
+  };
+  std::vector<Polar> points;
+  for (const Vec3& v : mesh.vertices)
+    points.push_back({v[2], std::hypot(v[0], v[1]), std::atan2(v[1], v[0])});
+  std::sort(points.begin(), points.end(), [](const Polar& a, const Polar& b) { return a.z < b.z; });
+  // Each height's vertices off the axis: one radius, all the way round.
+  std::size_t rings = 0;
+  for (std::size_t begin = 0; begin < points.size();) {
+    std::size_t end = begin + 1;
+    while (end < points.size() && points[end].z - points[begin].z <= height_tol) ++end;
+    std::vector<double> angles;
+    double radius = -1.0;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (points[i].r <= radius_tol) continue;
+      if (radius < 0.0) radius = points[i].r;
+      if (std::abs(points[i].r - radius) > radius_tol) return std::nullopt;
+      angles.push_back(points[i].angle);
+    }
+    if (!angles.empty()) {
+      std::sort(angles.begin(), angles.end());
+      double gap = angles.front() + 2.0 * std::numbers::pi - angles.back();
+      for (std::size_t i = 1; i < angles.size(); ++i)
+        gap = std::max(gap, angles[i] - angles[i - 1]);
+      if (gap > kLargestRevolutionGap_rad) return std::nullopt;
+      ++rings;
+    }
+    begin = end;
+  }
+  if (rings == 0) return std::nullopt;
+  // The profile of the section areas, as the analytic path takes a mesh (a faceted circle's
+  // equal-area radius); a flat end (the widest section already at the tip) is a flat punch.
+  fe::AxisymmetricNeedle profile = equivalent_axisymmetric_needle(mesh, length);
+  if (profile.radii_m.front() >= profile.max_radius() * (1.0 - 1e-6))
+    return fe::AxisymmetricNeedle::flat_punch(profile.max_radius());
+  return profile;
+}
+
 bool mirror_symmetric_y0(const TriangleMesh& mesh) {
   return maps_onto_itself(mesh, {1.0, -1.0, 1.0});
 }
@@ -196,7 +247,11 @@ bool mirror_symmetric_x0(const TriangleMesh& mesh) {
 NeedleSymmetry needle_symmetry(const PluginRegistry& registry, const NeedleSource& needle,
                                const std::string& where) {
   NeedleSymmetry s;
+  // A plugin's exact profile where it has one, else the mesh's when it is round: an STL that
+  // `generate` wrote from a plugin then takes the plugin's model (docs/model.md, "Scene
+  // planner", round meshes).
   s.axisymmetric = axisymmetric_profile(registry, needle, where);
+  if (!s.axisymmetric) s.axisymmetric = revolution_profile(needle.mesh);
   s.mirror_y0 = s.axisymmetric.has_value() || mirror_symmetric_y0(needle.mesh);
   s.mirror_x0 = mirror_symmetric_x0(needle.mesh);
   return s;

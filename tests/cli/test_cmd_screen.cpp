@@ -42,8 +42,8 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
   ASSERT_EQ(j["designs"].size(), 4u);
   EXPECT_EQ(j["fidelity"], "fast");
   // What the README says of this table: with the scene's stress criterion every design punctures
-  // at a resolved depth (none at first contact), sharp bevel < cone < blunt bevel < cylinder,
-  // each at the depth the README quotes (fast; standard and fine within 5 %). Pinned to 1 %: the
+  // at a resolved depth (none at first contact), cone < sharp bevel < blunt bevel < cylinder,
+  // each at the depth the README quotes (fast; standard and fine within 6 %). Pinned to 1 %: the
   // run is deterministic, so any move is a change of the model or the mesh to explain
   // (docs/validation.md, "The stress criterion in skin").
   std::map<std::string, nlohmann::json> by_name;
@@ -54,10 +54,10 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
     EXPECT_DOUBLE_EQ(d["target_depth_m"].get<double>(), 200e-6);
     by_name[d["design"].get<std::string>()] = d;
   }
-  const std::vector<std::pair<std::string, double>> readme = {{"sharp_bevel", 65.1e-6},
-                                                              {"cone", 71.7e-6},
+  const std::vector<std::pair<std::string, double>> readme = {{"cone", 62.5e-6},
+                                                              {"sharp_bevel", 65.1e-6},
                                                               {"blunt_bevel", 100.0e-6},
-                                                              {"cylinder", 153.3e-6}};
+                                                              {"cylinder", 148.0e-6}};
   for (std::size_t i = 0; i < readme.size(); ++i) {
     const auto& [name, depth] = readme[i];
     const auto& d = by_name[name];

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -64,6 +65,18 @@ std::optional<fe::AxisymmetricNeedle> axisymmetric_profile(const PluginRegistry&
                                                            const NeedleSource& needle,
                                                            const std::string& where);
 
+/// Largest angle between neighbouring vertices of one ring for a mesh to count as a body of
+/// revolution: 30 deg, twelve facets round (the STLs mneedle writes have 64).
+inline constexpr double kLargestRevolutionGap_rad = std::numbers::pi / 6.0;
+
+/// The profile of a mesh needle (in its needle frame: axis z, tip at z = 0) that is a solid body
+/// of revolution: every height's vertices off the axis lie on one circle, all the way round (no
+/// gap above kLargestRevolutionGap_rad). The profile is that of the mesh's section areas (each
+/// faceted circle's equal-area radius; a flat punch when the end is flat). nullopt otherwise: a
+/// bevel (its rings are open), a hollow needle (two radii at one height), or a mesh that is not
+/// round.
+std::optional<fe::AxisymmetricNeedle> revolution_profile(const TriangleMesh& mesh);
+
 /// True when the mirror image (x, -y, z) of every vertex is a vertex (within 1e-6 of the mesh
 /// size): the needle is symmetric about its y = 0 plane (bevels, bodies of revolution).
 bool mirror_symmetric_y0(const TriangleMesh& mesh);
@@ -73,7 +86,7 @@ bool mirror_symmetric_x0(const TriangleMesh& mesh);
 /// What a needle's shape lets the pre-puncture model reduce (docs/model.md, "Half and quarter
 /// models"): the body-of-revolution profile and the mirror planes through its axis.
 struct NeedleSymmetry {
-  std::optional<fe::AxisymmetricNeedle> axisymmetric;  // cylinder and cone plugins
+  std::optional<fe::AxisymmetricNeedle> axisymmetric;  // cylinder and cone plugins, round meshes
   bool mirror_y0 = false;                              // symmetric about its y = 0 plane
   bool mirror_x0 = false;                              // symmetric about its x = 0 plane
 };
