@@ -24,7 +24,6 @@
 #include "mneedle/design_source.h"
 #include "mneedle/fe/tissue_mesh.h"
 #include "mneedle/geometry/cross_section.h"
-#include "mneedle/insertion/puncture.h"
 #include "mneedle/needle/mesh.h"
 #include "mneedle/needle/mesh_io.h"
 #include "mneedle/optimum_report.h"
@@ -358,7 +357,13 @@ double fixed_tip_size(const Problem& p, const std::vector<DesignVariable>& vars,
   const double block = std::max(p.scene.tissue.size[0], p.scene.tissue.size[1]);
   // The stress criterion's length caps the tip element as in every run (docs/model.md,
   // "Tissue block and mesh").
-  const double length = puncture_threshold(p.scene, p.scene.model.criterion).average_length_m;
+  // A scene without the stress criterion's data has no length (and may have no puncture data at
+  // all: it then runs without a criterion).
+  const auto& layers = p.scene.tissue.layers;
+  const double length = p.scene.model.criterion == PunctureCriterion::Stress && !layers.empty() &&
+                                layers.front().strength
+                            ? layers.front().strength->length
+                            : 0.0;
   return fe::mesh_sizing(p.evaluation.fidelity, 2, max_radius_up_to(n.mesh, depth), block, {},
                          length)
       .fine_size;

@@ -8,8 +8,8 @@
 
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
+#include "mneedle/geometry/cross_section.h"
 #include "mneedle/geometry/holder.h"
-#include "mneedle/insertion/analytic_indentation.h"
 #include "mneedle/needle/mesh_io.h"
 #include "mneedle/needle/mesh_validation.h"
 #include "mneedle/needle/needle_frame.h"
@@ -187,50 +187,103 @@ bool maps_onto_itself(const TriangleMesh& mesh, const Vec3& mirror) {
 
 }  // namespace
 
+namespace {
+
+// The largest angle between neighbouring directions (rad), all the way round; the sum of the
+// sines of the angles between neighbours, which is 2 pi for a circle (the polygon's area is half
+// of it times r^2).
+struct Coverage {
+  double gap = 2.0 * std::numbers::pi;
+  double sine_sum = 0.0;
+};
+
+Coverage coverage(std::vector<double> angles) {
+  Coverage c;
+  if (angles.empty()) return c;
+  std::sort(angles.begin(), angles.end());
+  angles.push_back(angles.front() + 2.0 * std::numbers::pi);
+  c.gap = 0.0;
+  for (std::size_t i = 1; i < angles.size(); ++i) {
+    c.gap = std::max(c.gap, angles[i] - angles[i - 1]);
+    c.sine_sum += std::sin(angles[i] - angles[i - 1]);
+  }
+  return c;
+}
+
+// Twelve facets round give a gap of exactly pi / 6, which round-off puts on either side.
+bool closes_round(const Coverage& c) {
+  return c.gap <= kLargestRevolutionGap_rad * (1.0 + 1e-6);
+}
+
+}  // namespace
+
 std::optional<fe::AxisymmetricNeedle> revolution_profile(const TriangleMesh& mesh) {
-  if (mesh.vertices.empty()) return std::nullopt;
+  if (mesh.vertices.empty() || mesh.triangles.empty()) return std::nullopt;
   const BoundingBox box = bounding_box(mesh);
   const double length = box.max[2] - box.min[2];
   double widest = 0.0;
   for (const Vec3& v : mesh.vertices) widest = std::max(widest, std::hypot(v[0], v[1]));
   if (!(length > 0.0) || !(widest > 0.0)) return std::nullopt;
-  // STL stores single precision: 1e-5 of the needle's size is far above its round-off and far
-  // below any feature a design has.
-  const double radius_tol = 1e-5 * std::max(widest, length), height_tol = radius_tol;
+  // 1e-4 of the needle's size: far above the single precision an STL was written in (even far
+  // from its file's origin), far below any feature a design has.
+  const double tol = 1e-4 * std::max(widest, length);
   struct Polar {
     double z, r, angle;
   };
   std::vector<Polar> points;
   for (const Vec3& v : mesh.vertices)
-    points.push_back({v[2], std::hypot(v[0], v[1]), std::atan2(v[1], v[0])});
+    points.push_back({v[2] - box.min[2], std::hypot(v[0], v[1]), std::atan2(v[1], v[0])});
   std::sort(points.begin(), points.end(), [](const Polar& a, const Polar& b) { return a.z < b.z; });
-  // Each height's vertices off the axis: one radius, all the way round.
-  std::size_t rings = 0;
+  // Each height's vertices off the axis: one radius, all the way round. Its section is the
+  // polygon through them, of area (r^2 / 2) sum sin(angle between neighbours).
+  std::vector<double> heights, radii;
   for (std::size_t begin = 0; begin < points.size();) {
     std::size_t end = begin + 1;
-    while (end < points.size() && points[end].z - points[begin].z <= height_tol) ++end;
+    while (end < points.size() && points[end].z - points[begin].z <= tol) ++end;
     std::vector<double> angles;
     double radius = -1.0;
     for (std::size_t i = begin; i < end; ++i) {
-      if (points[i].r <= radius_tol) continue;
+      if (points[i].r <= tol) continue;
       if (radius < 0.0) radius = points[i].r;
-      if (std::abs(points[i].r - radius) > radius_tol) return std::nullopt;
+      if (std::abs(points[i].r - radius) > tol) return std::nullopt;  // two radii: hollow, stepped
       angles.push_back(points[i].angle);
     }
-    if (!angles.empty()) {
-      std::sort(angles.begin(), angles.end());
-      double gap = angles.front() + 2.0 * std::numbers::pi - angles.back();
-      for (std::size_t i = 1; i < angles.size(); ++i)
-        gap = std::max(gap, angles[i] - angles[i - 1]);
-      if (gap > kLargestRevolutionGap_rad) return std::nullopt;
-      ++rings;
+    heights.push_back(points[begin].z);
+    if (angles.empty()) {
+      radii.push_back(0.0);  // on the axis only: a sharp point
+    } else {
+      const Coverage c = coverage(angles);
+      if (!closes_round(c)) return std::nullopt;
+      radii.push_back(radius * std::sqrt(c.sine_sum / (2.0 * std::numbers::pi)));
     }
     begin = end;
   }
-  if (rings == 0) return std::nullopt;
-  // The profile of the section areas, as the analytic path takes a mesh (a faceted circle's
-  // equal-area radius); a flat end (the widest section already at the tip) is a flat punch.
-  fe::AxisymmetricNeedle profile = equivalent_axisymmetric_needle(mesh, length);
+  // Between two heights the faces must close round the axis too, in one loop: a square pyramid
+  // on a round shaft has round rings and square sections, a sealed cavity two loops.
+  std::optional<CrossSectionSlicer> slicer;
+  try {
+    slicer.emplace(mesh);
+  } catch (const InputError&) {
+    return std::nullopt;  // not a closed surface: the 3-D path says why
+  }
+  for (std::size_t k = 0; k + 1 < heights.size(); ++k) {
+    const CrossSection section = slicer->slice(0.5 * (heights[k] + heights[k + 1]));
+    if (section.polygons.size() != 1) return std::nullopt;
+    std::vector<double> angles;
+    for (const auto& p : section.polygons.front()) angles.push_back(std::atan2(p[1], p[0]));
+    if (!closes_round(coverage(angles))) return std::nullopt;
+  }
+  // The profile through the rings (the faces are straight between them), heights from the tip,
+  // kept non-decreasing (a narrower section above a wider one never meets the tissue first); a
+  // flat end (the widest section already at the tip) is a flat punch.
+  fe::AxisymmetricNeedle profile;
+  double running = 0.0;
+  for (std::size_t k = 0; k < heights.size(); ++k) {
+    running = std::max(running, radii[k]);
+    profile.heights_m.push_back(k == 0 ? 0.0 : heights[k]);
+    profile.radii_m.push_back(running);
+  }
+  if (!(profile.max_radius() > 0.0)) return std::nullopt;
   if (profile.radii_m.front() >= profile.max_radius() * (1.0 - 1e-6))
     return fe::AxisymmetricNeedle::flat_punch(profile.max_radius());
   return profile;

@@ -132,8 +132,8 @@ std::string design_fingerprint(const DesignInput& d) {
 }
 
 // The design's mesh with what lets run_insertion reduce the model: an axisymmetric profile for
-// the cylinder and cone plugins, the x = 0 and y = 0 mirror planes (a vertex lookup) for any mesh:
-// needle_symmetry, as simulate takes them.
+// the cylinder and cone plugins and for round meshes, the x = 0 and y = 0 mirror planes (a vertex
+// lookup) for any mesh: needle_symmetry, as simulate takes them.
 struct ScreenedNeedle {
   TriangleMesh mesh;
   EvaluationOptions options;

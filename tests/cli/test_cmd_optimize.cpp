@@ -61,6 +61,18 @@ TEST(OptimizeCommand, ConeWithItsDefaultSharpPointEvaluatesInSkin) {
   EXPECT_EQ(j["evaluations"].get<int>(), 3);
 }
 
+// A scene without puncture data optimises a force: the tip element's size once asked the scene
+// for its criterion's threshold first, and stopped on "fracture.critical_pressure: missing".
+TEST(OptimizeCommand, ASceneWithoutPunctureDataOptimisesThePeakForce) {
+  const auto run =
+      run_mneedle("optimize --plugin sharp_bevel --scene '" + std::string(MNEEDLE_SOURCE_ROOT) +
+                  "/tests/assets/scenes/axisymmetric_punch.toml' --vary bevel_angle"
+                  " --objective peak-force --model analytic --max-evals 3 --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["evaluations"].get<int>(), 3) << j.dump(2);
+}
+
 TEST(OptimizeCommand, SummaryPrintsParametersInTheirUnits) {
   const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSilicone +
                                "' --vary bevel_angle --bound bevel_angle=15deg:60deg"

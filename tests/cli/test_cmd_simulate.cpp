@@ -188,7 +188,7 @@ TEST(CmdSimulate, PaperAArrayRunsAsAQuarterModelAndReportsEveryNeedle) {
 // explain.
 TEST(CmdSimulate, PaperASkinNeedlesPunctureInPaperAsOrderUnderTheStressCriterion) {
   const std::vector<std::pair<std::string, double>> needles = {
-      {"sharp_bevel", 65.5e-6}, {"blunt_bevel", 101.8e-6}, {"cylinder", 140.9e-6}};
+      {"sharp_bevel", 65.8e-6}, {"blunt_bevel", 101.8e-6}, {"cylinder", 140.9e-6}};
   for (const auto& [needle, depth] : needles) {
     const std::string file =
         std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/paper_a_skin_" + needle + ".toml";

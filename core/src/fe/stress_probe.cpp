@@ -323,27 +323,6 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
         candidates_.push_back(
             {mesh.nodes[i], static_cast<int>(s), (mesh.nodes[i].head<2>() - sites_xy[s]).norm()});
   }
-  // The balls of a half (quarter) model see the mirror image of the meshed part as the whole
-  // block's do: the sub-points within L of a symmetry plane are reflected across it.
-  struct Image {
-    Eigen::Vector3d x;
-    int source;  // index into points_
-    int mirror;  // bit 0: y negated, bit 1: x negated
-  };
-  std::vector<Image> images;
-  for (std::size_t i = 0; i < points_.size(); ++i)
-    images.push_back({points_[i].x, static_cast<int>(i), 0});
-  for (int axis : {1, 0}) {
-    if (!(axis == 1 ? mesh.mirror_y0 : mesh.mirror_x0)) continue;
-    const std::size_t count = images.size();
-    for (std::size_t i = 0; i < count; ++i) {
-      if (images[i].x(axis) >= length_m) continue;
-      Image mirrored = images[i];
-      mirrored.x(axis) = -mirrored.x(axis);
-      mirrored.mirror |= axis == 1 ? 1 : 2;
-      images.push_back(mirrored);
-    }
-  }
   // Each sub-tetrahedron's corners and the farthest corner's distance from its centroid.
   std::vector<std::array<Eigen::Vector3d, 4>> sub_corners(points_.size());
   std::vector<double> sub_reach(points_.size(), 0.0);
@@ -359,6 +338,28 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
       sub_reach[i] = std::max(sub_reach[i], (x - points_[i].x).norm());
     }
     widest = std::max(widest, sub_reach[i]);
+  }
+  // The balls of a half (quarter) model see the mirror image of the meshed part as the whole
+  // block's do: the sub-tetrahedra that reach within L of a symmetry plane are reflected across it.
+  struct Image {
+    Eigen::Vector3d x;
+    int source;  // index into points_
+    int mirror;  // bit 0: y negated, bit 1: x negated
+  };
+  std::vector<Image> images;
+  for (std::size_t i = 0; i < points_.size(); ++i)
+    images.push_back({points_[i].x, static_cast<int>(i), 0});
+  for (int axis : {1, 0}) {
+    if (!(axis == 1 ? mesh.mirror_y0 : mesh.mirror_x0)) continue;
+    const std::size_t count = images.size();
+    for (std::size_t i = 0; i < count; ++i) {
+      if (images[i].x(axis) >= length_m + sub_reach[static_cast<std::size_t>(images[i].source)])
+        continue;
+      Image mirrored = images[i];
+      mirrored.x(axis) = -mirrored.x(axis);
+      mirrored.mirror |= axis == 1 ? 1 : 2;
+      images.push_back(mirrored);
+    }
   }
   // Images bucketed on a grid of cells a hair wider than L plus the widest reach: a
   // sub-tetrahedron that reaches into a ball has its centroid in a neighbouring cell.

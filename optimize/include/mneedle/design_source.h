@@ -60,7 +60,7 @@ NeedleSource needle_from_scene(const PluginRegistry& registry, const NeedleSpec&
 
 /// The outer profile of a body-of-revolution plugin needle (the cylinder and cone plugins),
 /// sampled from the plugin's section area A(h) = pi (r_out^2 - r_bore^2); nullopt for any other
-/// shape. `where` prefixes messages.
+/// shape (round meshes: revolution_profile, below). `where` prefixes messages.
 std::optional<fe::AxisymmetricNeedle> axisymmetric_profile(const PluginRegistry& registry,
                                                            const NeedleSource& needle,
                                                            const std::string& where);
@@ -69,12 +69,13 @@ std::optional<fe::AxisymmetricNeedle> axisymmetric_profile(const PluginRegistry&
 /// revolution: 30 deg, twelve facets round (the STLs mneedle writes have 64).
 inline constexpr double kLargestRevolutionGap_rad = std::numbers::pi / 6.0;
 
-/// The profile of a mesh needle (in its needle frame: axis z, tip at z = 0) that is a solid body
-/// of revolution: every height's vertices off the axis lie on one circle, all the way round (no
-/// gap above kLargestRevolutionGap_rad). The profile is that of the mesh's section areas (each
-/// faceted circle's equal-area radius; a flat punch when the end is flat). nullopt otherwise: a
-/// bevel (its rings are open), a hollow needle (two radii at one height), or a mesh that is not
-/// round.
+/// The profile of a mesh needle (in its needle frame: axis z) that is a solid body of
+/// revolution: every height's vertices off the axis lie on one circle all the way round (no gap
+/// above kLargestRevolutionGap_rad), and half-way between two such heights the faces cut one
+/// loop that goes round too. The profile runs through the rings, each at its polygon's
+/// equal-area radius; a flat punch when the end is flat. nullopt otherwise: a bevel (its rings
+/// are open), a hollow or stepped needle (two radii at one height), a pyramid (square sections),
+/// a sealed cavity (two loops), an open surface.
 std::optional<fe::AxisymmetricNeedle> revolution_profile(const TriangleMesh& mesh);
 
 /// True when the mirror image (x, -y, z) of every vertex is a vertex (within 1e-6 of the mesh

@@ -19,7 +19,8 @@ struct FidelityOverrides {
   std::optional<int> elements_through_top;  ///< elements through the top layer's thickness
   /// 3-D tissue only: the grid is built 2^n coarser at the needle and bisected back to the tip
   /// size along the needle's path (0: the plain tensor grid; at most 6). Unset: TET10 gets 2 at
-  /// standard and fine and 0 at fast, TET4 0 (default_refinement_levels).
+  /// standard and fine and 0 at fast (2 with a criterion length), TET4 0
+  /// (default_refinement_levels).
   std::optional<int> refinement_levels;
 };
 
