@@ -355,10 +355,9 @@ double fixed_tip_size(const Problem& p, const std::vector<DesignVariable>& vars,
   }
   const double depth = p.scene.requirements.target_depth.value_or(p.scene.insertion.depth);
   const double block = std::max(p.scene.tissue.size[0], p.scene.tissue.size[1]);
-  // The stress criterion's length caps the tip element as in every run (docs/model.md,
-  // "Tissue block and mesh").
-  // A scene without the stress criterion's data has no length (and may have no puncture data at
-  // all: it then runs without a criterion).
+  // The stress criterion's length caps the tip element as in every run (docs/model.md, "Tissue
+  // block and mesh"); a scene without the criterion's data has none (it may have no puncture data
+  // at all, and then runs without a criterion).
   const auto& layers = p.scene.tissue.layers;
   const double length = p.scene.model.criterion == PunctureCriterion::Stress && !layers.empty() &&
                                 layers.front().strength

@@ -100,6 +100,22 @@ double tet_volume(const std::array<Eigen::Vector3d, 4>& p) {
   return std::abs((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]))) / 6.0;
 }
 
+// The eight children of the eight-way split (every edge halved; equal volumes), of corners given
+// in any affine coordinates.
+std::array<std::array<Barycentric, 4>, 8> split_in_eight(const std::array<Barycentric, 4>& t) {
+  const auto m = [&](int a, int b) { return Barycentric(0.5 * (t[a] + t[b])); };
+  const Barycentric m01 = m(0, 1), m02 = m(0, 2), m03 = m(0, 3), m12 = m(1, 2), m13 = m(1, 3),
+                    m23 = m(2, 3);
+  return {{{t[0], m01, m02, m03},
+           {m01, t[1], m12, m13},
+           {m02, m12, t[2], m23},
+           {m03, m13, m23, t[3]},
+           {m01, m02, m03, m13},
+           {m01, m02, m12, m13},
+           {m02, m03, m13, m23},
+           {m02, m12, m13, m23}}};
+}
+
 // Integrates over a sub-tetrahedron (four barycentric corners) of the element: whole when it is
 // inside the sphere, skipped when outside, split in eight when cut. The stress of a TET10 is
 // linear in the element, so a 4-point rule per piece, and 1 point for a TET4, is enough.
@@ -118,19 +134,8 @@ void integrate(const ElementField& field, const std::array<Barycentric, 4>& sub,
   const double volume = tet_volume(p);
   const bool inside = farthest <= radius;
   if (!inside && level < kMaxLevel) {
-    std::array<std::array<Barycentric, 4>, 8> children;
-    const auto m = [&](int a, int b) { return Barycentric(0.5 * (sub[a] + sub[b])); };
-    const Barycentric m01 = m(0, 1), m02 = m(0, 2), m03 = m(0, 3), m12 = m(1, 2), m13 = m(1, 3),
-                      m23 = m(2, 3);
-    children = {{{sub[0], m01, m02, m03},
-                 {m01, sub[1], m12, m13},
-                 {m02, m12, sub[2], m23},
-                 {m03, m13, m23, sub[3]},
-                 {m01, m02, m03, m13},
-                 {m01, m02, m12, m13},
-                 {m02, m03, m13, m23},
-                 {m02, m12, m13, m23}}};
-    for (const auto& child : children) integrate(field, child, centre, radius, level + 1, sum);
+    for (const auto& child : split_in_eight(sub))
+      integrate(field, child, centre, radius, level + 1, sum);
     return;
   }
   const Barycentric centroid = 0.25 * (sub[0] + sub[1] + sub[2] + sub[3]);
@@ -192,17 +197,8 @@ std::vector<std::array<Barycentric, 4>> sub_tetrahedra(int levels) {
   for (int level = 0; level < levels; ++level) {
     std::vector<std::array<Barycentric, 4>> next;
     for (const auto& sub : pieces) {
-      const auto m = [&](int a, int b) { return Barycentric(0.5 * (sub[a] + sub[b])); };
-      const Barycentric m01 = m(0, 1), m02 = m(0, 2), m03 = m(0, 3), m12 = m(1, 2), m13 = m(1, 3),
-                        m23 = m(2, 3);
-      next.insert(next.end(), {{sub[0], m01, m02, m03},
-                               {m01, sub[1], m12, m13},
-                               {m02, m12, sub[2], m23},
-                               {m03, m13, m23, sub[3]},
-                               {m01, m02, m03, m13},
-                               {m01, m02, m12, m13},
-                               {m02, m03, m13, m23},
-                               {m02, m12, m13, m23}});
+      const auto children = split_in_eight(sub);
+      next.insert(next.end(), children.begin(), children.end());
     }
     pieces = std::move(next);
   }
@@ -291,8 +287,8 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
     const auto& element = mesh.elements[e];
     const auto [corners, mid, reach] = element_bounds(mesh, e);
     // Within reach of a centre: a ball of radius L about a node no farther than the search
-    // radius from a site and no deeper than the search depth (mirror images lie within L of
-    // the plane, so the meshed part holds every element they come from).
+    // radius from a site and no deeper than the search depth (a mirror image is as far from a
+    // site on the plane as its source, so the meshed part holds every element they come from).
     bool near = mid.z() + reach >= -(search_depth_m + length_m);
     bool beside = false;
     for (std::size_t s = 0; s < sites_xy.size(); ++s)
