@@ -6,12 +6,16 @@
 // Run on demand, never from ctest (finer: several minutes and several GB per needle):
 //   bench_puncture_convergence [--criterion penetration|pressure|energy|stress]
 //       [--no-finer] [--finest] [--refine N] [--tissue silicone|skin] [--frictionless] [--model3d]
+//       [--contact-zone UM]
 //       [--level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]]... [sharp_bevel] [blunt_bevel]
-//       [cylinder]   (none: sharp_bevel)
+//       [cylinder] [cone]   (none: sharp_bevel; cone: a solid 15-degree cone, 230 um, in the
+//       sharp bevel's scene)
 // --refine N: every level's grid built 2^N coarser and bisected back along the needle's path
 // (refinement_levels; 0 is the plain tensor grid; default: the level's, docs/model.md "Tissue
 // block and mesh"); --model3d: the 3-D model even where the planner would run the axisymmetric one;
-// --finest: a level beyond finer (10.5 spacings per radius, growth 1.2).
+// --finest: a level beyond finer (10.5 spacings per radius, growth 1.2); --contact-zone UM: the
+// top layer around the needle's first contact bisected to UM micrometres in the 3-D model
+// (FidelityOverrides::contact_zone_size_m, docs/validation.md "The stress criterion in skin").
 // --level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS] (repeatable): run these levels instead of
 // the fidelities (errors are against the last one listed; --refine does not apply; SPACINGS are
 // TET10 node spacings per radius), each the given fidelity with its tip size, growth,
@@ -56,6 +60,8 @@ struct Options {
   std::string tissue = "silicone";  // paper_a_<tissue>_<needle>.toml
   std::optional<Contact> contact;   // empty: the scene's
   bool full3d = false;              // --model3d: the 3-D model even where the planner would not
+  std::optional<double>
+      contact_zone_m;  // --contact-zone UM: FidelityOverrides::contact_zone_size_m
   std::vector<std::string> needles;
   // --level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]: levels of one's own instead of the
   // fidelities (a fidelity's steps and layers through the top, with node spacings per needle radius
@@ -129,6 +135,8 @@ Options parse(int argc, char** argv) {
       o.finest = true;
     } else if (a == "--model3d") {
       o.full3d = true;
+    } else if (a == "--contact-zone" && i + 1 < argc) {
+      o.contact_zone_m = std::atof(argv[++i]) * 1e-6;
     } else if (a == "--frictionless") {
       o.contact = Contact::Frictionless;
     } else if (a == "--criterion" && i + 1 < argc) {
@@ -145,14 +153,15 @@ Options parse(int argc, char** argv) {
         std::cerr << "bench_puncture_convergence: unknown criterion '" << c << "'\n";
         std::exit(2);
       }
-    } else if (a == "sharp_bevel" || a == "blunt_bevel" || a == "cylinder") {
+    } else if (a == "sharp_bevel" || a == "blunt_bevel" || a == "cylinder" || a == "cone") {
       o.needles.push_back(a);
     } else {
       std::cerr << "usage: bench_puncture_convergence [--criterion C] [--no-finer] [--finest] "
                    "[--refine N] [--tissue silicone|skin] [--frictionless] [--model3d] "
+                   "[--contact-zone UM] "
                    "[--level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]]... [sharp_bevel] "
                    "[blunt_bevel] "
-                   "[cylinder]\n";
+                   "[cylinder] [cone]\n";
       std::exit(a == "--help" || a == "-h" ? 0 : 2);
     }
   }
@@ -175,6 +184,7 @@ std::vector<Level> levels(const Scene& scene, const PreparedNeedle& needle, cons
     r.contact = o.contact.value_or(scene.model.contact);
     r.criterion = o.criterion;
     r.overrides.refinement_levels = o.refine;
+    r.overrides.contact_zone_size_m = o.contact_zone_m;
     if (o.full3d) r.model = PreModel::Full3d;
     return r;
   };
@@ -327,9 +337,18 @@ int main(int argc, char** argv) {
   try {
     const PluginRegistry registry = PluginRegistry::discover();
     for (const std::string& needle : options.needles) {
-      const fs::path file = fs::path(MNEEDLE_SOURCE_ROOT) / "designs" / "scenes" /
-                            ("paper_a_" + options.tissue + "_" + needle + ".toml");
-      const Scene scene = load_scene(file);
+      // "cone": the sharp bevel's scene with paper A's needle replaced by a solid 15-degree cone
+      // of the same diameter (a pointed tip on the axis, solved in 3-D with --model3d).
+      const bool cone = needle == "cone";
+      const fs::path file =
+          fs::path(MNEEDLE_SOURCE_ROOT) / "designs" / "scenes" /
+          ("paper_a_" + options.tissue + "_" + (cone ? "sharp_bevel" : needle) + ".toml");
+      Scene scene = load_scene(file);
+      if (cone)
+        scene.needles.front().geometry = PluginGeometry{"cone",
+                                                        {{"diameter", parse_quantity("230 um")},
+                                                         {"length", parse_quantity("1000 um")},
+                                                         {"half_angle", parse_quantity("15 deg")}}};
       const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene);
       std::vector<Outcome> runs;
       for (const Level& l : levels(scene, needles.front(), options)) {

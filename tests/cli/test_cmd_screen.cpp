@@ -45,7 +45,8 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
   // at a resolved depth (none at first contact), cone < sharp bevel < blunt bevel < cylinder,
   // each at the depth the README quotes (fast; standard and fine within 6 %). Pinned to 1 %: the
   // run is deterministic, so any move is a change of the model or the mesh to explain
-  // (docs/validation.md, "The stress criterion in skin").
+  // (docs/validation.md, "The stress criterion in skin"; the cone moved 62.3 -> 62.8 um with the
+  // pointed-tip mesh rule of the axisymmetric model, docs/model.md "Mesh").
   std::map<std::string, nlohmann::json> by_name;
   for (const auto& d : j["designs"]) {
     EXPECT_TRUE(d["ok"].get<bool>()) << d.dump();
@@ -54,7 +55,7 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
     EXPECT_DOUBLE_EQ(d["target_depth_m"].get<double>(), 200e-6);
     by_name[d["design"].get<std::string>()] = d;
   }
-  const std::vector<std::pair<std::string, double>> readme = {{"cone", 62.3e-6},
+  const std::vector<std::pair<std::string, double>> readme = {{"cone", 62.8e-6},
                                                               {"sharp_bevel", 65.4e-6},
                                                               {"blunt_bevel", 100.0e-6},
                                                               {"cylinder", 148.0e-6}};

@@ -1002,12 +1002,29 @@ AxisymmetricMeshOptions mesh_options_for(const AxisymmetricProblem& problem) {
   const FidelityOverrides& ov = problem.overrides;
   AxisymmetricMeshOptions o;
   o.radius_m = problem.radius_m * ov.domain_scale.value_or(1.0);
-  o.h_m = std::min(ov.tip_size_m.value_or(a / per_radius), o.radius_m);
+  double h = a / per_radius;
+  o.h_m = std::min(ov.tip_size_m.value_or(h), o.radius_m);
   o.fine_radius_m = 2.0 * a;
   // Total Lagrangian: the captured nodes sit on the reference surface, so the fine zone is the
   // reference neighbourhood of the footprint (a deep, slender needle does not need a fine
   // column down to its depth); below it the rows grow geometrically.
   o.fine_depth_m = std::min(problem.depth_m, a) + a;
+  // A pointed needle under the stress criterion loads the top layer at one point until it
+  // breaks: the layer's underside below it reads the averaged stress only with elements a
+  // fraction of L (docs/model.md, "Axisymmetric mesh"), near the axis.
+  const double length = problem.stress_average_length_m;
+  if (length > 0.0 && !ov.tip_size_m && !needle.radii_m.empty() && needle.radii_m.front() == 0.0 &&
+      !problem.layers.empty()) {
+    const double per_length = problem.fidelity == Fidelity::Fast   ? 2.0
+                              : problem.fidelity == Fidelity::Fine ? 8.0
+                                                                   : 4.0;
+    const double h_length = std::max(length / per_length, o.h_m / 8.0);
+    if (h_length < o.h_m) {
+      o.h_m = h_length;
+      const double reach = problem.layers.front().thickness_m + 2.0 * length;
+      o.fine_radius_m = std::min(o.fine_radius_m, std::max(reach, 8.0 * h_length));
+    }
+  }
   o.growth = ov.growth.value_or(growth);
   o.max_size_m = o.radius_m / 8.0;
   o.elements_through_top = ov.elements_through_top.value_or(0);

@@ -128,6 +128,24 @@ struct AxisymmetricModel::Impl {
   std::vector<char> pair_closed;
   std::vector<std::array<int, 4>> pair_slots;
 
+  // The stress criterion's balls (AxisymmetricModel::peak_averaged_max_principal_stress), built
+  // once per averaging length, layer and search radius: the sub-points of the layer's elements
+  // within reach and, per centre, each sub-point's weight 2 pi r dA x the fraction of its ring
+  // inside the ball. Only the stresses change from call to call. A cache in a const method: a
+  // model is used by one thread at a time.
+  struct StressBalls {
+    double length = 0.0;
+    double radius = -1.0;
+    int layer = -1;
+    std::vector<std::size_t> element;   // per sub-point
+    std::vector<axi::PointData> point;  // per sub-point
+    std::vector<double> centre_r;       // per centre (nodes of the layer, r <= radius)
+    std::vector<std::size_t> start;     // per centre + 1: its entries
+    std::vector<std::uint32_t> source;  // per entry: the sub-point
+    std::vector<double> weight;         // per entry
+  };
+  mutable StressBalls balls;
+
   void precompute_geometry();
   void build_pattern();
   void element(std::size_t e, const Eigen::VectorXd& u, axi::Vector12& f, axi::Matrix12* k,

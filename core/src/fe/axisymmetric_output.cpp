@@ -143,46 +143,72 @@ double AxisymmetricModel::peak_averaged_max_principal_stress(const Eigen::Vector
   if (!(length_m > 0.0)) throw InputError("stress average: length must be > 0 m");
   if (!(search_radius_m >= 0.0)) throw InputError("stress average: search radius must be >= 0 m");
   const Impl& m = *impl_;
-  static const std::vector<Eigen::Vector2d> kSub = sub_centroids(4);
-  struct SubPoint {
-    Eigen::Vector2d x;
-    double weight, stress;
-  };
-  std::vector<SubPoint> points;
-  std::vector<char> centre(m.mesh.nodes.size(), 0);
-  const Material& material = m.materials[layer];
-  for (std::size_t e = 0; e < m.mesh.elements.size(); ++e) {
-    if (m.mesh.element_layer[e] != layer) continue;
-    const auto& nodes = m.mesh.elements[e];
-    double r_min = std::numeric_limits<double>::infinity();
-    for (int a = 0; a < 3; ++a) r_min = std::min(r_min, m.mesh.nodes[nodes[a]].x());
-    if (r_min > search_radius_m + length_m) continue;
-    for (const Eigen::Vector2d& c : kSub) {
-      const PointData p = point_data(m.mesh, nodes, c.x(), c.y(), 1.0 / kSub.size());
-      Eigen::Vector2d X = Eigen::Vector2d::Zero();
-      for (int a = 0; a < kNodes; ++a) X += p.N[a] * m.mesh.nodes[nodes[a]];
-      const Eigen::Matrix3d F = deformation_gradient(p, u, nodes);
-      points.push_back({X, p.w, max_principal(cauchy_stress(material, F, nullptr))});
+  Impl::StressBalls& b = m.balls;
+  if (b.length != length_m || b.layer != layer || b.radius < search_radius_m) {
+    // Built for half as far again, so that a search radius growing with the depth rebuilds the
+    // balls a few times per insertion, not at every step.
+    b = Impl::StressBalls{};
+    b.length = length_m;
+    b.layer = layer;
+    b.radius = 1.5 * search_radius_m;
+    static const std::vector<Eigen::Vector2d> kSub = sub_centroids(4);
+    struct SubPoint {
+      Eigen::Vector2d x;
+      double weight;
+      std::uint32_t index;
+    };
+    std::vector<SubPoint> points;
+    std::vector<char> centre(m.mesh.nodes.size(), 0);
+    for (std::size_t e = 0; e < m.mesh.elements.size(); ++e) {
+      if (m.mesh.element_layer[e] != layer) continue;
+      const auto& nodes = m.mesh.elements[e];
+      double r_min = std::numeric_limits<double>::infinity();
+      for (int a = 0; a < 3; ++a) r_min = std::min(r_min, m.mesh.nodes[nodes[a]].x());
+      if (r_min > b.radius + length_m) continue;
+      for (const Eigen::Vector2d& c : kSub) {
+        const PointData p = point_data(m.mesh, nodes, c.x(), c.y(), 1.0 / kSub.size());
+        Eigen::Vector2d X = Eigen::Vector2d::Zero();
+        for (int a = 0; a < kNodes; ++a) X += p.N[a] * m.mesh.nodes[nodes[a]];
+        points.push_back({X, p.w, static_cast<std::uint32_t>(b.point.size())});
+        b.element.push_back(e);
+        b.point.push_back(p);
+      }
+      for (std::uint32_t n : nodes)
+        if (m.mesh.nodes[n].x() <= b.radius) centre[n] = 1;
     }
-    for (std::uint32_t n : nodes)
-      if (m.mesh.nodes[n].x() <= search_radius_m) centre[n] = 1;
+    // Sub-points sorted by r: each centre scans the band |r - r_c| <= length_m.
+    std::sort(points.begin(), points.end(),
+              [](const SubPoint& p, const SubPoint& q) { return p.x.x() < q.x.x(); });
+    b.start.push_back(0);
+    for (std::size_t n = 0; n < centre.size(); ++n) {
+      if (!centre[n]) continue;
+      const Eigen::Vector2d& c = m.mesh.nodes[n];
+      auto it = std::lower_bound(points.begin(), points.end(), c.x() - length_m,
+                                 [](const SubPoint& p, double r) { return p.x.x() < r; });
+      for (; it != points.end() && it->x.x() <= c.x() + length_m; ++it) {
+        const double fraction = ring_fraction_in_ball(it->x, c, length_m);
+        if (fraction <= 0.0) continue;
+        b.source.push_back(it->index);
+        b.weight.push_back(fraction * it->weight);
+      }
+      b.centre_r.push_back(c.x());
+      b.start.push_back(b.source.size());
+    }
   }
-  // Sub-points sorted by r: each centre scans the band |r - r_c| <= length_m.
-  std::sort(points.begin(), points.end(),
-            [](const SubPoint& a, const SubPoint& b) { return a.x.x() < b.x.x(); });
+  const Material& material = m.materials[layer];
+  std::vector<double> stress(b.point.size());
+  for (std::size_t i = 0; i < b.point.size(); ++i) {
+    const Eigen::Matrix3d F = deformation_gradient(b.point[i], u, m.mesh.elements[b.element[i]]);
+    stress[i] = max_principal(cauchy_stress(material, F, nullptr));
+  }
   double best = 0.0;
   bool found = false;
-  for (std::size_t n = 0; n < centre.size(); ++n) {
-    if (!centre[n]) continue;
-    const Eigen::Vector2d& c = m.mesh.nodes[n];
-    auto it = std::lower_bound(points.begin(), points.end(), c.x() - length_m,
-                               [](const SubPoint& p, double r) { return p.x.x() < r; });
+  for (std::size_t k = 0; k < b.centre_r.size(); ++k) {
+    if (b.centre_r[k] > search_radius_m) continue;
     double weighted = 0.0, volume = 0.0;
-    for (; it != points.end() && it->x.x() <= c.x() + length_m; ++it) {
-      const double fraction = ring_fraction_in_ball(it->x, c, length_m);
-      if (fraction <= 0.0) continue;
-      weighted += fraction * it->weight * it->stress;
-      volume += fraction * it->weight;
+    for (std::size_t j = b.start[k]; j < b.start[k + 1]; ++j) {
+      weighted += b.weight[j] * stress[b.source[j]];
+      volume += b.weight[j];
     }
     if (!(volume > 0.0)) continue;
     const double mean = weighted / volume;

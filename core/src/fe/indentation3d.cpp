@@ -1479,6 +1479,8 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
     tips.push_back(axis + shape.first_contact_xy(1e-9));
     fe::NeedleSite site{needle.x, needle.y, shape.max_radius_up_to(options.depth), std::nullopt};
     if ((tips.back() - axis).norm() > 1e-3 * site.radius) site.tip = tips.back();
+    for (const Eigen::Vector2d& corner : shape.first_contact_outline(1e-9))
+      site.first_contact.push_back(axis + corner);
     block.sites.push_back(site);
   }
   std::vector<Eigen::Vector2d> first_contact;  // of the kept needles

@@ -7,6 +7,7 @@
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/boost/graph/helpers.h>
+#include <CGAL/convex_hull_2.h>
 
 #include <algorithm>
 #include <cmath>
@@ -168,6 +169,19 @@ Eigen::Vector2d NeedleShape::first_contact_xy(double tolerance) const {
       ++count;
     }
   return sum / count;
+}
+
+std::vector<Eigen::Vector2d> NeedleShape::first_contact_outline(double tolerance) const {
+  double lowest = std::numeric_limits<double>::max();
+  for (const Eigen::Vector3d& v : impl_->vertices) lowest = std::min(lowest, v.z());
+  std::vector<CgalKernel::Point_2> points;
+  for (const Eigen::Vector3d& v : impl_->vertices)
+    if (v.z() <= lowest + tolerance) points.emplace_back(v.x(), v.y());
+  std::vector<CgalKernel::Point_2> hull;
+  CGAL::convex_hull_2(points.begin(), points.end(), std::back_inserter(hull));
+  std::vector<Eigen::Vector2d> outline;
+  for (const auto& p : hull) outline.emplace_back(p.x(), p.y());
+  return outline;
 }
 
 }  // namespace mneedle::fe

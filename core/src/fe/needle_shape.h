@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <vector>
 
 #include "mneedle/needle/mesh.h"
 
@@ -44,6 +45,9 @@ class NeedleShape {
   /// Mean (x, y) of the lowest vertices (within `tolerance` of the lowest z): where the needle
   /// first touches a flat surface, needle frame.
   Eigen::Vector2d first_contact_xy(double tolerance) const;
+  /// Convex hull (x, y) of the same lowest vertices, counter-clockwise, needle frame: one point
+  /// for a pointed tip, a polygon for a flat end.
+  std::vector<Eigen::Vector2d> first_contact_outline(double tolerance) const;
 
  private:
   struct Impl;

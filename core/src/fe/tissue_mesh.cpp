@@ -42,6 +42,9 @@ void validate(const TissueBlockSpec& spec) {
       (*spec.overrides.refinement_levels < 0 ||
        *spec.overrides.refinement_levels > kMaxRefinementLevels))
     bad_spec("overrides.refinement_levels", "must be 0 to " + std::to_string(kMaxRefinementLevels));
+  if (spec.overrides.contact_zone_size_m && (!(*spec.overrides.contact_zone_size_m > 0.0) ||
+                                             !std::isfinite(*spec.overrides.contact_zone_size_m)))
+    bad_spec("overrides.contact_zone_size_m", "must be positive and finite");
   for (const NeedleSite& site : spec.sites) {
     if (!(site.radius > 0.0)) bad_spec("needle radius", "must be positive");
     if (std::abs(site.x) >= spec.size_x / 2 || std::abs(site.y) >= spec.size_y / 2)
@@ -56,11 +59,48 @@ double graded_size(double distance_outside, const MeshSizing& sizing) {
   return std::min(size, sizing.max_size);
 }
 
+// Distance (m) from q to a convex counter-clockwise outline: 0 inside, to the point or segment
+// for one or two vertices.
+double distance_to_outline(const Eigen::Vector2d& q, const std::vector<Eigen::Vector2d>& outline) {
+  const std::size_t n = outline.size();
+  if (n == 1) return (q - outline[0]).norm();
+  bool inside = n >= 3;
+  double nearest = std::numeric_limits<double>::max();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& a = outline[i];
+    const Eigen::Vector2d& b = outline[(i + 1) % n];
+    const Eigen::Vector2d edge = b - a;
+    if (edge.x() * (q - a).y() - edge.y() * (q - a).x() < 0.0) inside = false;
+    const double t = std::clamp((q - a).dot(edge) / std::max(edge.squaredNorm(), 1e-300), 0.0, 1.0);
+    nearest = std::min(nearest, (a + t * edge - q).norm());
+  }
+  return inside ? 0.0 : nearest;
+}
+
+// The top layer around each needle's first contact (its outline, or its whole end face when
+// the outline is unknown), with elements of at most `size` (m; 0: no zone):
+// FidelityOverrides::contact_zone_size_m.
+struct ContactZone {
+  double size = 0.0;
+  double radius = 0.0;  ///< m, lateral reach beyond the outline (or beyond the needle's radius)
+  double depth = 0.0;   ///< m, below the surface
+};
+
+ContactZone contact_zone(const TissueBlockSpec& spec) {
+  ContactZone zone;
+  if (!spec.overrides.contact_zone_size_m || spec.layers.empty()) return zone;
+  zone.size = *spec.overrides.contact_zone_size_m;
+  zone.radius = 3.0 * std::max(zone.size, spec.criterion_length);
+  zone.depth = std::min(spec.layers.front().thickness, 2.0 * zone.radius);
+  return zone;
+}
+
 // Element size wanted at p (m) when the grid is refined along the needles' paths: the fine size
 // within fine_half_width of a needle's axis and above the insertion depth, growing by `growth`
 // per element with the distance from that cylinder (the tensor grid's grading, made radial).
 double refinement_target(const Eigen::Vector3d& p, const std::vector<NeedleSite>& sites,
-                         const MeshSizing& sizing, double insertion_depth) {
+                         const MeshSizing& sizing, double insertion_depth,
+                         const ContactZone& zone) {
   const double below = -p.z() - insertion_depth;
   auto from_axis = [&](double x, double y) {
     const double lateral = std::hypot(p.x() - x, p.y() - y) - sizing.fine_half_width;
@@ -69,6 +109,19 @@ double refinement_target(const Eigen::Vector3d& p, const std::vector<NeedleSite>
   if (sites.empty()) return from_axis(0.0, 0.0);
   double size = sizing.max_size;
   for (const NeedleSite& site : sites) size = std::min(size, from_axis(site.x, site.y));
+  if (zone.size > 0.0) {
+    // Distance outside the zone, graded from the zone's size at the sizing's growth.
+    MeshSizing graded = sizing;
+    graded.fine_size = zone.size;
+    const double under = -p.z() - zone.depth;
+    for (const NeedleSite& site : sites) {
+      const double lateral =
+          (site.first_contact.empty() ? std::hypot(p.x() - site.x, p.y() - site.y) - site.radius
+                                      : distance_to_outline(p.head<2>(), site.first_contact)) -
+          zone.radius;
+      size = std::min(size, graded_size(std::max(lateral, under), graded));
+    }
+  }
   return size;
 }
 
@@ -602,13 +655,14 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
     split_cells(axes, cell_layer, mirrored[0], mirrored[1],
                 [&](const std::array<int, 4>& path, int layer) { add_element(mesh, path, layer); });
   } else {
+    const ContactZone zone = contact_zone(spec);
     TetBisection bisection(std::move(mesh.nodes));
     split_cells(
         axes, cell_layer, mirrored[0], mirrored[1],
         [&](const std::array<int, 4>& path, int layer) { bisection.add_kuhn_tet(path, layer); });
     bisection.refine(
         [&](const Eigen::Vector3d& p) {
-          return refinement_target(p, spec.sites, sizing, spec.insertion_depth);
+          return refinement_target(p, spec.sites, sizing, spec.insertion_depth, zone);
         },
         kMaxRefinedTets);
     mesh.nodes = bisection.nodes();

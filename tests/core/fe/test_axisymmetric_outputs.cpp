@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -59,6 +60,42 @@ TEST(AxisymmetricOverrides, TipSizeGrowthDomainAndStepsAreHonoured) {
   p.overrides.steps = 3;
   p.overrides.order = 2;
   EXPECT_EQ(simulate_axisymmetric(p).steps.size(), 3u);
+}
+
+// Under the stress criterion a pointed needle's tip element is a fraction of L near the axis
+// (fast L/2, standard L/4, fine L/8; at most three halvings below the usual size): a point load
+// on a 20 um stratum corneum reads the averaged stress at its underside only with elements well
+// below the layer's thickness (docs/model.md, "Axisymmetric mesh"). A flat end and an explicit
+// tip size are left alone.
+TEST(AxisymmetricOverrides, AStressLengthSizesAPointedTipToAFractionOfItNearTheAxis) {
+  AxisymmetricProblem p;
+  p.layers = {{20e-6, material(MaterialModel::Linear, 1e9, 0.4)},
+              {1e-3, material(MaterialModel::Linear, 1e5, 0.4)}};
+  p.radius_m = 1.5e-3;
+  p.needle = AxisymmetricNeedle::cone(15.0 * std::numbers::pi / 180.0, 115e-6);
+  p.depth_m = 200e-6;
+  const double length = 10e-6;
+  for (const auto& [fidelity, per_length] :
+       {std::pair{Fidelity::Fast, 2.0}, {Fidelity::Standard, 4.0}, {Fidelity::Fine, 8.0}}) {
+    p.fidelity = fidelity;
+    p.stress_average_length_m = 0.0;
+    const AxisymmetricMeshOptions plain = mesh_options_for(p);
+    p.stress_average_length_m = length;
+    const AxisymmetricMeshOptions o = mesh_options_for(p);
+    EXPECT_DOUBLE_EQ(o.h_m, std::max(length / per_length, plain.h_m / 8.0)) << per_length;
+    EXPECT_LT(o.h_m, plain.h_m);
+    EXPECT_DOUBLE_EQ(o.fine_radius_m,
+                     std::min(plain.fine_radius_m, std::max(20e-6 + 2.0 * length, 8.0 * o.h_m)));
+    EXPECT_DOUBLE_EQ(o.fine_depth_m, plain.fine_depth_m);
+  }
+  p.fidelity = Fidelity::Standard;
+  p.overrides.tip_size_m = 7e-6;
+  EXPECT_DOUBLE_EQ(mesh_options_for(p).h_m, 7e-6);
+  p.overrides = {};
+  p.needle = AxisymmetricNeedle::flat_punch(115e-6, 45e-6);
+  const AxisymmetricMeshOptions flat = mesh_options_for(p);
+  p.stress_average_length_m = 0.0;
+  EXPECT_DOUBLE_EQ(flat.h_m, mesh_options_for(p).h_m);
 }
 
 TEST(AxisymmetricOverrides, LinearOrderAndBadValuesAreRejected) {
@@ -222,6 +259,39 @@ TEST(AxisymmetricPeakStress, PeakIsTheLargestCentreMeanWithinTheRadius) {
   }
   ASSERT_GT(largest, 0.0);
   EXPECT_NEAR(fe.peak_averaged_max_principal_stress(u, radius, length, 0), largest, 0.02 * largest);
+}
+
+// The balls are built once per length, layer and search radius and reused: the same peak as a
+// model that builds them afresh for each call, to round-off (the sums are the same; only their
+// order may differ), whether the radius then shrinks, grows within the built reach or beyond it.
+TEST(AxisymmetricPeakStress, ReusedBallsGiveWhatFreshBallsGive) {
+  const MaterialParameters m = material(MaterialModel::Linear, 1e5, 0.0);
+  AxisymmetricModel reused = small_model(m);
+  const AxisymmetricMesh& mesh = reused.mesh();
+  const double c = 10.0, k = -10.0, length = 1e-4;
+  std::vector<std::uint32_t> dofs;
+  std::vector<double> values;
+  for (std::uint32_t node = 0; node < mesh.nodes.size(); ++node) {
+    const double r = mesh.nodes[node].x(), z = mesh.nodes[node].y();
+    dofs.insert(dofs.end(), {2 * node, 2 * node + 1});
+    values.insert(values.end(), {c * r * r, 0.5 * k * z * z});
+  }
+  const Eigen::VectorXd u =
+      reused
+          .solve(dofs, Eigen::Map<const Eigen::VectorXd>(values.data(), values.size()),
+                 Eigen::VectorXd::Zero(reused.dof_count()))
+          .displacement;
+  for (double radius : {2e-4, 1e-4, 2.5e-4, 6e-4, 0.0}) {
+    const double fresh = small_model(m).peak_averaged_max_principal_stress(u, radius, length, 0);
+    ASSERT_GT(fresh, 0.0) << radius;
+    EXPECT_NEAR(reused.peak_averaged_max_principal_stress(u, radius, length, 0), fresh,
+                1e-12 * fresh)
+        << "radius " << radius;
+  }
+  // A new length or layer rebuilds them.
+  const double other = small_model(m).peak_averaged_max_principal_stress(u, 2e-4, 0.5 * length, 0);
+  EXPECT_NEAR(reused.peak_averaged_max_principal_stress(u, 2e-4, 0.5 * length, 0), other,
+              1e-12 * other);
 }
 
 // The peak averages over a ball, as the 3-D probe does, not over a disc in (r, z) (a torus round

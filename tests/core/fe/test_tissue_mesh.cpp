@@ -340,6 +340,47 @@ TEST(TissueMesh, RefinementReachesTheTipSizeAtTheSiteWithFewerNodes) {
   EXPECT_LT(refined.nodes.size(), plain.nodes.size());
 }
 
+// The convergence study's contact zone (docs/model.md, "Tissue block and mesh"): the top layer
+// within 3 max(size, L) of the first contact is bisected down to the size; elsewhere the mesh
+// is refined only as before (more nodes, every zone element no wider than the size).
+TEST(TissueMesh, AContactZoneRefinesTheTopLayerAroundTheFirstContactOnly) {
+  const Eigen::Vector2d contact(-115e-6, 0.0);
+  auto spec = refined_skin(2);
+  spec.sites.front().tip = contact;
+  spec.sites.front().first_contact = {contact};
+  spec.criterion_length = 10e-6;
+  const TetMesh plain = generate_tissue_mesh(spec);
+  spec.overrides.contact_zone_size_m = 8e-6;
+  const TetMesh zoned = generate_tissue_mesh(spec);
+  // Bounding-box extent of the layer-0 elements whose centroid lies within `reach` of the
+  // contact (laterally), largest of them.
+  auto widest_near = [&](const TetMesh& m, double reach) {
+    double widest = 0.0;
+    for (std::size_t e = 0; e < m.elements.size(); ++e) {
+      if (m.element_layer[e] != 0) continue;
+      Eigen::Vector3d lo = m.nodes[static_cast<std::size_t>(m.elements[e][0])], hi = lo, mid;
+      mid.setZero();
+      for (int a = 0; a < 4; ++a) {
+        const Eigen::Vector3d& p = m.nodes[static_cast<std::size_t>(m.elements[e][a])];
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+        mid += 0.25 * p;
+      }
+      if ((mid.head<2>() - contact).norm() <= reach)
+        widest = std::max(widest, (hi - lo).maxCoeff());
+    }
+    return widest;
+  };
+  const double zone_radius = 3.0 * 10e-6;
+  EXPECT_LE(widest_near(zoned, zone_radius - 8e-6), 8e-6 * (1.0 + 1e-9));
+  EXPECT_GT(widest_near(plain, zone_radius - 8e-6), 8e-6);
+  EXPECT_GT(zoned.nodes.size(), plain.nodes.size());
+  // Far from the contact (beyond the zone's grading) the top layer is the plain mesh's.
+  EXPECT_DOUBLE_EQ(widest_near(zoned, 1500e-6), widest_near(plain, 1500e-6));
+  spec.overrides.contact_zone_size_m = -1.0;
+  EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
+}
+
 TEST(TissueMesh, RefinedMeshIsMirrorSymmetricAndItsQuarterIsThePositivePart) {
   TissueBlockSpec spec = refined_skin(2);
   const TetMesh full = generate_tissue_mesh(spec);

@@ -22,6 +22,11 @@ struct FidelityOverrides {
   /// standard and fine and 0 at fast (2 with a criterion length), TET4 0
   /// (default_refinement_levels).
   std::optional<int> refinement_levels;
+  /// 3-D tissue with refinement levels: the top layer around each needle's first contact (its
+  /// lowest points) is bisected down to this element size, within three times the larger of it
+  /// and the criterion length of that contact (docs/model.md, "Tissue block and mesh"; a
+  /// convergence study's knob, unset in every fidelity).
+  std::optional<double> contact_zone_size_m;
 };
 
 /// Largest refinement_levels: each level halves the element size along the needle's path, and

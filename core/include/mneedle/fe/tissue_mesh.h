@@ -38,6 +38,10 @@ struct NeedleSite {
   /// Where the needle first touches the surface when that is off its axis (a bevel's tip), m:
   /// the grid gets lines through it too.
   std::optional<Eigen::Vector2d> tip;
+  /// Convex outline (x, y; m, block frame) of the needle's lowest points, counter-clockwise: one
+  /// point for a pointed tip, a polygon for a flat end; empty: unknown. Under a criterion length
+  /// the top layer is refined around it (docs/model.md, "Tissue block and mesh").
+  std::vector<Eigen::Vector2d> first_contact;
 };
 
 /// The block spans x in [-size_x/2, size_x/2], y likewise and z in [-total thickness, 0]; the top
