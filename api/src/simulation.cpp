@@ -55,6 +55,7 @@ nlohmann::json point_json(const RunPoint& p, std::optional<PunctureCriterion> cr
     j["alpha_N"] = p.alpha_N;
     j["beta_N"] = p.beta_N;
     j["friction_N"] = p.friction_N;
+    j["collar_N"] = p.collar_N;
   }
   return j;
 }

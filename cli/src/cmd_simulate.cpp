@@ -65,7 +65,7 @@ void print_csv(const InsertionRun& run) {
   std::cout << provenance_comment() << "\n";
   std::cout << "depth_m,force_N,stage,lateral_force_x_N,lateral_force_y_N,contact_area_m2,"
                "contact_pressure_Pa,section_area_m2,section_pressure_Pa,strain_energy_J,alpha_N,"
-               "beta_N,friction_N,needle\n";
+               "beta_N,friction_N,collar_N,needle\n";
   std::cout << std::setprecision(9);
   auto rows = [](const std::vector<RunPoint>& curve, const std::string& name) {
     for (const RunPoint& p : curve)
@@ -73,7 +73,7 @@ void print_csv(const InsertionRun& run) {
                 << p.lateral_force_N[0] << "," << p.lateral_force_N[1] << "," << p.contact_area_m2
                 << "," << p.contact_pressure_Pa << "," << p.section_area_m2 << ","
                 << p.section_pressure_Pa << "," << p.strain_energy_J << "," << p.alpha_N << ","
-                << p.beta_N << "," << p.friction_N << "," << name << "\n";
+                << p.beta_N << "," << p.friction_N << "," << p.collar_N << "," << name << "\n";
   };
   for (const NeedleRun& n : run.needles) rows(n.curve, n.name);
   if (run.needles.size() > 1) rows(run.total_curve, "total");

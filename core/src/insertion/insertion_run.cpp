@@ -551,6 +551,37 @@ RunPoint interpolated_point(const std::vector<RunPoint>& points, double depth) {
   return points.empty() ? RunPoint{} : points.back();
 }
 
+// The post-puncture point at `depth` when the stress criterion broke a stiff top layer over
+// softer ones (docs/model.md, "The broken top layer"): the layer stays gripped to the shaft and is
+// dragged down, so the tissue keeps the deformation it had before the puncture, the force rising
+// at the pre-puncture stiffness from the puncture force, until that needs more than the layer's
+// grip, its own distributed loads (wedge and friction, capped at its strength); then it slides
+// and carries its grip. The layers below carry their distributed loads throughout.
+RunPoint gripped_point(const SurfaceLoadModel& model, double depth, double puncture_depth,
+                       double puncture_force, double stiffness) {
+  std::vector<LoadSample> layers;
+  const LoadSample total = model.at(depth, &layers);
+  const LoadSample& top = layers.front();
+  RunPoint p;
+  p.depth_m = depth;
+  p.stage = Stage::Post;
+  const double held = puncture_force + stiffness * (depth - puncture_depth);
+  const double below = total.force_N - top.force_N;
+  const double share = std::clamp(held - below, 0.0, top.force_N);
+  if (share >= top.force_N) {  // sliding: every layer's distributed loads
+    p.alpha_N = total.alpha_N;
+    p.beta_N = total.beta_N;
+    p.friction_N = total.friction_N;
+  } else {
+    p.alpha_N = total.alpha_N - top.alpha_N;
+    p.beta_N = total.beta_N - top.beta_N;
+    p.friction_N = total.friction_N - top.friction_N;
+    p.collar_N = share;
+  }
+  p.force_N = p.alpha_N + p.beta_N + p.friction_N + p.collar_N;
+  return p;
+}
+
 NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const RunPlan& plan,
                           const SectionArea& area, const SurfaceLoadModel* post) {
   NeedleRun run;
@@ -613,11 +644,23 @@ NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const R
     puncture.flat_tip =
         plan.threshold->criterion == PunctureCriterion::Penetration && area.ends_flat();
     if (post != nullptr) {
-      puncture.post_force_N = post->at(crossing->depth_m).force_N;
+      // A stiff top layer broken by the stress criterion over softer layers keeps its grip
+      // (gripped_point); the pre-puncture stiffness at the puncture is the last step's slope.
+      const bool gripped = plan.threshold->criterion == PunctureCriterion::Stress &&
+                           post->layers().size() >= 2 && plan.full_layers.size() >= 2;
+      double stiffness = crossing->depth_m > 0.0 ? at.force_N / crossing->depth_m : 0.0;
+      for (const RunPoint& p : pre.points)
+        if (p.depth_m < crossing->depth_m)
+          stiffness = (at.force_N - p.force_N) / (crossing->depth_m - p.depth_m);
+      auto post_at = [&](double d) {
+        return gripped ? gripped_point(*post, d, crossing->depth_m, at.force_N, stiffness)
+                       : post_point(*post, d);
+      };
+      puncture.post_force_N = post_at(crossing->depth_m).force_N;
       if (plan.post_stage) {
-        run.curve.push_back(post_point(*post, crossing->depth_m));
+        run.curve.push_back(post_at(crossing->depth_m));
         for (double d : post_depths(plan))
-          if (d > crossing->depth_m) run.curve.push_back(post_point(*post, d));
+          if (d > crossing->depth_m) run.curve.push_back(post_at(d));
       }
     }
     run.puncture = puncture;
@@ -660,6 +703,7 @@ RunPoint curve_at(const std::vector<RunPoint>& curve, double depth, bool after) 
       r.alpha_N = mix(before.alpha_N, p.alpha_N);
       r.beta_N = mix(before.beta_N, p.beta_N);
       r.friction_N = mix(before.friction_N, p.friction_N);
+      r.collar_N = mix(before.collar_N, p.collar_N);
       return r;
     }
     before = p;
@@ -690,6 +734,7 @@ std::vector<RunPoint> total_curve(const std::vector<NeedleRun>& needles) {
         sum.alpha_N += p.alpha_N;
         sum.beta_N += p.beta_N;
         sum.friction_N += p.friction_N;
+        sum.collar_N += p.collar_N;
         if (i == 0) sum.strain_energy_J = p.strain_energy_J;  // one tissue: the system's energy
       }
       sum.contact_pressure_Pa = sum.contact_area_m2 > 0.0 ? sum.force_N / sum.contact_area_m2 : 0.0;

@@ -382,7 +382,8 @@ void SurfaceLoadModel::add_piece(const Face& face, const std::vector<Vertex>& po
   }
 }
 
-void SurfaceLoadModel::add_face(const Face& face, double depth_m, LoadSample& sample) const {
+void SurfaceLoadModel::add_face(const Face& face, double depth_m, LoadSample& sample,
+                                std::vector<LoadSample>* by_layer) const {
   double layer_top = 0.0;
   for (std::size_t j = 0; j < layer_bottom_m_.size(); ++j) {
     // Layer j covers heights above the tip in [depth - bottom, depth - top].
@@ -397,17 +398,33 @@ void SurfaceLoadModel::add_face(const Face& face, double depth_m, LoadSample& sa
                : (face.lowest >= high || face.highest <= low))
       continue;
     const std::vector<Vertex> polygon = clip_to_slab(face, low, high);
-    if (polygon.size() >= 3) add_piece(face, polygon, layers_[j], sample);
+    if (polygon.size() < 3) continue;
+    if (by_layer == nullptr) {
+      add_piece(face, polygon, layers_[j], sample);
+      continue;
+    }
+    LoadSample piece;
+    add_piece(face, polygon, layers_[j], piece);
+    for (LoadSample* s : {&sample, &(*by_layer)[j]}) {
+      s->alpha_N += piece.alpha_N;
+      s->beta_N += piece.beta_N;
+      s->friction_N += piece.friction_N;
+    }
   }
 }
 
 LoadSample SurfaceLoadModel::at(double depth_m) const {
+  return at(depth_m, nullptr);
+}
+
+LoadSample SurfaceLoadModel::at(double depth_m, std::vector<LoadSample>* by_layer) const {
   require(!std::isnan(depth_m), "depth is not a number");
   LoadSample sample;
   sample.depth_m = depth_m;
+  if (by_layer != nullptr) by_layer->assign(layer_bottom_m_.size(), LoadSample{depth_m});
   if (depth_m > 0.0) {
     for (const Face& face : faces_) {
-      if (face.lowest < depth_m) add_face(face, depth_m, sample);
+      if (face.lowest < depth_m) add_face(face, depth_m, sample, by_layer);
     }
     if (constants_.friction == ShaftFriction::linear_growth) {
       // Paper C eq. 2: F_f = F_max x / d up to full penetration, F_max after.
@@ -416,6 +433,9 @@ LoadSample SurfaceLoadModel::at(double depth_m) const {
     }
   }
   sample.force_N = sample.alpha_N + sample.beta_N + sample.friction_N;
+  if (by_layer != nullptr)
+    for (LoadSample& layer : *by_layer)
+      layer.force_N = layer.alpha_N + layer.beta_N + layer.friction_N;
   return sample;
 }
 

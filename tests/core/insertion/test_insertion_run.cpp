@@ -116,6 +116,61 @@ TEST(InsertionRun, PostStageFollowsThePunctureWithTheSurfaceLoadModel) {
   EXPECT_EQ(n.max_force_N, max_force);
 }
 
+// Paper A's skin (a 1 GPa stratum corneum with a strength over soft layers) under the stress
+// criterion: the broken top layer keeps its grip on the shaft (docs/model.md, "The broken top
+// layer"). Right after the puncture the force is the pre-puncture one; it then rises at the
+// pre-puncture stiffness while the layer's own distributed loads (its grip) can hold it, and is
+// the distributed loads of every layer once they cannot (the layer slides): min of the two,
+// never below what the layers beneath carry. A flat punch, axisymmetric, fast.
+TEST(InsertionRun, ABrokenStiffTopLayerKeepsItsGripUntilItsOwnLoadsAreExceeded) {
+  const std::string text =
+      "[tissue]\nsize = [\"3000 um\", \"3000 um\", \"1150 um\"]\n"
+      "[[tissue.layers]]\nname = \"stratum_corneum\"\nthickness = \"20 um\"\n"
+      "material = { model = \"linear\", E = \"1 GPa\", nu = 0.4 }\n"
+      "strength = \"21.6 MPa\"\nstrength_length = \"10 um\"\n"
+      "[[tissue.layers]]\nname = \"epidermis\"\nthickness = \"100 um\"\n"
+      "material = { model = \"linear\", E = \"0.134 MPa\", nu = 0.4 }\n"
+      "[[tissue.layers]]\nname = \"dermis\"\n"
+      "material = { model = \"linear\", E = \"0.08 MPa\", nu = 0.4 }\n" +
+      kOnePunch +
+      "[insertion]\ndepth = \"800 um\"\n[model]\nfidelity = \"fast\"\n"
+      "criterion = \"stress\"\noutputs = [\"puncture\", \"force_curve\"]\n";
+  const Scene scene = parse_scene(text, "skin.toml");
+  const PreparedNeedle needle = punch("punch", 115e-6);
+  InsertionRunOptions options = fast();
+  options.criterion = PunctureCriterion::Stress;
+  const InsertionRun run = run_insertion(scene, {needle}, options);
+  const NeedleRun& n = run.needles.front();
+  ASSERT_TRUE(n.puncture.has_value());
+  const double dp = n.puncture->depth_m, fp = n.puncture->force_N;
+  EXPECT_NEAR(n.puncture->post_force_N, fp, 1e-12 * fp);
+  // The pre-puncture stiffness at the puncture: the slope over the last step before it.
+  const RunPoint* last = nullptr;
+  for (const RunPoint& p : n.curve)
+    if (p.stage == Stage::Pre && p.depth_m < dp) last = &p;
+  ASSERT_NE(last, nullptr);
+  const double stiffness = (fp - last->force_N) / (dp - last->depth_m);
+  const SurfaceLoadModel loads(needle.mesh, load_constants(scene));
+  bool gripped = false, slid = false;
+  double previous = 0.0;
+  for (const RunPoint& p : n.curve) {
+    if (p.stage != Stage::Post) continue;
+    std::vector<LoadSample> layers;
+    const LoadSample all = loads.at(p.depth_m, &layers);
+    const double below = all.force_N - layers.front().force_N;
+    const double held = fp + stiffness * (p.depth_m - dp);
+    EXPECT_NEAR(p.force_N, std::max(below, std::min(held, all.force_N)), 1e-12 * all.force_N)
+        << p.depth_m;
+    EXPECT_NEAR(p.force_N, p.alpha_N + p.beta_N + p.friction_N + p.collar_N, 1e-12 * p.force_N);
+    gripped = gripped || p.collar_N > 0.0;
+    slid = slid || (p.collar_N == 0.0 && p.depth_m > dp);
+    EXPECT_GE(p.force_N, previous * (1.0 - 1e-12)) << "the force falls at " << p.depth_m;
+    previous = p.force_N;
+  }
+  EXPECT_TRUE(gripped);
+  EXPECT_TRUE(slid) << "the layer never slid within 800 um";
+}
+
 TEST(InsertionRun, NeedleThatNeverPuncturesReportsItsMaximumForce) {
   const Scene scene =
       punch_scene("[tissue.fracture]\ntoughness = \"19 J/m^2\"\ncritical_pressure = \"50 MPa\"\n");

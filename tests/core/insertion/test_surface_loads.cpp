@@ -173,6 +173,42 @@ TEST(SurfaceLoads, EachLayerLoadsWithItsOwnStiffness) {
   EXPECT_NEAR(model.at(150e-6).alpha_N, 0.2e6 / (1 - 0.16) * kS * end, 1e-12);
 }
 
+// Each layer's share (at(depth, &by_layer)) is what that layer's faces carry: the shares sum to
+// the total (round-off), the total is at(depth)'s, and a layer the tip has not reached carries
+// nothing.
+TEST(SurfaceLoads, EachLayersSharesSumToTheTotalAndAnUnreachedLayerCarriesNothing) {
+  LoadConstants c;
+  c.layers = {layer(20e-6, 1e9, 0.4), layer(100e-6, 0.134e6, 0.4), layer(0.0, 0.08e6, 0.4)};
+  for (const auto& mesh : {mneedle::test::cylinder({}), mneedle::test::cone({}, 0.3)}) {
+    const SurfaceLoadModel model(mesh, c);
+    for (double depth : {10e-6, 20e-6, 50e-6, 300e-6}) {
+      std::vector<mneedle::LoadSample> shares;
+      const mneedle::LoadSample total = model.at(depth, &shares);
+      ASSERT_EQ(shares.size(), 3u);
+      mneedle::LoadSample sum;
+      for (const auto& s : shares) {
+        EXPECT_NEAR(s.force_N, s.alpha_N + s.beta_N + s.friction_N, 1e-15);
+        sum.alpha_N += s.alpha_N;
+        sum.beta_N += s.beta_N;
+        sum.friction_N += s.friction_N;
+      }
+      EXPECT_NEAR(sum.alpha_N, total.alpha_N, 1e-12 * total.force_N) << depth;
+      EXPECT_NEAR(sum.beta_N, total.beta_N, 1e-12 * total.force_N) << depth;
+      EXPECT_NEAR(sum.friction_N, total.friction_N, 1e-12 * total.force_N) << depth;
+      EXPECT_NEAR(model.at(depth).force_N, total.force_N, 1e-12 * total.force_N) << depth;
+      if (depth < 20e-6) {
+        EXPECT_EQ(shares[1].force_N, 0.0) << depth;
+      }
+      if (depth <= 120e-6) {
+        EXPECT_EQ(shares[2].force_N, 0.0) << depth;
+      }
+      if (depth > 20e-6) {
+        EXPECT_GT(shares[1].force_N, 0.0) << depth;
+      }
+    }
+  }
+}
+
 TEST(SurfaceLoads, FlatEndExactlyOnALayerInterfaceIsLoadedByTheDeeperLayer) {
   // A face across the axis has no height extent: at a depth sample on an interface it belonged
   // to neither slab and carried nothing (half the force on a split gel). It lies in the deeper

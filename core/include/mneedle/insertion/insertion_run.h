@@ -99,6 +99,10 @@ struct RunPoint {
   double alpha_N = 0.0;
   double beta_N = 0.0;
   double friction_N = 0.0;
+  /// The broken top layer's share while it still grips the shaft (docs/model.md, "The broken top
+  /// layer"); alpha_N, beta_N and friction_N are then the layers' below it. force_N is the sum of
+  /// the four.
+  double collar_N = 0.0;
 };
 
 struct Puncture {

@@ -108,6 +108,9 @@ class SurfaceLoadModel {
 
   /// Load with the tip depth_m below the surface (0 above it). Throws InputError for NaN.
   LoadSample at(double depth_m) const;
+  /// The same, and each layer's share of it in `by_layer` (one sample per layer, from the top;
+  /// a paper C friction law, not a layer's, is in the total only).
+  LoadSample at(double depth_m, std::vector<LoadSample>* by_layer) const;
 
   std::vector<LoadSample> curve(const std::vector<double>& depths_m) const;
 
@@ -133,7 +136,8 @@ class SurfaceLoadModel {
   };
 
  private:
-  void add_face(const Face& face, double depth_m, LoadSample& sample) const;
+  void add_face(const Face& face, double depth_m, LoadSample& sample,
+                std::vector<LoadSample>* by_layer) const;
   void add_piece(const Face& face, const std::vector<Vertex>& polygon, const LayerPressure& layer,
                  LoadSample& sample) const;
   void add_beta(const Face& face, const std::vector<Vertex>& polygon, const LayerPressure& layer,
