@@ -1013,8 +1013,9 @@ AxisymmetricMeshOptions mesh_options_for(const AxisymmetricProblem& problem) {
   // breaks: the layer's underside below it reads the averaged stress only with elements a
   // fraction of L (docs/model.md, "Axisymmetric mesh"), near the axis.
   const double length = problem.stress_average_length_m;
-  if (length > 0.0 && !ov.tip_size_m && !needle.radii_m.empty() && needle.radii_m.front() == 0.0 &&
-      !problem.layers.empty()) {
+  const bool pointed =
+      !needle.radii_m.empty() && needle.radii_m.front() <= 1e-9 * needle.max_radius();
+  if (length > 0.0 && !ov.tip_size_m && pointed && !problem.layers.empty()) {
     const double per_length = problem.fidelity == Fidelity::Fast   ? 2.0
                               : problem.fidelity == Fidelity::Fine ? 8.0
                                                                    : 4.0;

@@ -38,6 +38,10 @@ struct RunPlan {
   double inp_depth_m = 0.0;
   std::vector<std::string> inp_comment;
   std::vector<Reduction> reductions;
+  /// False for the reference runs that measure a reduction: no early stop at the crossing, but
+  /// the criterion's data kept, so that the mesh is the one the run being checked had (the
+  /// stress criterion's length sizes the axisymmetric tip).
+  bool stop_at_crossing = true;
   /// Where every model run of this plan and its copies adds its time (the run's record).
   RunSeconds* seconds = nullptr;
 };

@@ -128,7 +128,9 @@ fe::ContactMode to_fe(Contact c) {
 class CrossingWatch {
  public:
   CrossingWatch(std::size_t needles, const RunPlan& plan)
-      : crossed_(needles, false), threshold_(plan.threshold), depth_m_(plan.depth_m) {}
+      : crossed_(needles, false),
+        threshold_(plan.stop_at_crossing ? plan.threshold : std::nullopt),
+        depth_m_(plan.depth_m) {}
   // False once every needle's criterion has reached the threshold.
   bool keep_going(std::size_t needle, const CriterionSample& s) {
     if (threshold_ && criterion_value(threshold_->criterion, s) >= threshold_->threshold)
@@ -419,7 +421,7 @@ void check_layer_merge(const RunPlan& plan, const PreparedNeedle& needle, const 
   if (merge == reductions.end() || reduced.needles[0].points.empty()) return;
   RunPlan full = plan;
   full.layers = plan.full_layers;
-  full.threshold.reset();  // same depth steps, no early stop: compare at the reduced run's end
+  full.stop_at_crossing = false;  // same steps and mesh, no early stop: the reduced run's end
   full.vtu_directory.clear();
   full.depth_m = reduced.needles[0].points.back().depth_m;
   const PreResult reference = run_axisymmetric(full, needle, area, options, 0.0);
@@ -452,7 +454,7 @@ void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
   auto reference_on = [&](double size_x, double size_y) {
     RunPlan probe = plan;
     probe.axisymmetric_radius_m = fe::equal_area_radius(std::sqrt(size_x * size_y));
-    probe.threshold.reset();  // same depth steps, no early stop
+    probe.stop_at_crossing = false;  // same depth steps and mesh rule, no early stop
     probe.vtu_directory.clear();
     probe.depth_m = reduced.needles[0].points.back().depth_m;
     return run_axisymmetric(probe, proxy, areas[0], proxy_options, 0.0)
@@ -558,7 +560,7 @@ RunPoint interpolated_point(const std::vector<RunPoint>& points, double depth) {
 // grip, its own distributed loads (wedge and friction, capped at its strength); then it slides
 // and carries its grip. The layers below carry their distributed loads throughout.
 RunPoint gripped_point(const SurfaceLoadModel& model, double depth, double puncture_depth,
-                       double puncture_force, double stiffness) {
+                       double puncture_force, double stiffness, bool& slid) {
   std::vector<LoadSample> layers;
   const LoadSample total = model.at(depth, &layers);
   const LoadSample& top = layers.front();
@@ -567,8 +569,10 @@ RunPoint gripped_point(const SurfaceLoadModel& model, double depth, double punct
   p.stage = Stage::Post;
   const double held = puncture_force + stiffness * (depth - puncture_depth);
   const double below = total.force_N - top.force_N;
-  const double share = std::clamp(held - below, 0.0, top.force_N);
-  if (share >= top.force_N) {  // sliding: every layer's distributed loads
+  // Once it slides it does not grip again (evaluated at increasing depths).
+  const double share = slid ? top.force_N : std::clamp(held - below, 0.0, top.force_N);
+  slid = share >= top.force_N;
+  if (slid) {  // sliding: every layer's distributed loads
     p.alpha_N = total.alpha_N;
     p.beta_N = total.beta_N;
     p.friction_N = total.friction_N;
@@ -645,15 +649,24 @@ NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const R
         plan.threshold->criterion == PunctureCriterion::Penetration && area.ends_flat();
     if (post != nullptr) {
       // A stiff top layer broken by the stress criterion over softer layers keeps its grip
-      // (gripped_point); the pre-puncture stiffness at the puncture is the last step's slope.
+      // (gripped_point); the pre-puncture stiffness at the puncture is the slope of the step it
+      // lies in (from the origin in the first step).
       const bool gripped = plan.threshold->criterion == PunctureCriterion::Stress &&
-                           post->layers().size() >= 2 && plan.full_layers.size() >= 2;
-      double stiffness = crossing->depth_m > 0.0 ? at.force_N / crossing->depth_m : 0.0;
-      for (const RunPoint& p : pre.points)
-        if (p.depth_m < crossing->depth_m)
-          stiffness = (at.force_N - p.force_N) / (crossing->depth_m - p.depth_m);
+                           post->layers().size() >= 2 && plan.full_layers.size() >= 2 &&
+                           plan.full_layers[0].material.E > plan.full_layers[1].material.E;
+      const RunPoint* below = nullptr;
+      const RunPoint* above = nullptr;
+      for (const RunPoint& p : pre.points) {
+        if (p.depth_m < crossing->depth_m) below = &p;
+        if (p.depth_m >= crossing->depth_m && above == nullptr) above = &p;
+      }
+      const double from_d = below ? below->depth_m : 0.0, from_f = below ? below->force_N : 0.0;
+      const double to_d = above ? above->depth_m : crossing->depth_m;
+      const double to_f = above ? above->force_N : at.force_N;
+      const double stiffness = to_d > from_d ? (to_f - from_f) / (to_d - from_d) : 0.0;
+      bool slid = false;
       auto post_at = [&](double d) {
-        return gripped ? gripped_point(*post, d, crossing->depth_m, at.force_N, stiffness)
+        return gripped ? gripped_point(*post, d, crossing->depth_m, at.force_N, stiffness, slid)
                        : post_point(*post, d);
       };
       puncture.post_force_N = post_at(crossing->depth_m).force_N;

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "fe/needle_meshes.h"
@@ -480,6 +481,45 @@ const Reduction* find_reduction(const InsertionRun& run, const std::string& name
   for (const Reduction& r : run.reductions)
     if (r.name == name) return &r;
   return nullptr;
+}
+
+// The reduction's reference run meshes as the run it checks: under the stress criterion a
+// pointed tip's axisymmetric mesh is sized from L (docs/model.md, "Mesh"), and a reference run
+// without the criterion's data was meshed coarser, so the "measured effect" of a cut held the
+// two meshes' difference too (1.3 %, a review's measurement). A 15-degree cone in a 12 mm block
+// of paper A's skin, pressed 50 um (before its puncture): the measured effect is the change
+// between the cut run and the same run on the whole block, to round-off.
+TEST(ScenePlanner, AReductionIsMeasuredOnTheMeshOfTheRunItChecks) {
+  const std::string text =
+      "[tissue]\nsize = [\"12 mm\", \"12 mm\", \"1150 um\"]\n"
+      "[[tissue.layers]]\nname = \"stratum_corneum\"\nthickness = \"20 um\"\n"
+      "material = { model = \"linear\", E = \"1 GPa\", nu = 0.4 }\n"
+      "strength = \"21.6 MPa\"\nstrength_length = \"10 um\"\n"
+      "[[tissue.layers]]\nname = \"epidermis\"\nthickness = \"100 um\"\n"
+      "material = { model = \"linear\", E = \"0.134 MPa\", nu = 0.4 }\n"
+      "[[tissue.layers]]\nname = \"dermis\"\n"
+      "material = { model = \"linear\", E = \"0.08 MPa\", nu = 0.4 }\n"
+      "[[needles]]\nname = \"cone\"\ngeometry = { plugin = \"cone\", diameter = \"230 um\" }\n"
+      "[insertion]\ndepth = \"50 um\"\n[model]\nfidelity = \"fast\"\n"
+      "criterion = \"stress\"\noutputs = [\"puncture\"]\n";
+  const Scene scene = parse_scene(text, "cone.toml");
+  PreparedNeedle cone;
+  cone.name = "cone";
+  cone.mesh = test::cone_needle(15.0 * std::numbers::pi / 180.0, 115e-6, 1e-3);
+  cone.axisymmetric = fe::AxisymmetricNeedle::cone(15.0 * std::numbers::pi / 180.0, 115e-6);
+  InsertionRunOptions options = fast();
+  options.criterion = PunctureCriterion::Stress;
+  const InsertionRun cut_run = run_insertion(scene, {cone}, options);
+  options.allow_reductions = false;
+  const InsertionRun whole = run_insertion(scene, {cone}, options);
+  const Reduction* cut = find_reduction(cut_run, "domain_cut");
+  ASSERT_NE(cut, nullptr);
+  ASSERT_TRUE(cut->measured_effect.has_value());
+  ASSERT_FALSE(cut_run.needles.front().puncture.has_value());
+  const RunPoint& a = cut_run.needles.front().curve.back();
+  const RunPoint& b = whole.needles.front().curve.back();
+  ASSERT_DOUBLE_EQ(a.depth_m, b.depth_m);
+  EXPECT_NEAR(*cut->measured_effect, std::abs(a.force_N - b.force_N) / b.force_N, 1e-9);
 }
 
 TEST(ScenePlanner, DomainCutAroundTheNeedleKeepsTheAxisymmetricForceWithinTheTolerance) {

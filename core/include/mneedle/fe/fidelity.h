@@ -25,7 +25,7 @@ struct FidelityOverrides {
   /// 3-D tissue with refinement levels: the top layer around each needle's first contact (its
   /// lowest points) is bisected down to this element size, within three times the larger of it
   /// and the criterion length of that contact (docs/model.md, "Tissue block and mesh"; a
-  /// convergence study's knob, unset in every fidelity).
+  /// convergence study's knob, unset in every fidelity; without refinement levels, none).
   std::optional<double> contact_zone_size_m;
 };
 
