@@ -48,6 +48,16 @@ const std::string kFracture =
 const std::string kOnePunch =
     "[[needles]]\nname = \"punch\"\ngeometry = { plugin = \"cylinder\", diameter = \"230 um\" }\n";
 
+// Paper A's skin: a 1 GPa stratum corneum with the skin scenes' strength, over soft layers.
+const std::string kPaperASkinLayers =
+    "[[tissue.layers]]\nname = \"stratum_corneum\"\nthickness = \"20 um\"\n"
+    "material = { model = \"linear\", E = \"1 GPa\", nu = 0.4 }\n"
+    "strength = \"21.6 MPa\"\nstrength_length = \"10 um\"\n"
+    "[[tissue.layers]]\nname = \"epidermis\"\nthickness = \"100 um\"\n"
+    "material = { model = \"linear\", E = \"0.134 MPa\", nu = 0.4 }\n"
+    "[[tissue.layers]]\nname = \"dermis\"\n"
+    "material = { model = \"linear\", E = \"0.08 MPa\", nu = 0.4 }\n";
+
 Scene punch_scene(const std::string& fracture = kFracture,
                   const std::string& outputs = "[\"puncture\", \"force_curve\"]") {
   return parse_scene(scene_text("", fracture, kOnePunch, outputs), "punch.toml");
@@ -124,18 +134,10 @@ TEST(InsertionRun, PostStageFollowsThePunctureWithTheSurfaceLoadModel) {
 // the distributed loads of every layer once they cannot (the layer slides): min of the two,
 // never below what the layers beneath carry. A flat punch, axisymmetric, fast.
 TEST(InsertionRun, ABrokenStiffTopLayerKeepsItsGripUntilItsOwnLoadsAreExceeded) {
-  const std::string text =
-      "[tissue]\nsize = [\"3000 um\", \"3000 um\", \"1150 um\"]\n"
-      "[[tissue.layers]]\nname = \"stratum_corneum\"\nthickness = \"20 um\"\n"
-      "material = { model = \"linear\", E = \"1 GPa\", nu = 0.4 }\n"
-      "strength = \"21.6 MPa\"\nstrength_length = \"10 um\"\n"
-      "[[tissue.layers]]\nname = \"epidermis\"\nthickness = \"100 um\"\n"
-      "material = { model = \"linear\", E = \"0.134 MPa\", nu = 0.4 }\n"
-      "[[tissue.layers]]\nname = \"dermis\"\n"
-      "material = { model = \"linear\", E = \"0.08 MPa\", nu = 0.4 }\n" +
-      kOnePunch +
-      "[insertion]\ndepth = \"800 um\"\n[model]\nfidelity = \"fast\"\n"
-      "criterion = \"stress\"\noutputs = [\"puncture\", \"force_curve\"]\n";
+  const std::string text = "[tissue]\nsize = [\"3000 um\", \"3000 um\", \"1150 um\"]\n" +
+                           kPaperASkinLayers + kOnePunch +
+                           "[insertion]\ndepth = \"800 um\"\n[model]\nfidelity = \"fast\"\n"
+                           "criterion = \"stress\"\noutputs = [\"puncture\", \"force_curve\"]\n";
   const Scene scene = parse_scene(text, "skin.toml");
   const PreparedNeedle needle = punch("punch", 115e-6);
   InsertionRunOptions options = fast();
@@ -491,14 +493,7 @@ const Reduction* find_reduction(const InsertionRun& run, const std::string& name
 // between the cut run and the same run on the whole block, to round-off.
 TEST(ScenePlanner, AReductionIsMeasuredOnTheMeshOfTheRunItChecks) {
   const std::string text =
-      "[tissue]\nsize = [\"12 mm\", \"12 mm\", \"1150 um\"]\n"
-      "[[tissue.layers]]\nname = \"stratum_corneum\"\nthickness = \"20 um\"\n"
-      "material = { model = \"linear\", E = \"1 GPa\", nu = 0.4 }\n"
-      "strength = \"21.6 MPa\"\nstrength_length = \"10 um\"\n"
-      "[[tissue.layers]]\nname = \"epidermis\"\nthickness = \"100 um\"\n"
-      "material = { model = \"linear\", E = \"0.134 MPa\", nu = 0.4 }\n"
-      "[[tissue.layers]]\nname = \"dermis\"\n"
-      "material = { model = \"linear\", E = \"0.08 MPa\", nu = 0.4 }\n"
+      "[tissue]\nsize = [\"12 mm\", \"12 mm\", \"1150 um\"]\n" + kPaperASkinLayers +
       "[[needles]]\nname = \"cone\"\ngeometry = { plugin = \"cone\", diameter = \"230 um\" }\n"
       "[insertion]\ndepth = \"50 um\"\n[model]\nfidelity = \"fast\"\n"
       "criterion = \"stress\"\noutputs = [\"puncture\"]\n";
