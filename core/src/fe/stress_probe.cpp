@@ -205,9 +205,38 @@ std::vector<std::array<Barycentric, 4>> sub_tetrahedra(int levels) {
   return pieces;
 }
 
+// The pieces of one, eight and 64 (levels 0, 1 and 2 of the eight-way split) in one table: an
+// element split `level` times uses the 8^level entries from subdivision_offset(level) on.
+constexpr int kProbeLevels = 3;
 const std::vector<std::array<Barycentric, 4>>& probe_subdivision() {
-  static const std::vector<std::array<Barycentric, 4>> pieces = sub_tetrahedra(2);
+  static const std::vector<std::array<Barycentric, 4>> pieces = [] {
+    std::vector<std::array<Barycentric, 4>> all;
+    for (int level = 0; level < kProbeLevels; ++level) {
+      const auto some = sub_tetrahedra(level);
+      all.insert(all.end(), some.begin(), some.end());
+    }
+    return all;
+  }();
   return pieces;
+}
+
+std::size_t subdivision_offset(int level) {
+  std::size_t offset = 0;
+  for (int l = 0; l < level; ++l) offset += std::size_t{1} << (3 * l);
+  return offset;
+}
+
+// Splits an element of `reach` (its farthest corner from its centroid, m) needs so that no
+// piece reaches farther than kPieceReachPerLength L; at most two (64 pieces). The default meshes'
+// tip elements reach 0.6 L and more after two splits, so they keep 64 pieces and their balls are
+// unchanged; a finer element (the convergence study's contact zone) takes fewer, no wider than
+// theirs, instead of 64 each (which ran a 6 um zone out of memory, docs/validation.md).
+constexpr double kPieceReachPerLength = 0.5;
+int probe_level(double reach, double length) {
+  int level = 0;
+  while (level + 1 < kProbeLevels && reach / std::ldexp(1.0, level) > kPieceReachPerLength * length)
+    ++level;
+  return level;
 }
 
 Barycentric centroid_of(const std::array<Barycentric, 4>& sub) {
@@ -305,8 +334,10 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
           beside || (mid.head<2>() - sites_xy[s]).norm() - reach <= search_radius_m[s] + length_m;
     if (!near || !beside) continue;
     elements_.push_back(static_cast<int>(e));
-    const double volume = tet_volume(corners) / static_cast<double>(subs.size());
-    for (std::size_t k = 0; k < subs.size(); ++k) {
+    const int level = probe_level(reach, length_m);
+    const std::size_t first = subdivision_offset(level), count = std::size_t{1} << (3 * level);
+    const double volume = tet_volume(corners) / static_cast<double>(count);
+    for (std::size_t k = first; k < first + count; ++k) {
       const Barycentric l = centroid_of(subs[k]);
       const Eigen::Vector3d x =
           l(0) * corners[0] + l(1) * corners[1] + l(2) * corners[2] + l(3) * corners[3];
