@@ -82,6 +82,11 @@ TEST_F(DesignSource, AConeStlHasThePluginsProfileToItsFacets) {
   for (double h = 1e-6; h < 600e-6; h += 7e-6)
     worst = std::max(worst, std::abs(radius_at(*profile, h) - radius_at(*plugin.axisymmetric, h)));
   EXPECT_LT(worst, 0.002 * R);
+  // Pointed, as the plugin's, so the stress criterion meshes its tip alike (the pointed-tip rule
+  // of mesh_options_for, docs/model.md "Mesh"), and it never narrows upward (footprint_radius).
+  EXPECT_LE(profile->radii_m.front(), 1e-9 * profile->max_radius());
+  for (std::size_t i = 1; i < profile->radii_m.size(); ++i)
+    EXPECT_GE(profile->radii_m[i], profile->radii_m[i - 1]);
 }
 
 TEST_F(DesignSource, ABevelOrAMeshThatIsNotRoundHasNoProfile) {

@@ -1002,8 +1002,7 @@ AxisymmetricMeshOptions mesh_options_for(const AxisymmetricProblem& problem) {
   const FidelityOverrides& ov = problem.overrides;
   AxisymmetricMeshOptions o;
   o.radius_m = problem.radius_m * ov.domain_scale.value_or(1.0);
-  double h = a / per_radius;
-  o.h_m = std::min(ov.tip_size_m.value_or(h), o.radius_m);
+  o.h_m = std::min(ov.tip_size_m.value_or(a / per_radius), o.radius_m);
   o.fine_radius_m = 2.0 * a;
   // Total Lagrangian: the captured nodes sit on the reference surface, so the fine zone is the
   // reference neighbourhood of the footprint (a deep, slender needle does not need a fine

@@ -227,10 +227,10 @@ std::size_t subdivision_offset(int level) {
 }
 
 // Splits an element of `reach` (its farthest corner from its centroid, m) needs so that no
-// piece reaches farther than kPieceReachPerLength L; at most two (64 pieces). The default meshes'
-// tip elements reach 0.6 L and more after two splits, so they keep 64 pieces and their balls are
-// unchanged; a finer element (the convergence study's contact zone) takes fewer, no wider than
-// theirs, instead of 64 each (which ran a 6 um zone out of memory, docs/validation.md).
+// piece reaches farther than kPieceReachPerLength L; at most two (64 pieces). The fidelities'
+// skin meshes keep 64 pieces (their depths did not move, to the last digit, at fast, standard
+// and fine); a finer element (the convergence study's contact zone) takes fewer, none wider
+// than that, instead of 64 each (which ran a 6 um zone out of memory, docs/validation.md).
 constexpr double kPieceReachPerLength = 0.5;
 int probe_level(double reach, double length) {
   int level = 0;
@@ -359,21 +359,22 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
         candidates_.push_back(
             {mesh.nodes[i], static_cast<int>(s), (mesh.nodes[i].head<2>() - sites_xy[s]).norm()});
   }
-  // Each sub-tetrahedron's corners and the farthest corner's distance from its centroid.
-  std::vector<std::array<Eigen::Vector3d, 4>> sub_corners(points_.size());
+  // Each sub-tetrahedron's children's centroids and its farthest corner's distance from its
+  // centroid.
   std::vector<std::array<Eigen::Vector3d, 8>> sub_children(points_.size());
   std::vector<double> sub_reach(points_.size(), 0.0);
   for (std::size_t i = 0; i < points_.size(); ++i) {
     const auto& element = mesh.elements[static_cast<std::size_t>(points_[i].element)];
     const std::array<Barycentric, 4>& sub = subs[static_cast<std::size_t>(points_[i].sub)];
+    std::array<Eigen::Vector3d, 4> corners;
     for (std::size_t v = 0; v < 4; ++v) {
       Eigen::Vector3d x = Eigen::Vector3d::Zero();
       for (int a = 0; a < 4; ++a)
         x += sub[v](a) * mesh.nodes[static_cast<std::size_t>(element[static_cast<std::size_t>(a)])];
-      sub_corners[i][v] = x;
+      corners[v] = x;
       sub_reach[i] = std::max(sub_reach[i], (x - points_[i].x).norm());
     }
-    sub_children[i] = children_of(sub_corners[i]);
+    sub_children[i] = children_of(corners);
   }
   // The pieces of elements_[k] are points_[piece_start[k] .. piece_start[k + 1]).
   std::vector<std::size_t> piece_start{0};
