@@ -341,10 +341,14 @@ nlohmann::json number_or_null(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
 
-// One element size at the tip for every design of the run (from the start design's radius), so
-// the tissue mesh does not jump between designs and the objective stays smooth.
-double fixed_tip_size(const Problem& p, const std::vector<DesignVariable>& vars,
-                      const std::vector<double>& start) {
+// One element size at the tip for every 3-D design of the run, so that the tissue mesh does not
+// jump between designs and the objective stays smooth: the size the start design's own run
+// takes. The axisymmetric model is left to its own rule (docs/model.md, "Mesh"): it sizes a
+// pointed tip under the stress criterion from the criterion's length, not from the design, and
+// a size imposed from outside would switch that rule off, so the start design would no longer
+// puncture where `simulate` punctures it. Returns no size when the start runs no 3-D model.
+std::optional<double> fixed_tip_size(const Problem& p, const std::vector<DesignVariable>& vars,
+                                     const std::vector<double>& start) {
   std::map<std::string, double> at_start;
   for (std::size_t i = 0; i < vars.size(); ++i) at_start[vars[i].name] = start[i];
   NeedleSource n;
@@ -353,6 +357,14 @@ double fixed_tip_size(const Problem& p, const std::vector<DesignVariable>& vars,
   } catch (const std::exception&) {
     n = p.needle({});  // the start is not a valid shape: the plugin's defaults are
   }
+  const PreModel model = p.evaluation.model;
+  if (model == PreModel::Analytic || model == PreModel::Axisymmetric) return std::nullopt;
+  // The planner's rule (run_insertion): one needle of revolution on the block's axis runs
+  // axisymmetric; a design is evaluated alone, in the place of the scene's first needle.
+  const auto& at = p.scene.needles.front().at;
+  if (model == PreModel::Auto && std::hypot(at[0], at[1]) < 1e-12 &&
+      needle_symmetry(p.registry, n, "optimize: " + p.args.plugin).axisymmetric)
+    return std::nullopt;
   const double depth = p.scene.requirements.target_depth.value_or(p.scene.insertion.depth);
   const double block = std::max(p.scene.tissue.size[0], p.scene.tissue.size[1]);
   // The stress criterion's length caps the tip element as in every run (docs/model.md, "Tissue
@@ -477,7 +489,9 @@ void run_optimize(const OptimizeArgs& a) {
       {"stop_reason", r.stop_reason},
       {"seconds", r.seconds},
       {"fidelity", a.fidelity},
-      {"tip_element_size_m", *problem.evaluation.overrides.tip_size_m},
+      {"tip_element_size_m", problem.evaluation.overrides.tip_size_m
+                                 ? nlohmann::json(*problem.evaluation.overrides.tip_size_m)
+                                 : nlohmann::json(nullptr)},
       {"material", problem.material},
       {"optimum", optimum_json(report)},
       {"history", history_json(r.history)}};

@@ -51,14 +51,25 @@ TEST(OptimizeCommand, SearchOverThePluginsWholeRangesStartsFromItsDefaults) {
 
 TEST(OptimizeCommand, ConeWithItsDefaultSharpPointEvaluatesInSkin) {
   // Failed every evaluation ("tip_size_m must be > 0 m"): no vertex but the point lies below the
-  // target depth, so the tip element size was sized from a zero radius.
+  // target depth, so the 3-D tip element size was sized from a zero radius.
+  const auto run3d = run_mneedle("optimize --plugin cone --scene '" + kSkin +
+                                 "' --vary half_angle --max-evals 1 --material silicon"
+                                 " --fidelity fast --model 3d --json");
+  ASSERT_EQ(run3d.exit_code, 0) << run3d.err;
+  const auto j3d = nlohmann::json::parse(run3d.out);
+  EXPECT_GT(j3d["tip_element_size_m"].get<double>(), 0.0);
+  EXPECT_EQ(j3d["evaluations"].get<int>(), 1);
+  EXPECT_TRUE(j3d["best"]["puncture_depth_m"].is_number()) << j3d.dump(2);
+  // On the axisymmetric model the planner chooses for it, no size is imposed: the model sizes
+  // its mesh by its own rule (docs/cli.md, "Smoothness").
   const auto run = run_mneedle("optimize --plugin cone --scene '" + kSkin +
                                "' --vary half_angle --max-evals 3 --seed 7 --material silicon"
                                " --fidelity fast --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
-  EXPECT_GT(j["tip_element_size_m"].get<double>(), 0.0);
+  EXPECT_TRUE(j["tip_element_size_m"].is_null()) << j["tip_element_size_m"];
   EXPECT_EQ(j["evaluations"].get<int>(), 3);
+  EXPECT_EQ(j["optimum"]["failed_evaluations"], 0) << j["optimum"].dump(2);
 }
 
 // A scene without puncture data optimises a force: the tip element's size once asked the scene
@@ -266,6 +277,58 @@ TEST(OptimizeCommand, BevelLongerThanTheNeedleIsAnImpossibleDesignNotAFailure) {
   EXPECT_NE(optimum["impossible_causes"][0]["error"].get<std::string>().find("longer than"),
             std::string::npos)
       << optimum.dump(2);
+}
+
+// "Same needle, same answer": the optimiser evaluates a design through the code path of `screen`
+// and `simulate` (evaluate_design). Its start design also sizes the run's one tissue mesh
+// (tip_element_size_m, docs/cli.md "Smoothness"), so for that design the three paths must agree
+// bit for bit, on the 3-D model and on the axisymmetric one. A later design runs on the start's
+// mesh; that is the one place where the optimiser and simulate may differ, by the mesh error.
+TEST(OptimizeCommand, ItsStartDesignPuncturesWhereSimulatePuncturesIt) {
+  struct Case {
+    std::string scene, plugin, vary, set;
+  };
+  const std::vector<Case> cases = {
+      // 3-D half model, pressure criterion, silicone (the plugin-or-STL test's scene)
+      {kRoot + "/tests/assets/scenes/bevel_silicone_3d.toml", "sharp_bevel", "bevel_angle",
+       "--set diameter=230um --set length=1000um --set bevel_angle=30deg"},
+      // axisymmetric model, stress criterion, layered skin (the README's cone)
+      {kRoot + "/designs/scenes/human_skin.toml", "cone", "half_angle", ""}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.plugin);
+    const auto opt = run_mneedle("optimize --plugin " + c.plugin + " --scene '" + c.scene +
+                                 "' --vary " + c.vary + " " + c.set +
+                                 " --material silicon --fidelity fast --max-evals 1 --json");
+    ASSERT_EQ(opt.exit_code, 0) << opt.err;
+    const auto summary = nlohmann::json::parse(opt.out);
+    const auto& best = summary["best"];
+    ASSERT_TRUE(best["puncture_depth_m"].is_number()) << best.dump(2);
+    // The same design in a scene of its own: the scene's needle line replaced by the start's
+    // parameters as the optimiser reports them (SI, full precision, each with its unit).
+    std::string geometry = "geometry = { plugin = \"" + c.plugin + "\"";
+    for (const auto& [name, value] : best["params"].items()) {
+      const std::string unit = summary["parameter_units"][name].get<std::string>();
+      geometry +=
+          ", " + name + " = " +
+          (unit.empty() || unit == "1" ? value.dump() : "\"" + value.dump() + " " + unit + "\"");
+    }
+    geometry += " }";
+    std::string text = mneedle::test::file_text(c.scene);
+    const auto line = text.find("geometry = {");
+    ASSERT_NE(line, std::string::npos);
+    text.replace(line, text.find('\n', line) - line, geometry);
+    const fs::path dir = temp_dir("optimize_same_" + c.plugin);
+    fs::create_directories(dir);
+    std::ofstream(dir / "design.toml") << text;
+    const auto sim =
+        run_mneedle("simulate '" + (dir / "design.toml").string() + "' --fidelity fast --json");
+    ASSERT_EQ(sim.exit_code, 0) << sim.err;
+    const auto puncture = nlohmann::json::parse(sim.out)["needles"][0]["puncture"];
+    ASSERT_TRUE(puncture.is_object()) << sim.out;
+    EXPECT_EQ(puncture["depth_m"].get<double>(), best["puncture_depth_m"].get<double>());
+    EXPECT_EQ(puncture["force_N"].get<double>(), best["puncture_force_N"].get<double>());
+    fs::remove_all(dir);
+  }
 }
 
 TEST(OptimizeCommand, KilledRunKeepsEveryEvaluatedDesignInItsHistory) {
