@@ -84,6 +84,49 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
   }
 }
 
+// The README's claim on the same table at the finer levels: "`standard` and `fine` read each
+// within 6 % of these". Measured 2026-12-05 (standard / fine, um): cone 65.44 / 65.79, sharp
+// bevel 65.76 / 68.97, blunt bevel 101.79 / 104.51, cylinder 141.43 / 140.52; the largest gap to
+// fast is the sharp bevel's +5.5 % at fine. Each level is also pinned to 1 % of its own reading,
+// so that a move inside the 6 % is seen and explained.
+TEST(ScreenCommand, ReadmeMainJobReadsWithinSixPercentOfFastAtStandardAndFine) {
+  const std::map<std::string, double> fast = {{"cone", 62.8e-6},
+                                              {"sharp_bevel", 65.4e-6},
+                                              {"blunt_bevel", 100.0e-6},
+                                              {"cylinder", 148.0e-6}};
+  const std::map<std::string, std::map<std::string, double>> level = {{"standard",
+                                                                       {{"cone", 65.44e-6},
+                                                                        {"sharp_bevel", 65.76e-6},
+                                                                        {"blunt_bevel", 101.79e-6},
+                                                                        {"cylinder", 141.43e-6}}},
+                                                                      {"fine",
+                                                                       {{"cone", 65.79e-6},
+                                                                        {"sharp_bevel", 68.97e-6},
+                                                                        {"blunt_bevel", 104.51e-6},
+                                                                        {"cylinder", 140.52e-6}}}};
+  for (const auto& [fidelity, depths] : level) {
+    const auto run = run_mneedle("screen '" + kRoot + "/designs' --scene '" + kSkin +
+                                 "' --fidelity " + fidelity + " --jobs 2 --json");
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const auto j = nlohmann::json::parse(run.out);
+    ASSERT_EQ(j["designs"].size(), 4u);
+    std::vector<std::string> order;
+    for (const auto& d : j["designs"]) {
+      const std::string name = d["design"].get<std::string>();
+      order.push_back(name);
+      SCOPED_TRACE(fidelity + " " + name);
+      ASSERT_TRUE(d["punctured"].get<bool>());
+      EXPECT_FALSE(d["puncture_at_first_contact"].get<bool>());
+      const double depth = d["puncture_depth_m"].get<double>();
+      EXPECT_NEAR(depth, fast.at(name), 0.06 * fast.at(name));
+      EXPECT_NEAR(depth, depths.at(name), 0.01 * depths.at(name));
+    }
+    // Paper A's order at every level: sharp tips first, the flat end last.
+    EXPECT_EQ(order.back(), "cylinder") << fidelity;
+    EXPECT_EQ(order[2], "blunt_bevel") << fidelity;
+  }
+}
+
 // The analytic model in skin: the stratum corneum spreads a flat punch's load as in the FE (the
 // cylinder's F / A_sec stays below 3 MPa to 200 um; docs/validation.md), so neither shipped STL
 // punctures. (Until the round-off guard of the equivalent needle the flat STL cylinder carried

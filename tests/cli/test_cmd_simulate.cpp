@@ -203,34 +203,80 @@ TEST(CmdSimulate, PaperASkinNeedlesPunctureInPaperAsOrderUnderTheStressCriterion
   }
 }
 
-// The skin scene's post-puncture curve (docs/model.md, "The broken top layer"): it starts at the
-// puncture force (paper A: the force after the puncture is at most slightly below it; the issue's
-// band 0.5-1.0), never falls over the 800 um insertion and stays finite; the layer's grip shows as
-// collar_N until the stratum corneum slides.
+// Force at depth d (m) on a run's curve, linear between its points.
+double force_at(const nlohmann::json& curve, double d) {
+  for (std::size_t i = 1; i < curve.size(); ++i) {
+    const double d0 = curve[i - 1]["depth_m"].get<double>(), d1 = curve[i]["depth_m"].get<double>();
+    if (d1 >= d) {
+      const double f0 = curve[i - 1]["force_N"].get<double>(),
+                   f1 = curve[i]["force_N"].get<double>();
+      return f0 + (f1 - f0) * (d - d0) / (d1 - d0);
+    }
+  }
+  return std::nan("");
+}
+
+// The skin scenes' post-puncture curves (docs/model.md, "The broken top layer"), the README's and
+// paper A's three needles: each starts at the puncture force (paper A: the force after the
+// puncture is at most slightly below it; the band 0.5-1.0), never falls over the 800 um
+// insertion and stays finite; the layer's grip shows as collar_N until the stratum corneum
+// slides; and at 200 um it is within 0.3-3 times the intact FE force there (the band),
+// the intact curve taken from the penetration criterion, which never fires in skin. Measured
+// 2026-12-05 at fast: 1.00 / 1.06 / 1.00 (human_skin's sharp bevel, blunt bevel, cylinder).
 TEST(CmdSimulate, InSkinTheForceAfterThePunctureStartsAtThePunctureForceAndNeverFalls) {
-  const std::string file = std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/human_skin.toml";
+  // paper_a_skin_sharp_bevel is left out: its hollow bevel reads what human_skin's solid one reads
+  // to the last digit (the stiff layer holds the tip in point contact to 800 um, so the bore is
+  // never touched before the puncture, and the grip continues the pre-puncture curve).
+  for (const char* name : {"human_skin", "paper_a_skin_blunt_bevel", "paper_a_skin_cylinder"}) {
+    SCOPED_TRACE(name);
+    const std::string file = std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/" + name + ".toml";
+    const CommandRun run = run_mneedle("simulate '" + file + "' --fidelity fast --json");
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const auto j = nlohmann::json::parse(run.out);
+    const auto& needle = j["needles"][0];
+    const auto& p = needle["puncture"];
+    ASSERT_TRUE(p.is_object());
+    const double ratio = p["post_force_N"].get<double>() / p["force_N"].get<double>();
+    EXPECT_GE(ratio, 0.5);
+    EXPECT_LE(ratio, 1.0 + 1e-12);
+    double previous = 0.0, last_depth = 0.0;
+    bool gripped = false;
+    for (const auto& point : needle["curve"]) {
+      if (point["stage"] != "post") continue;
+      const double force = point["force_N"].get<double>();
+      EXPECT_TRUE(std::isfinite(force));
+      EXPECT_GE(force, previous * (1.0 - 1e-12)) << "falls at " << point["depth_m"];
+      gripped = gripped || point["collar_N"].get<double>() > 0.0;
+      previous = force;
+      last_depth = point["depth_m"].get<double>();
+    }
+    EXPECT_TRUE(gripped);
+    EXPECT_NEAR(last_depth, 800e-6, 1e-12);
+
+    const CommandRun intact =
+        run_mneedle("simulate '" + file + "' --fidelity fast --criterion penetration --json");
+    ASSERT_EQ(intact.exit_code, 0) << intact.err;
+    const auto k = nlohmann::json::parse(intact.out)["needles"][0];
+    ASSERT_TRUE(k["puncture"].is_null()) << "the intact reference punctured";
+    const double at_200 = force_at(needle["curve"], 200e-6) / force_at(k["curve"], 200e-6);
+    EXPECT_GE(at_200, 0.3);
+    EXPECT_LE(at_200, 3.0);
+  }
+}
+
+// The README's figure (docs/simulate-silicone-sharp-bevel.svg) and its caption: paper A's sharp
+// bevel in its silicone phantom, `--fidelity fast`, "the pressure criterion fires at 0.62 mm".
+// Measured 2026-12-05: 616.8 um at 27.50 mN; pinned to 1 %, as every README number is.
+TEST(CmdSimulate, ReadmeSiliconeFigurePuncturesWhereItsCaptionSays) {
+  const std::string file =
+      std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/paper_a_silicone_sharp_bevel.toml";
   const CommandRun run = run_mneedle("simulate '" + file + "' --fidelity fast --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
-  const auto j = nlohmann::json::parse(run.out);
-  const auto& needle = j["needles"][0];
-  const auto& p = needle["puncture"];
+  const auto p = nlohmann::json::parse(run.out)["needles"][0]["puncture"];
   ASSERT_TRUE(p.is_object());
-  const double ratio = p["post_force_N"].get<double>() / p["force_N"].get<double>();
-  EXPECT_GE(ratio, 0.5);
-  EXPECT_LE(ratio, 1.0 + 1e-12);
-  double previous = 0.0, last_depth = 0.0;
-  bool gripped = false;
-  for (const auto& point : needle["curve"]) {
-    if (point["stage"] != "post") continue;
-    const double force = point["force_N"].get<double>();
-    EXPECT_TRUE(std::isfinite(force));
-    EXPECT_GE(force, previous * (1.0 - 1e-12)) << "falls at " << point["depth_m"];
-    gripped = gripped || point["collar_N"].get<double>() > 0.0;
-    previous = force;
-    last_depth = point["depth_m"].get<double>();
-  }
-  EXPECT_TRUE(gripped);
-  EXPECT_NEAR(last_depth, 800e-6, 1e-12);
+  EXPECT_EQ(p["criterion"], "pressure");
+  EXPECT_FALSE(p["at_first_contact"].get<bool>());
+  EXPECT_NEAR(p["depth_m"].get<double>(), 0.62e-3, 0.01 * 0.62e-3);
 }
 
 TEST(CmdSimulate, SharpBevelFiresAtFirstContactOnAHalfModelAndSaysSo) {
