@@ -8,6 +8,7 @@
 #include "../plot/svg_reader.h"
 #include "run_mneedle.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -277,6 +278,55 @@ TEST(CmdSimulate, ReadmeSiliconeFigurePuncturesWhereItsCaptionSays) {
   EXPECT_EQ(p["criterion"], "pressure");
   EXPECT_FALSE(p["at_first_contact"].get<bool>());
   EXPECT_NEAR(p["depth_m"].get<double>(), 0.62e-3, 0.01 * 0.62e-3);
+}
+
+// The stress criterion on the analytic path (docs/model.md, "The stress criterion on the analytic
+// path"): the stratum corneum as a plate on the epidermis, pressed at one point by a pointed tip.
+// Every pointed tip punctures at the same depth there, as in the FE (docs/validation.md, "The
+// stress criterion in skin": cone 65.4, sharp bevel 65.8 um at standard). Measured 2026-12-05:
+// 58.41 um at 5.207 mN, pinned to 1 % (closed form: a move is a change to explain); against the
+// axisymmetric FE cone at standard -10.7 % in depth and -5.7 % in force, within the 15 % this
+// test allows (the plate's stiffness reads +5.6 % and its stress per newton +6 %). A flat end is
+// refused in one line naming the scene and the layer.
+TEST(CmdSimulate, AnalyticStressCriterionInSkinPuncturesAPointedTipNearTheFeDepth) {
+  const std::string skin = std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/human_skin.toml";
+  std::string cone = mneedle::test::file_text(skin);
+  const std::string bevel =
+      "geometry = { plugin = \"sharp_bevel\", diameter = \"230 um\", length "
+      "= \"1000 um\", bevel_angle = \"30 deg\" }";
+  ASSERT_NE(cone.find(bevel), std::string::npos);
+  cone.replace(cone.find(bevel), bevel.size(), "geometry = { plugin = \"cone\" }");
+  const fs::path file =
+      fs::temp_directory_path() / ("analytic_cone_" + std::to_string(::getpid()) + ".toml");
+  std::ofstream(file) << cone;
+  auto puncture_of = [](const std::string& scene, const std::string& model) {
+    const CommandRun run =
+        run_mneedle("simulate '" + scene + "' --model " + model + " --fidelity standard --json");
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    return nlohmann::json::parse(run.out)["needles"][0]["puncture"];
+  };
+  const auto fe = puncture_of(file.string(), "axisymmetric");
+  const auto closed = puncture_of(file.string(), "analytic");
+  const auto bevel_closed = puncture_of(skin, "analytic");
+  ASSERT_TRUE(fe.is_object() && closed.is_object() && bevel_closed.is_object());
+  EXPECT_EQ(closed["criterion"], "stress");
+  EXPECT_NEAR(closed["depth_m"].get<double>(), 58.41e-6, 0.01 * 58.41e-6);
+  EXPECT_NEAR(closed["force_N"].get<double>(), 5.207e-3, 0.01 * 5.207e-3);
+  const double d_fe = fe["depth_m"].get<double>();
+  EXPECT_NEAR(closed["depth_m"].get<double>(), d_fe, 0.15 * d_fe);
+  EXPECT_NEAR(closed["force_N"].get<double>(), fe["force_N"].get<double>(),
+              0.15 * fe["force_N"].get<double>());
+  EXPECT_EQ(bevel_closed["depth_m"].get<double>(), closed["depth_m"].get<double>());
+  fs::remove(file);
+
+  const CommandRun flat =
+      run_mneedle("simulate '" + std::string(MNEEDLE_SOURCE_ROOT) +
+                  "/designs/scenes/paper_a_skin_cylinder.toml' --model analytic --json");
+  EXPECT_EQ(flat.exit_code, 1);
+  EXPECT_NE(flat.err.find("paper_a_skin_cylinder.toml: "), std::string::npos) << flat.err;
+  EXPECT_NE(flat.err.find("'stratum_corneum' with a flat end 230 um wide"), std::string::npos)
+      << flat.err;
+  EXPECT_EQ(std::count(flat.err.begin(), flat.err.end(), '\n'), 1) << flat.err;
 }
 
 TEST(CmdSimulate, SharpBevelFiresAtFirstContactOnAHalfModelAndSaysSo) {

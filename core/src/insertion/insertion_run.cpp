@@ -21,6 +21,7 @@
 #include "mneedle/geometry/cross_section.h"
 #include "mneedle/insertion/analytic_indentation.h"
 #include "mneedle/insertion/penetration_force.h"
+#include "mneedle/insertion/plate_contact.h"
 #include "mneedle/insertion/puncture.h"
 #include "mneedle/insertion/surface_loads.h"
 
@@ -348,13 +349,17 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
 PreResult run_analytic(const RunPlan& plan, const Scene& scene,
                        const std::vector<PreparedNeedle>& needles,
                        const std::vector<SectionArea>& areas) {
-  if (plan.threshold && plan.threshold->criterion != PunctureCriterion::Pressure &&
-      plan.threshold->criterion != PunctureCriterion::Penetration)
+  const bool has_criterion = plan.threshold.has_value();
+  const PunctureCriterion criterion =
+      has_criterion ? plan.threshold->criterion : PunctureCriterion::Pressure;
+  if (has_criterion && criterion == PunctureCriterion::Energy)
     throw InputError(
-        "simulate: the analytic model gives no stress field or energy release rate; "
-        "the " +
-        std::string(to_string(plan.threshold->criterion)) +
-        " criterion needs --model axisymmetric or 3d");
+        "simulate: the analytic model gives no energy release rate; the energy criterion needs "
+        "--model axisymmetric or 3d");
+  // The stress criterion in closed form: the top layer as a plate on the layers beneath, pressed
+  // at the tip's point or along a flat end's rim (docs/model.md, "The stress criterion on the
+  // analytic path"). Its force replaces the indentation law's: the stress is the plate's.
+  const bool plate = has_criterion && criterion == PunctureCriterion::Stress;
   std::vector<double> depths;
   for (int k = 1; k <= plan.steps; ++k) depths.push_back(plan.horizon_m * k / plan.steps);
   PreResult out;
@@ -365,7 +370,20 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
                        : equivalent_axisymmetric_needle(n.mesh, 1.05 * plan.horizon_m));
     PreSeries series;
     CrossingWatch watch(1, plan);
-    for (const AnalyticStep& st : analytic_indentation(scene.tissue, *profile, depths)) {
+    std::vector<AnalyticStep> steps;
+    PlateContact contact;
+    if (plate) {
+      try {
+        contact = plate_contact(scene.tissue, profile->radii_m.front());
+      } catch (const InputError& e) {
+        // One line naming the scene (the message names the layer and the value).
+        throw InputError(scene.source_name + ": " + e.what());
+      }
+      for (double d : depths) steps.push_back({d, contact.stiffness_N_per_m * d, 0.0, 0.0});
+    } else {
+      steps = analytic_indentation(scene.tissue, *profile, depths);
+    }
+    for (const AnalyticStep& st : steps) {
       RunPoint p;
       p.depth_m = st.depth_m;
       p.force_N = st.force_N;
@@ -376,19 +394,24 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
       c.depth_m = st.depth_m;
       c.contact_pressure_Pa = p.section_pressure_Pa;
       c.penetration_ratio = areas[i].penetration_ratio(p.force_N, p.depth_m);
+      if (plate) p.tip_stress_Pa = c.tip_stress_Pa = contact.stress_per_force_Pa_per_N * p.force_N;
       series.points.push_back(p);
       series.samples.push_back(c);
       if (!watch.keep_going(0, c)) break;
     }
     const Tissue tissue = scene.tissue;
     const SectionArea area = areas[i];
-    const bool penetration =
-        plan.threshold && plan.threshold->criterion == PunctureCriterion::Penetration;
-    series.resolve = [tissue, profile, area, penetration](double depth) {
-      const double force = analytic_indentation(tissue, *profile, {depth}).front().force_N;
-      return penetration ? area.penetration_ratio(force, depth)
-                         : pressure_over(force, area.at(depth));
-    };
+    const bool penetration = has_criterion && criterion == PunctureCriterion::Penetration;
+    if (plate) {
+      const double per_depth = contact.stiffness_N_per_m * contact.stress_per_force_Pa_per_N;
+      series.resolve = [per_depth](double depth) { return per_depth * depth; };
+    } else {
+      series.resolve = [tissue, profile, area, penetration](double depth) {
+        const double force = analytic_indentation(tissue, *profile, {depth}).front().force_N;
+        return penetration ? area.penetration_ratio(force, depth)
+                           : pressure_over(force, area.at(depth));
+      };
+    }
     out.needles.push_back(std::move(series));
   }
   out.model = "analytic";

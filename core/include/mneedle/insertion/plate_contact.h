@@ -1,0 +1,34 @@
+#pragma once
+// The stress criterion in closed form, for the analytic path: a top layer much stiffer than the
+// layers beneath (skin's stratum corneum) bends as a thin plate on them and a sharp tip presses
+// it at one point. The force is then linear in the depth and the stress the criterion averages
+// is linear in the force (docs/model.md, "The stress criterion on the
+// analytic path"). SI units.
+
+#include "mneedle/scene/scene.h"
+
+namespace mneedle {
+
+struct PlateContact {
+  double stiffness_N_per_m = 0.0;  ///< F / d, the contact staying where it started
+  /// The top layer's maximum principal stress averaged over its strength_length around the
+  /// underside below the contact, per newton of needle force (Pa/N).
+  double stress_per_force_Pa_per_N = 0.0;
+  double bending_length_m = 0.0;       ///< l = (2 D / E*_f)^(1/3)
+  double foundation_modulus_Pa = 0.0;  ///< E*_f = E / (1 - nu^2) of the layer beneath
+};
+
+/// A top layer bends as a plate when the plate's length l is at least this many thicknesses:
+/// Kirchhoff's theory needs the thickness small beside the bending length.
+inline constexpr double kPlateLengthPerThickness = 5.0;
+
+/// The top layer of `tissue` as a Kirchhoff plate bonded to the layer beneath, taken for an
+/// elastic half-space, loaded at one point by a pointed tip (`contact_radius_m`, the radius of
+/// the needle's end, at most the layer's strength_length L). The stress is averaged over L, as
+/// the FE stress probe averages it. Throws InputError, naming the layer and the value, when the
+/// tissue has fewer than two layers, the top layer has no strength, l < kPlateLengthPerThickness
+/// thicknesses (the layer does not bend as a plate) or the end is a flat wider than 2 L (a rigid
+/// edge concentrates stress beyond a plate's reach): the FE models answer those.
+PlateContact plate_contact(const Tissue& tissue, double contact_radius_m);
+
+}  // namespace mneedle
