@@ -102,8 +102,6 @@ PlateContact plate_contact(const Tissue& tissue, double contact_radius_m) {
   out.bending_length_m = l;
   out.foundation_modulus_Pa = e_f;
 
-  // The ball of radius L centred on the underside, cut at the layer's top: slices at height z
-  // above the underside, each a disc of radius rho(z) weighted by the bending profile 1 - 2 z/t.
   if (contact_radius_m > L)
     throw InputError(
         "stress criterion on the analytic path: the needle meets layer '" + top.name +
@@ -112,7 +110,7 @@ PlateContact plate_contact(const Tissue& tissue, double contact_radius_m) {
         "in the layer beyond a plate's reach); use --model axisymmetric or 3d");
   // The ball of radius L centred on the underside below the point, cut at the layer's top:
   // slices at height z above the underside, each a disc of radius rho(z) weighted by the bending
-  // profile 1 - 2 z / t and by the disc's mean hoop moment (under a point the larger one).
+  // profile max(0, 1 - 2 z / t) and by the disc's mean hoop moment (under a point the larger one).
   const double z_max = std::min(L, t);
   double weighted = 0.0, volume = 0.0;
   constexpr int kSlices = 24;
@@ -120,7 +118,9 @@ PlateContact plate_contact(const Tissue& tissue, double contact_radius_m) {
     const double z = (s + 0.5) * z_max / kSlices;
     const double rho = std::sqrt(L * L - z * z);
     const double area = kPi * rho * rho;
-    weighted += area * (1.0 - 2.0 * z / t) * disc_mean_hoop_moment(rho / l, nu);
+    // Above the mid-plane both in-plane stresses are compressive and the maximum principal
+    // stress is the plate's out-of-plane one, zero.
+    weighted += area * std::max(0.0, 1.0 - 2.0 * z / t) * disc_mean_hoop_moment(rho / l, nu);
     volume += area;
   }
   // w(0) = 1 / (2 pi c l) int dx / (x^3 + 1) = 1 / (3 sqrt(3) c l).
