@@ -287,7 +287,8 @@ TEST(CmdSimulate, ReadmeSiliconeFigurePuncturesWhereItsCaptionSays) {
 // 58.41 um at 5.207 mN, pinned to 1 % (closed form: a move is a change to explain); against the
 // axisymmetric FE cone at standard -10.7 % in depth and -5.7 % in force, within the 15 % this
 // test allows (the plate's stiffness reads +5.6 % and its stress per newton +6 %). A flat end is
-// refused in one line naming the scene and the layer.
+// refused in one line naming the scene and the layer, and so is a tip whose flank meets the bent
+// layer before it breaks.
 TEST(CmdSimulate, AnalyticStressCriterionInSkinPuncturesAPointedTipNearTheFeDepth) {
   const std::string skin = std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/human_skin.toml";
   std::string cone = mneedle::test::file_text(skin);
@@ -317,6 +318,15 @@ TEST(CmdSimulate, AnalyticStressCriterionInSkinPuncturesAPointedTipNearTheFeDept
   EXPECT_NEAR(closed["force_N"].get<double>(), fe["force_N"].get<double>(),
               0.15 * fe["force_N"].get<double>());
   EXPECT_EQ(bevel_closed["depth_m"].get<double>(), closed["depth_m"].get<double>());
+  // A cone of 88 deg half-angle meets the bent layer with its flank before the layer breaks.
+  std::string blunt = cone;
+  const std::string sharp_cone = "{ plugin = \"cone\" }";
+  blunt.replace(blunt.find(sharp_cone), sharp_cone.size(),
+                "{ plugin = \"cone\", half_angle = \"88 deg\" }");
+  std::ofstream(file) << blunt;
+  const CommandRun flank = run_mneedle("simulate '" + file.string() + "' --model analytic --json");
+  EXPECT_EQ(flank.exit_code, 1);
+  EXPECT_NE(flank.err.find("with its flank at"), std::string::npos) << flank.err;
   fs::remove(file);
 
   const CommandRun flat =

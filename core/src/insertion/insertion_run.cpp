@@ -379,6 +379,19 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
         // One line naming the scene (the message names the layer and the value).
         throw InputError(scene.source_name + ": " + e.what());
       }
+      // The closed form holds while the tip alone touches the bent layer.
+      const double breaks = plan.threshold->threshold /
+                            (contact.stress_per_force_Pa_per_N * contact.stiffness_N_per_m);
+      const double touches = point_contact_depth_limit(contact, *profile);
+      if (touches < breaks)
+        throw InputError(
+            scene.source_name +
+            ": stress criterion on the analytic path: the needle meets the bent layer '" +
+            scene.tissue.layers[0].name + "' with its flank at " +
+            format_quantity(touches, Dimension::Length) +
+            ", before the layer breaks under its tip at " +
+            format_quantity(breaks, Dimension::Length) +
+            ": no longer a point contact; use --model axisymmetric or 3d");
       for (double d : depths) steps.push_back({d, contact.stiffness_N_per_m * d, 0.0, 0.0});
     } else {
       steps = analytic_indentation(scene.tissue, *profile, depths);

@@ -10,8 +10,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
@@ -127,6 +129,45 @@ PlateContact plate_contact(const Tissue& tissue, double contact_radius_m) {
   out.stiffness_N_per_m = 3.0 * std::sqrt(3.0) * c * l;
   out.stress_per_force_Pa_per_N = 6.0 / (t * t) * weighted / volume;
   return out;
+}
+
+double plate_deflection_shape(const PlateContact& plate, double radius_m) {
+  const double r = radius_m / plate.bending_length_m;
+  // int_0^inf J0(x r) / (x^3 + 1) dx to x = X, then the tail int_X^inf J0(x r) / x^3 dx, which is
+  // J0(X r) / (2 X^2) where J0 varies slowly over it and below 1e-6 of the whole where it does
+  // not.
+  constexpr double kX = 60.0;
+  const double integral = panels([&](double x) { return j0(x * r) / (x * x * x + 1.0); }, 0.0, kX,
+                                 std::min(0.25, kPi / (4.0 * std::max(r, 1e-9)))) +
+                          j0(kX * r) / (2.0 * kX * kX);
+  return integral * 3.0 * std::sqrt(3.0) / (2.0 * kPi);
+}
+
+double point_contact_depth_limit(const PlateContact& plate, const fe::AxisymmetricNeedle& needle) {
+  const auto& h = needle.heights_m;
+  const auto& r = needle.radii_m;
+  const double widest = r.empty() ? 0.0 : *std::max_element(r.begin(), r.end());
+  if (!(widest > 0.0)) return std::numeric_limits<double>::infinity();
+  // The plate's shape on 129 radii to the needle's widest, linear between them (it is smooth on
+  // that scale: l is hundreds of micrometres).
+  constexpr int kRadii = 128;
+  std::vector<double> shape(kRadii + 1);
+  for (int j = 0; j <= kRadii; ++j) shape[j] = plate_deflection_shape(plate, widest * j / kRadii);
+  auto shape_at = [&](double radius) {
+    const double u = std::clamp(radius / widest * kRadii, 0.0, static_cast<double>(kRadii));
+    const int j = std::min(static_cast<int>(u), kRadii - 1);
+    return shape[j] + (u - j) * (shape[j + 1] - shape[j]);
+  };
+  double limit = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 1; i < h.size(); ++i)
+    for (int k = 1; k <= 4; ++k) {  // four points along each piece, its upper corner included
+      const double f = k / 4.0;
+      const double radius = r[i - 1] + f * (r[i] - r[i - 1]);
+      const double gap = 1.0 - shape_at(radius);
+      if (radius > 0.0 && gap > 0.0)
+        limit = std::min(limit, (h[i - 1] + f * (h[i] - h[i - 1])) / gap);
+    }
+  return limit;
 }
 
 }  // namespace mneedle

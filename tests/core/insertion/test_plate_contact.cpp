@@ -66,6 +66,36 @@ TEST(PlateContact, APointsStressGrowsFasterThanTheBendingGradientAsTheAveragingL
   EXPECT_GT(stress(2e-6) / stress(10e-6), 0.925 / 0.625 + 0.3);
 }
 
+// w(r) / w(0) is 1 under the point (the integral of 1 / (x^3 + 1) is 2 pi / (3 sqrt 3)) and falls
+// with the distance from it.
+TEST(PlateContact, TheDeflectionIsLargestUnderThePointAndFallsAwayFromIt) {
+  const PlateContact plate = plate_contact(two_layers(0.134e6), 0.0);
+  EXPECT_NEAR(plate_deflection_shape(plate, 0.0), 1.0, 1e-6);
+  double previous = 1.0;
+  for (double r : {20e-6, 50e-6, 100e-6, 200e-6, 400e-6}) {
+    const double shape = plate_deflection_shape(plate, r);
+    EXPECT_LT(shape, previous) << r;
+    previous = shape;
+  }
+}
+
+// A cone touches the bent plate with its flank only when it is blunt: at 15 deg (the cone
+// plugin's default) the flank stays clear to millimetres, at 88 deg it meets the plate within
+// tens of micrometres, before the layer breaks under the tip (58 um here).
+TEST(PlateContact, OnlyABluntConesFlankMeetsTheBentPlateBeforeTheLayerBreaks) {
+  const PlateContact plate = plate_contact(two_layers(0.134e6), 0.0);
+  auto cone = [](double half_angle_deg) {
+    fe::AxisymmetricNeedle n;
+    const double radius = 115e-6;
+    const double height = radius / std::tan(half_angle_deg * 3.14159265358979 / 180.0);
+    n.heights_m = {0.0, height, height + 1e-3};
+    n.radii_m = {0.0, radius, radius};
+    return n;
+  };
+  EXPECT_GT(point_contact_depth_limit(plate, cone(15.0)), 1e-3);
+  EXPECT_LT(point_contact_depth_limit(plate, cone(88.0)), 50e-6);
+}
+
 TEST(PlateContact, ATissueThatIsNoPlateOnAFoundationIsRefusedByName) {
   Tissue one = two_layers(0.134e6);
   one.layers.pop_back();

@@ -5,6 +5,7 @@
 // is linear in the force (docs/model.md, "The stress criterion on the
 // analytic path"). SI units.
 
+#include "mneedle/fe/axisymmetric.h"
 #include "mneedle/scene/scene.h"
 
 namespace mneedle {
@@ -30,5 +31,13 @@ inline constexpr double kPlateLengthPerThickness = 5.0;
 /// thicknesses (the layer does not bend as a plate) or the end is a flat wider than 2 L (a rigid
 /// edge concentrates stress beyond a plate's reach): the FE models answer those.
 PlateContact plate_contact(const Tissue& tissue, double contact_radius_m);
+
+/// Deflection of the plate at radius r over its deflection under the point, w(r) / w(0).
+double plate_deflection_shape(const PlateContact& plate, double radius_m);
+
+/// The deepest tip travel (m) at which the needle still touches the bent plate at its tip only:
+/// the smallest h(r) / (1 - w(r)/w(0)) over the needle's profile, h(r) the needle's height above
+/// its tip at radius r (infinite when its flank never meets the plate).
+double point_contact_depth_limit(const PlateContact& plate, const fe::AxisymmetricNeedle& needle);
 
 }  // namespace mneedle
