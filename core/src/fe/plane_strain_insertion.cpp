@@ -254,6 +254,25 @@ class Block {
 
 }  // namespace
 
+double cohesive_damage(const CohesiveLaw& law, double largest_opening_m) {
+  if (!(law.toughness_J_per_m2 > 0.0) || largest_opening_m <= law.peak_opening_m) return 0.0;
+  if (largest_opening_m >= law.failure_opening_m) return 1.0;
+  // On the softening branch t = t_peak (delta_0 - delta) / (delta_0 - delta_y).
+  const double peak = 2.0 * law.toughness_J_per_m2 / law.failure_opening_m;
+  const double delta = largest_opening_m;
+  const double t =
+      peak * (law.failure_opening_m - delta) / (law.failure_opening_m - law.peak_opening_m);
+  return 1.0 - t / (peak / law.peak_opening_m * delta);
+}
+
+double cohesive_traction(const CohesiveLaw& law, double opening_m, double largest_opening_m) {
+  if (!(law.toughness_J_per_m2 > 0.0) || !(opening_m > 0.0)) return 0.0;
+  const double peak = 2.0 * law.toughness_J_per_m2 / law.failure_opening_m;
+  const double stiffness0 = peak / law.peak_opening_m;
+  const double reached = std::max(opening_m, largest_opening_m);
+  return (1.0 - cohesive_damage(law, reached)) * stiffness0 * opening_m;
+}
+
 PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInsertionProblem& p) {
   check(p);
   const Block block(p);
@@ -290,18 +309,10 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
   const bool cohesive = law.toughness_J_per_m2 > 0.0;
   const double peak_traction =
       cohesive ? 2.0 * law.toughness_J_per_m2 / law.failure_opening_m : 0.0;
-  auto traction = [&](double delta) {  // the envelope
-    if (delta <= law.peak_opening_m) return peak_traction * delta / law.peak_opening_m;
-    if (delta >= law.failure_opening_m) return 0.0;
-    return peak_traction * (law.failure_opening_m - delta) /
-           (law.failure_opening_m - law.peak_opening_m);
-  };
   std::vector<double> share(m, 0.0), opened(m, 0.0), secant(m, 0.0), damage(m, 0.0);
   const double stiffness0 = cohesive ? peak_traction / law.peak_opening_m : 0.0;
   // The law's damage at the largest opening reached: t = (1 - D) K delta on unloading.
-  auto law_damage = [&](double reached) {
-    return reached <= law.peak_opening_m ? 0.0 : 1.0 - traction(reached) / (stiffness0 * reached);
-  };
+  auto law_damage = [&](double reached) { return cohesive_damage(law, reached); };
   double relax = 0.0;  // travel of this step over the viscosity (0: none)
   std::vector<char> bonded(m, 0);
   for (int j = 0; j < m; ++j) {

@@ -35,6 +35,16 @@ struct CohesiveLaw {
   double viscosity_m = 0.5e-3;
 };
 
+/// The law's damage at the largest opening a cell has reached (m): 0 up to delta_y, then
+/// 1 - t(delta)/(K0 delta) on the softening branch, 1 from delta_0; K0 = t_peak / delta_y. It
+/// depends on the largest opening only, so it never falls: the crack never heals.
+double cohesive_damage(const CohesiveLaw& law, double largest_opening_m);
+
+/// Traction (Pa) across a cell open by `opening_m` that has reached `largest_opening_m` before:
+/// the law's envelope while the opening grows past it, (1 - D) K0 opening below it (unloading
+/// and reloading along the damaged secant, through the origin). 0 without cohesion.
+double cohesive_traction(const CohesiveLaw& law, double opening_m, double largest_opening_m);
+
 struct PlaneStrainInsertionProblem {
   double youngs_modulus_Pa = 0.0;
   double poisson_ratio = 0.0;
