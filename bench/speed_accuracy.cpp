@@ -347,7 +347,9 @@ int main(int argc, char** argv) {
     const PluginRegistry registry = PluginRegistry::discover();
     std::vector<RunOutcome> runs;
     for (const SceneEntry& entry : scenes) {
-      const Scene scene = load_scene(entry.file());
+      Scene scene = load_scene(entry.file());
+      // Messages name the scene as the repository does, not by this checkout's absolute path.
+      scene.source_name = fs::relative(entry.file(), MNEEDLE_SOURCE_ROOT).string();
       const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene);
       for (Case c : cases_for(entry, scene, needles.front(), options.quick)) {
         runs.push_back(run_case(entry, scene, needles, c));

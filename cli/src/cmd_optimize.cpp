@@ -341,12 +341,13 @@ nlohmann::json number_or_null(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
 
-// One element size at the tip for every 3-D design of the run, so that the tissue mesh does not
-// jump between designs and the objective stays smooth: the size the start design's own run
-// takes. The axisymmetric model is left to its own rule (docs/model.md, "Mesh"): it sizes a
-// pointed tip under the stress criterion from the criterion's length, not from the design, and
-// a size imposed from outside would switch that rule off, so the start design would no longer
-// puncture where `simulate` punctures it. Returns no size when the start runs no 3-D model.
+// One element size at the tip for every design of the run, so that the tissue mesh does not jump
+// between designs and the objective stays smooth: the 3-D size of the start design's radius. One
+// case is left to the model's own rule: a pointed tip on the axisymmetric model under the stress
+// criterion, which that model sizes from the criterion's length, not from the design
+// (docs/model.md, "Mesh"); an imposed size would switch the rule off, and the start design would
+// no longer puncture where `simulate` punctures it (the cone in skin read 56.4 against 62.8 um).
+// Returns no size then, and for the analytic model, which has no mesh.
 std::optional<double> fixed_tip_size(const Problem& p, const std::vector<DesignVariable>& vars,
                                      const std::vector<double>& start) {
   std::map<std::string, double> at_start;
@@ -358,23 +359,27 @@ std::optional<double> fixed_tip_size(const Problem& p, const std::vector<DesignV
     n = p.needle({});  // the start is not a valid shape: the plugin's defaults are
   }
   const PreModel model = p.evaluation.model;
-  if (model == PreModel::Analytic || model == PreModel::Axisymmetric) return std::nullopt;
+  if (model == PreModel::Analytic) return std::nullopt;
+  const auto& layers = p.scene.tissue.layers;
+  const double length = p.scene.model.criterion == PunctureCriterion::Stress && !layers.empty() &&
+                                layers.front().strength
+                            ? layers.front().strength->length
+                            : 0.0;
   // The planner's rule (run_insertion): one needle of revolution on the block's axis runs
   // axisymmetric; a design is evaluated alone, in the place of the scene's first needle.
   const auto& at = p.scene.needles.front().at;
-  if (model == PreModel::Auto && std::hypot(at[0], at[1]) < 1e-12 &&
-      needle_symmetry(p.registry, n, "optimize: " + p.args.plugin).axisymmetric)
+  const auto profile = needle_symmetry(p.registry, n, "optimize: " + p.args.plugin).axisymmetric;
+  const bool axisymmetric =
+      model == PreModel::Axisymmetric ||
+      (model == PreModel::Auto && std::hypot(at[0], at[1]) < 1e-12 && profile.has_value());
+  if (axisymmetric && length > 0.0 && profile &&
+      profile->radii_m.front() <= 1e-9 * profile->max_radius())
     return std::nullopt;
   const double depth = p.scene.requirements.target_depth.value_or(p.scene.insertion.depth);
   const double block = std::max(p.scene.tissue.size[0], p.scene.tissue.size[1]);
   // The stress criterion's length caps the tip element as in every run (docs/model.md, "Tissue
   // block and mesh"); a scene without the criterion's data has none (it may have no puncture data
   // at all, and then runs without a criterion).
-  const auto& layers = p.scene.tissue.layers;
-  const double length = p.scene.model.criterion == PunctureCriterion::Stress && !layers.empty() &&
-                                layers.front().strength
-                            ? layers.front().strength->length
-                            : 0.0;
   return fe::mesh_sizing(p.evaluation.fidelity, 2, max_radius_up_to(n.mesh, depth), block, {},
                          length)
       .fine_size;

@@ -150,8 +150,23 @@ std::optional<fe::AxisymmetricNeedle> axisymmetric_profile(const PluginRegistry&
   fe::AxisymmetricNeedle profile;
   profile.bore_radius_m = bore;
   constexpr int kSamples = 200;
-  for (int i = 0; i <= kSamples; ++i) {
-    const double h = top * i / kSamples;
+  std::vector<double> heights;
+  for (int i = 0; i <= kSamples; ++i) heights.push_back(top * i / kSamples);
+  // A rounded point (tip_radius rho) is a cap rho (1 - sin a) tall, often below one sample
+  // spacing (2.3 um for the default cone): 32 more samples, denser towards the point where the
+  // radius grows as sqrt(2 rho h), follow it up to twice its height.
+  const double cap = p.count("tip_radius") ? p.at("tip_radius") : 0.0;
+  if (cap > 0.0) {
+    const double cap_height = cap * (1.0 - std::sin(p.at("half_angle")));
+    for (int k = 1; k <= 32; ++k) {
+      const double f = k / 32.0;
+      const double h = 2.0 * cap_height * f * f;
+      if (h < top) heights.push_back(h);
+    }
+    std::sort(heights.begin(), heights.end());
+    heights.erase(std::unique(heights.begin(), heights.end()), heights.end());
+  }
+  for (const double h : heights) {
     const std::optional<double> area = registry.section_area(*needle.plugin, p, h);
     if (!area) throw InputError(where + ": the cone plugin gives no section area");
     const double r = std::sqrt(std::max(*area / M_PI + bore * bore, 0.0));

@@ -153,7 +153,7 @@ TEST_F(ForceCommand, PaperAFig20SharpBevelAndCylinderInTheFig17ModeArePinnedWith
   EXPECT_NEAR(f_sharp, 0.0329, 1e-4);
   EXPECT_NEAR(f_sharp / 0.014 - 1.0, 1.35, 0.01);  // the miss against paper A's 14 mN
   EXPECT_NEAR(f_cylinder, 0.00073, 1e-5);
-  EXPECT_LT(f_cylinder, f_sharp);  // paper A's Fig. 20: the cylinder's is the largest
+  EXPECT_LT(f_cylinder, f_sharp);  // the reverse of paper A's Fig. 20, where it is the largest
   std::filesystem::remove(sharp);
   std::filesystem::remove(cylinder);
 }

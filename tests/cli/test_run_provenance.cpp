@@ -131,7 +131,7 @@ TEST_F(Provenance, ScreenRowsCarryTheFileAndMeshDigests) {
   fs::remove_all(dir);
   fs::create_directories(dir / "in");
   fs::copy_file(kRoot + "/designs/cone.stl", dir / "in" / "cone.stl");
-  // The closed-form model has no stress field: the skin scene with the pressure criterion.
+  // The skin scene with the pressure criterion, which the closed-form model takes for any tip.
   const std::string args = "screen '" + (dir / "in").string() + "' --scene '" +
                            mneedle::test::skin_scene_with_criterion("pressure") +
                            "' --model analytic --out '" + (dir / "out").string() + "'";

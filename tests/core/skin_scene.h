@@ -1,7 +1,8 @@
 #pragma once
 // The shipped skin scene (designs/scenes/human_skin.toml) with its puncture criterion replaced,
 // written to a file: tests that run the closed-form pre-puncture model on skin use it with
-// "pressure", since that model has no stress field for the scene's own stress criterion.
+// "pressure", whose closed form takes every tip shape (the scene's own stress criterion takes
+// pointed tips only there: docs/model.md, "The stress criterion on the analytic path").
 
 #include <filesystem>
 #include <fstream>

@@ -89,6 +89,28 @@ TEST_F(DesignSource, AConeStlHasThePluginsProfileToItsFacets) {
     EXPECT_GE(profile->radii_m[i], profile->radii_m[i - 1]);
 }
 
+// A rounded point (the cone's tip_radius) is a cap rho (1 - sin a) tall: 1.85 um for a 5 um
+// tip on the 15 deg cone, below the 2.3 um spacing of the profile's even samples, which drew it
+// as a straight cone from the point. The profile now follows the sphere inside the cap.
+TEST_F(DesignSource, ARoundedConesProfileFollowsItsSphericalCap) {
+  const double rho = 2.5e-6, half_angle = 15.0 * std::numbers::pi / 180.0;
+  const auto cone = mneedle::needle_from_plugin(registry_, "cone", {{"tip_radius", rho}});
+  const auto profile = mneedle::axisymmetric_profile(registry_, cone, "cone");
+  ASSERT_TRUE(profile.has_value());
+  const double cap_height = rho * (1.0 - std::sin(half_angle));
+  int inside = 0;
+  for (std::size_t i = 0; i < profile->heights_m.size(); ++i) {
+    const double h = profile->heights_m[i];
+    if (h > cap_height) break;
+    ++inside;
+    // The plugin's analytic section at h: the sphere's radius, to the section's round-off.
+    EXPECT_NEAR(profile->radii_m[i], std::sqrt(std::max(0.0, 2.0 * rho * h - h * h)), 1e-9)
+        << "h = " << h;
+  }
+  EXPECT_GE(inside, 16);
+  EXPECT_LE(profile->radii_m.front(), 1e-9 * profile->max_radius());  // still pointed
+}
+
 TEST_F(DesignSource, ABevelOrAMeshThatIsNotRoundHasNoProfile) {
   const auto bevel = mneedle::needle_from_file(kRoot + "/designs/sharp_bevel.stl", 1e-3);
   EXPECT_FALSE(mneedle::revolution_profile(bevel.mesh).has_value());

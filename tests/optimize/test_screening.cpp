@@ -37,9 +37,9 @@ class Screening : public ::testing::Test {
     std::ofstream(dir_ / "list.toml")
         << "[[designs]]\nname = \"bevel_20\"\nplugin = \"sharp_bevel\"\n"
            "bevel_angle = \"20 deg\"\n";
-    // The closed-form model these tests run has no stress field for the skin scene's own stress
-    // criterion: the screening machinery is checked on a copy with the pressure criterion (a
-    // file, since uncertainty runs re-read it with drawn values).
+    // The closed-form model these tests run takes the skin scene's own stress criterion for
+    // pointed tips only: the screening machinery is checked on a copy with the pressure
+    // criterion (a file, since uncertainty runs re-read it with drawn values).
     scene_file_ = mneedle::test::write_skin_scene_with_criterion("pressure",
                                                                  dir_ / "human_skin_pressure.toml");
     scene_ = mneedle::load_scene(scene_file_);

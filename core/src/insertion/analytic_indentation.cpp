@@ -300,11 +300,6 @@ fe::AxisymmetricNeedle equivalent_axisymmetric_needle(const TriangleMesh& mesh, 
   return needle;
 }
 
-double layered_reduced_modulus(const Tissue& tissue, double contact_radius_m) {
-  check_tissue(tissue);
-  return effective_modulus(tissue, contact_radius_m).reduced_modulus_Pa;
-}
-
 std::vector<AnalyticStep> analytic_indentation(const Tissue& tissue,
                                                const fe::AxisymmetricNeedle& needle,
                                                const std::vector<double>& depths_m) {

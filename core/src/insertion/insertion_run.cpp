@@ -356,9 +356,9 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
     throw InputError(
         "simulate: the analytic model gives no energy release rate; the energy criterion needs "
         "--model axisymmetric or 3d");
-  // The stress criterion in closed form: the top layer as a plate on the layers beneath, pressed
-  // at the tip's point or along a flat end's rim (docs/model.md, "The stress criterion on the
-  // analytic path"). Its force replaces the indentation law's: the stress is the plate's.
+  // The stress criterion in closed form: the top layer as a plate on the layer beneath, pressed
+  // at one point by a pointed tip (docs/model.md, "The stress criterion on the analytic path").
+  // Its force replaces the indentation law's: the stress is the plate's.
   const bool plate = has_criterion && criterion == PunctureCriterion::Stress;
   std::vector<double> depths;
   for (int k = 1; k <= plan.steps; ++k) depths.push_back(plan.horizon_m * k / plan.steps);
@@ -379,11 +379,12 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
         // One line naming the scene (the message names the layer and the value).
         throw InputError(scene.source_name + ": " + e.what());
       }
-      // The closed form holds while the tip alone touches the bent layer.
+      // The closed form holds while the tip alone touches the bent layer, as far as this rung of
+      // the pre-puncture model goes (the puncture, or the rung's horizon before it).
       const double breaks = plan.threshold->threshold /
                             (contact.stress_per_force_Pa_per_N * contact.stiffness_N_per_m);
       const double touches = point_contact_depth_limit(contact, *profile);
-      if (touches < breaks)
+      if (touches < std::min(breaks, plan.horizon_m))
         throw InputError(
             scene.source_name +
             ": stress criterion on the analytic path: the needle meets the bent layer '" +

@@ -53,7 +53,8 @@ double j1(double x) {
 // Mean over a disc of radius rho (in units of l) of the hoop moment under a unit point load:
 //   1/(2 pi) int x^2/(x^3+1) [nu A0(x rho) + (1 - nu) A1(x rho)] dx,
 // A0(y) = 2 J1(y)/y and A1(y) = 2 (1 - J0(y))/y^2 being the disc means of J0 and J1(y)/y.
-// Beyond x = 20 the kernel is 1/x to 4e-5 and the integral is taken in y = x rho, whose
+// Beyond x = 20 the kernel is 1/x (relative error 1.25e-4 at x = 20, 4e-5 of the integral
+// past it) and the integral is taken in y = x rho, whose
 // oscillation period 2 pi is fixed (panels of width 1); past y = 200 only A1's smooth part 2/y^2
 // counts (its tail is added; A0's oscillating remainder is below 1e-4 of the sum).
 double disc_mean_hoop_moment(double rho, double nu) {
@@ -107,9 +108,10 @@ PlateContact plate_contact(const Tissue& tissue, double contact_radius_m) {
   if (contact_radius_m > L)
     throw InputError(
         "stress criterion on the analytic path: the needle meets layer '" + top.name +
-        "' with a flat end " + format_quantity(2.0 * contact_radius_m, Dimension::Length) +
-        " wide; the plate model holds for a pointed tip only (a rigid edge concentrates stress "
-        "in the layer beyond a plate's reach); use --model axisymmetric or 3d");
+        "' with a flat end (as wide as a circle of " +
+        format_quantity(2.0 * contact_radius_m, Dimension::Length) +
+        ", its area's); the plate model holds for a pointed tip only (a rigid edge concentrates "
+        "stress in the layer beyond a plate's reach); use --model axisymmetric or 3d");
   // The ball of radius L centred on the underside below the point, cut at the layer's top:
   // slices at height z above the underside, each a disc of radius rho(z) weighted by the bending
   // profile max(0, 1 - 2 z / t) and by the disc's mean hoop moment (under a point the larger one).
@@ -133,9 +135,9 @@ PlateContact plate_contact(const Tissue& tissue, double contact_radius_m) {
 
 double plate_deflection_shape(const PlateContact& plate, double radius_m) {
   const double r = radius_m / plate.bending_length_m;
-  // int_0^inf J0(x r) / (x^3 + 1) dx to x = X, then the tail int_X^inf J0(x r) / x^3 dx, which is
-  // J0(X r) / (2 X^2) where J0 varies slowly over it and below 1e-6 of the whole where it does
-  // not.
+  // int_0^inf J0(x r) / (x^3 + 1) dx to x = X, then the tail int_X^inf J0(x r) / x^3 dx, taken
+  // as J0(X r) / (2 X^2): exact where J0 varies slowly over the tail, within about 1e-5 of the
+  // whole where it does not (measured at r = l/2).
   constexpr double kX = 60.0;
   const double integral = panels([&](double x) { return j0(x * r) / (x * x * x + 1.0); }, 0.0, kX,
                                  std::min(0.25, kPi / (4.0 * std::max(r, 1e-9)))) +

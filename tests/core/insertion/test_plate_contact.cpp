@@ -111,7 +111,7 @@ TEST(PlateContact, ATissueThatIsNoPlateOnAFoundationIsRefusedByName) {
   EXPECT_NE(m.find("--model axisymmetric or 3d"), std::string::npos) << m;
   // A flat end wider than 2 L: paper A's cylinder (230 um).
   const std::string flat = message_of(two_layers(0.134e6), 115e-6);
-  EXPECT_NE(flat.find("flat end 230 um wide"), std::string::npos) << flat;
+  EXPECT_NE(flat.find("flat end (as wide as a circle of 230 um"), std::string::npos) << flat;
 }
 
 }  // namespace

@@ -24,11 +24,6 @@ struct AnalyticStep {
 fe::AxisymmetricNeedle equivalent_axisymmetric_needle(const TriangleMesh& mesh, double height_m,
                                                       int samples = 200);
 
-/// Reduced modulus E* = E / (1 - nu^2) of the layered block as a rigid punch of radius
-/// `contact_radius_m` feels it (Gao, Chiu & Lee's weight function applied layer by layer, a stiff
-/// top layer capped by its plate modulus; docs/model.md, "The fast analytic path"), Pa.
-double layered_reduced_modulus(const Tissue& tissue, double contact_radius_m);
-
 /// Force, contact area and mean pressure at each depth (ascending, m). Throws InputError for a
 /// tissue or needle it cannot represent.
 std::vector<AnalyticStep> analytic_indentation(const Tissue& tissue,
