@@ -363,6 +363,44 @@ TEST(CmdSimulate, PressureCrossingOfAFlatPunchInSiliconeIsTheClosedFormsWithinTw
   EXPECT_NEAR(depth("axisymmetric"), closed, 0.02 * closed);
 }
 
+// The README's "forces 3-30x below those measured in human skin": Roemgens et al. 2014 measured
+// 20 mN at the drop for a 5 um tip and 167 mN for a 37 um tip (docs/validation.md, "Tip radius,
+// against Roemgens"). Our cone with those tips on human_skin.toml (axisymmetric, standard):
+// 61.9 um / 5.551 mN and 61.3 um / 5.547 mN, measured 2026-12-05, pinned to 1 %; the misses are
+// 3.6x and 30x, and the force does not rise with the tip.
+TEST(CmdSimulate, RoundedConeTipsInSkinPunctureFarBelowTheForcesRoemgensMeasured) {
+  std::string text = mneedle::test::file_text(std::string(MNEEDLE_SOURCE_ROOT) +
+                                              "/designs/scenes/human_skin.toml");
+  const std::string bevel =
+      "geometry = { plugin = \"sharp_bevel\", diameter = \"230 um\", length "
+      "= \"1000 um\", bevel_angle = \"30 deg\" }";
+  const auto at = text.find(bevel);
+  ASSERT_NE(at, std::string::npos);
+  const fs::path file =
+      fs::temp_directory_path() / ("roemgens_" + std::to_string(::getpid()) + ".toml");
+  struct Tip {
+    std::string radius;
+    double depth, force, measured;
+  };
+  for (const Tip& tip :
+       {Tip{"2.5 um", 61.87e-6, 5.551e-3, 20e-3}, Tip{"18.5 um", 61.28e-6, 5.547e-3, 167e-3}}) {
+    std::string scene = text;
+    scene.replace(at, bevel.size(),
+                  "geometry = { plugin = \"cone\", tip_radius = \"" + tip.radius + "\" }");
+    std::ofstream(file) << scene;
+    const CommandRun run = run_mneedle("simulate '" + file.string() + "' --json");
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const auto p = nlohmann::json::parse(run.out)["needles"][0]["puncture"];
+    ASSERT_TRUE(p.is_object()) << tip.radius;
+    EXPECT_NEAR(p["depth_m"].get<double>(), tip.depth, 0.01 * tip.depth) << tip.radius;
+    EXPECT_NEAR(p["force_N"].get<double>(), tip.force, 0.01 * tip.force) << tip.radius;
+    const double miss = tip.measured / p["force_N"].get<double>();
+    EXPECT_GE(miss, 3.0) << tip.radius;
+    EXPECT_LE(miss, 31.0) << tip.radius;
+  }
+  fs::remove(file);
+}
+
 TEST(CmdSimulate, SharpBevelFiresAtFirstContactOnAHalfModelAndSaysSo) {
   const CommandRun run = run_mneedle("simulate '" + scene("puncture_bevel.toml") + "' --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
