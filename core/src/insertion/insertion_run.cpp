@@ -381,8 +381,9 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
       }
       // The closed form holds while the tip alone touches the bent layer, as far as this rung of
       // the pre-puncture model goes (the puncture, or the rung's horizon before it).
-      const double breaks = plan.threshold->threshold /
-                            (contact.stress_per_force_Pa_per_N * contact.stiffness_N_per_m);
+      const double breaks =
+          plate_depth_at_force(contact, scene.tissue, *profile,
+                               plan.threshold->threshold / contact.stress_per_force_Pa_per_N);
       const double touches = point_contact_depth_limit(contact, *profile);
       if (touches < std::min(breaks, plan.horizon_m))
         throw InputError(
@@ -393,7 +394,8 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
             ", before the layer breaks under its tip at " +
             format_quantity(breaks, Dimension::Length) +
             ": no longer a point contact; use --model axisymmetric or 3d");
-      for (double d : depths) steps.push_back({d, contact.stiffness_N_per_m * d, 0.0, 0.0});
+      for (double d : depths)
+        steps.push_back({d, plate_force_at_depth(contact, scene.tissue, *profile, d), 0.0, 0.0});
     } else {
       steps = analytic_indentation(scene.tissue, *profile, depths);
     }
@@ -417,8 +419,10 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
     const SectionArea area = areas[i];
     const bool penetration = has_criterion && criterion == PunctureCriterion::Penetration;
     if (plate) {
-      const double per_depth = contact.stiffness_N_per_m * contact.stress_per_force_Pa_per_N;
-      series.resolve = [per_depth](double depth) { return per_depth * depth; };
+      series.resolve = [contact, tissue, profile](double depth) {
+        return contact.stress_per_force_Pa_per_N *
+               plate_force_at_depth(contact, tissue, *profile, depth);
+      };
     } else {
       series.resolve = [tissue, profile, area, penetration](double depth) {
         const double force = analytic_indentation(tissue, *profile, {depth}).front().force_N;

@@ -17,6 +17,7 @@
 
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
+#include "mneedle/insertion/analytic_indentation.h"
 
 namespace mneedle {
 namespace {
@@ -170,6 +171,56 @@ double point_contact_depth_limit(const PlateContact& plate, const fe::Axisymmetr
         limit = std::min(limit, (h[i - 1] + f * (h[i] - h[i - 1])) / gap);
     }
   return limit;
+}
+
+namespace {
+
+// The top layer alone as a half-space: one layer a metre thick and wide, where Hayes' and the
+// block's corrections vanish (a/H below 1e-3).
+Tissue top_layer_half_space(const Tissue& tissue) {
+  Tissue half;
+  half.size = {1.0, 1.0, 1.0};
+  TissueLayer layer = tissue.layers.front();
+  layer.thickness = 1.0;
+  layer.top = 0.0;
+  half.layers = {layer};
+  return half;
+}
+
+double local_force(const Tissue& half, const fe::AxisymmetricNeedle& needle, double indentation) {
+  if (!(indentation > 0.0)) return 0.0;
+  return analytic_indentation(half, needle, {indentation}).front().force_N;
+}
+
+}  // namespace
+
+double plate_depth_at_force(const PlateContact& plate, const Tissue& tissue,
+                            const fe::AxisymmetricNeedle& needle, double force_N) {
+  if (!(force_N > 0.0)) return 0.0;
+  const Tissue half = top_layer_half_space(tissue);
+  // The local indentation carrying force_N: bracket, then bisect (the force rises with it).
+  double lo = 0.0, hi = 1e-9;
+  while (local_force(half, needle, hi) < force_N && hi < 1.0) hi *= 2.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (local_force(half, needle, mid) < force_N ? lo : hi) = mid;
+  }
+  return force_N / plate.stiffness_N_per_m + 0.5 * (lo + hi);
+}
+
+double plate_force_at_depth(const PlateContact& plate, const Tissue& tissue,
+                            const fe::AxisymmetricNeedle& needle, double depth_m) {
+  if (!(depth_m > 0.0)) return 0.0;
+  const Tissue half = top_layer_half_space(tissue);
+  // The travel splits into the plate's deflection F / k_p and the local indentation delta, with
+  // F = Sneddon(delta): bisect on delta in [0, d], where F / k_p + delta - d rises from -d.
+  double lo = 0.0, hi = depth_m;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * depth_m; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    const double excess = local_force(half, needle, mid) / plate.stiffness_N_per_m + mid - depth_m;
+    (excess < 0.0 ? lo : hi) = mid;
+  }
+  return local_force(half, needle, 0.5 * (lo + hi));
 }
 
 }  // namespace mneedle

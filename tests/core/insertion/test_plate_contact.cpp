@@ -96,6 +96,24 @@ TEST(PlateContact, OnlyABluntConesFlankMeetsTheBentPlateBeforeTheLayerBreaks) {
   EXPECT_LT(point_contact_depth_limit(plate, cone(88.0)), 50e-6);
 }
 
+// The tip's local indentation in series with the plate: for a sharp cone Sneddon's closed form
+// F = (2/pi) E* tan(a) delta^2 on the top layer, so the travel at force F is F / k_p plus
+// sqrt(pi F / (2 E* tan a)); and the travel and the force are each other's inverse.
+TEST(PlateContact, ASharpConesTravelIsThePlatesDeflectionPlusItsSneddonIndentation) {
+  const Tissue tissue = two_layers(0.134e6);
+  const PlateContact plate = plate_contact(tissue, 0.0);
+  fe::AxisymmetricNeedle cone;
+  const double half_angle = 15.0 * 3.14159265358979 / 180.0, radius = 115e-6;
+  cone.heights_m = {0.0, radius / std::tan(half_angle), radius / std::tan(half_angle) + 1e-3};
+  cone.radii_m = {0.0, radius, radius};
+  const double force = 5e-3;
+  const double e_star = 1e9 / (1.0 - 0.4 * 0.4);
+  const double local = std::sqrt(3.14159265358979 * force / (2.0 * e_star * std::tan(half_angle)));
+  const double travel = plate_depth_at_force(plate, tissue, cone, force);
+  EXPECT_NEAR(travel, force / plate.stiffness_N_per_m + local, 1e-6 * travel);
+  EXPECT_NEAR(plate_force_at_depth(plate, tissue, cone, travel), force, 1e-8 * force);
+}
+
 TEST(PlateContact, ATissueThatIsNoPlateOnAFoundationIsRefusedByName) {
   Tissue one = two_layers(0.134e6);
   one.layers.pop_back();

@@ -32,6 +32,15 @@ inline constexpr double kPlateLengthPerThickness = 5.0;
 /// edge concentrates stress beyond a plate's reach): the FE models answer those.
 PlateContact plate_contact(const Tissue& tissue, double contact_radius_m);
 
+/// The tip's local indentation of the top layer, in series with the plate's bending: Sneddon's
+/// frictionless punch of the needle's profile on a half-space of the top layer's E and nu
+/// (docs/model.md, "The stress criterion on the analytic path"). The tip travel at force F is
+/// F / k_p + delta(F); these give it both ways (N and m).
+double plate_depth_at_force(const PlateContact& plate, const Tissue& tissue,
+                            const fe::AxisymmetricNeedle& needle, double force_N);
+double plate_force_at_depth(const PlateContact& plate, const Tissue& tissue,
+                            const fe::AxisymmetricNeedle& needle, double depth_m);
+
 /// Deflection of the plate at radius r over its deflection under the point, w(r) / w(0).
 double plate_deflection_shape(const PlateContact& plate, double radius_m);
 
