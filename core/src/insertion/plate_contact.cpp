@@ -55,9 +55,9 @@ double j1(double x) {
 //   1/(2 pi) int x^2/(x^3+1) [nu A0(x rho) + (1 - nu) A1(x rho)] dx,
 // A0(y) = 2 J1(y)/y and A1(y) = 2 (1 - J0(y))/y^2 being the disc means of J0 and J1(y)/y.
 // Beyond x = 20 the kernel is 1/x (relative error 1.25e-4 at x = 20, 4e-5 of the integral
-// past it) and the integral is taken in y = x rho, whose
-// oscillation period 2 pi is fixed (panels of width 1); past y = 200 only A1's smooth part 2/y^2
-// counts (its tail is added; A0's oscillating remainder is below 1e-4 of the sum).
+// past it) and the integral is taken in y = x rho, whose oscillation period 2 pi is fixed
+// (panels of width 1); past y = 200 only A1's smooth part 2/y^2 counts (its tail is added; A0's
+// oscillating remainder is below 1e-4 of the sum).
 double disc_mean_hoop_moment(double rho, double nu) {
   auto shape = [nu](double y) {
     if (y < 1e-6) return 1.0 * nu + (1.0 - nu) * 0.5;
