@@ -6,7 +6,7 @@
 // Run on demand, never from ctest (finer: several minutes and several GB per needle):
 //   bench_puncture_convergence [--criterion penetration|pressure|energy|stress]
 //       [--no-finer] [--finest] [--refine N] [--tissue silicone|skin] [--frictionless] [--model3d]
-//       [--contact-zone UM]
+//       [--contact-zone UM] [--zone-reach K] [--resolution N]
 //       [--level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]]... [sharp_bevel] [blunt_bevel]
 //       [cylinder] [cone]   (none: sharp_bevel; cone: a solid 15-degree cone, 230 um, in the
 //       sharp bevel's scene)
@@ -15,7 +15,9 @@
 // block and mesh"); --model3d: the 3-D model even where the planner would run the axisymmetric one;
 // --finest: a level beyond finer (10.5 spacings per radius, growth 1.2); --contact-zone UM: the
 // top layer around the needle's first contact bisected to UM micrometres in the 3-D model
-// (FidelityOverrides::contact_zone_size_m, docs/validation.md "The stress criterion in skin").
+// (FidelityOverrides::contact_zone_size_m, docs/validation.md "The stress criterion in skin");
+// --zone-reach K: its lateral reach in multiples of max(UM, the criterion length)
+// (contact_zone_reach); --resolution N: the needle plugin's polygon segments (default 64).
 // --level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS] (repeatable): run these levels instead of
 // the fidelities (errors are against the last one listed; --refine does not apply; SPACINGS are
 // TET10 node spacings per radius), each the given fidelity with its tip size, growth,
@@ -31,7 +33,9 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
+#include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "mneedle/base/memory.h"
@@ -61,7 +65,9 @@ struct Options {
   std::optional<Contact> contact;   // empty: the scene's
   bool full3d = false;              // --model3d: the 3-D model even where the planner would not
   std::optional<double>
-      contact_zone_m;  // --contact-zone UM: FidelityOverrides::contact_zone_size_m
+      contact_zone_m;                // --contact-zone UM: FidelityOverrides::contact_zone_size_m
+  std::optional<double> zone_reach;  // --zone-reach K: FidelityOverrides::contact_zone_reach
+  std::optional<int> resolution;     // --resolution N: the plugin's segments
   std::vector<std::string> needles;
   // --level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]: levels of one's own instead of the
   // fidelities (a fidelity's steps and layers through the top, with node spacings per needle radius
@@ -137,6 +143,10 @@ Options parse(int argc, char** argv) {
       o.full3d = true;
     } else if (a == "--contact-zone" && i + 1 < argc) {
       o.contact_zone_m = std::atof(argv[++i]) * 1e-6;
+    } else if (a == "--zone-reach" && i + 1 < argc) {
+      o.zone_reach = std::atof(argv[++i]);
+    } else if (a == "--resolution" && i + 1 < argc) {
+      o.resolution = std::atoi(argv[++i]);
     } else if (a == "--frictionless") {
       o.contact = Contact::Frictionless;
     } else if (a == "--criterion" && i + 1 < argc) {
@@ -158,7 +168,7 @@ Options parse(int argc, char** argv) {
     } else {
       std::cerr << "usage: bench_puncture_convergence [--criterion C] [--no-finer] [--finest] "
                    "[--refine N] [--tissue silicone|skin] [--frictionless] [--model3d] "
-                   "[--contact-zone UM] "
+                   "[--contact-zone UM] [--zone-reach K] [--resolution N] "
                    "[--level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]]... [sharp_bevel] "
                    "[blunt_bevel] "
                    "[cylinder] [cone]\n";
@@ -185,6 +195,7 @@ std::vector<Level> levels(const Scene& scene, const PreparedNeedle& needle, cons
     r.criterion = o.criterion;
     r.overrides.refinement_levels = o.refine;
     r.overrides.contact_zone_size_m = o.contact_zone_m;
+    r.overrides.contact_zone_reach = o.zone_reach;
     if (o.full3d) r.model = PreModel::Full3d;
     return r;
   };
@@ -349,6 +360,11 @@ int main(int argc, char** argv) {
                                                         {{"diameter", parse_quantity("230 um")},
                                                          {"length", parse_quantity("1000 um")},
                                                          {"half_angle", parse_quantity("15 deg")}}};
+      if (options.resolution) {
+        auto* plugin = std::get_if<PluginGeometry>(&scene.needles.front().geometry);
+        if (plugin == nullptr) throw std::runtime_error("--resolution needs a plugin needle");
+        plugin->parameters["resolution"] = parse_quantity(std::to_string(*options.resolution));
+      }
       const std::vector<PreparedNeedle> needles = prepare_needles(registry, scene);
       std::vector<Outcome> runs;
       for (const Level& l : levels(scene, needles.front(), options)) {

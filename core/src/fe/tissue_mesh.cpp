@@ -45,6 +45,9 @@ void validate(const TissueBlockSpec& spec) {
   if (spec.overrides.contact_zone_size_m && (!(*spec.overrides.contact_zone_size_m > 0.0) ||
                                              !std::isfinite(*spec.overrides.contact_zone_size_m)))
     bad_spec("overrides.contact_zone_size_m", "must be positive and finite");
+  if (spec.overrides.contact_zone_reach && (!(*spec.overrides.contact_zone_reach > 0.0) ||
+                                            !(*spec.overrides.contact_zone_reach <= 100.0)))
+    bad_spec("overrides.contact_zone_reach", "must be in (0, 100]");
   for (const NeedleSite& site : spec.sites) {
     if (!(site.radius > 0.0)) bad_spec("needle radius", "must be positive");
     if (std::abs(site.x) >= spec.size_x / 2 || std::abs(site.y) >= spec.size_y / 2)
@@ -77,6 +80,13 @@ double distance_to_outline(const Eigen::Vector2d& q, const std::vector<Eigen::Ve
   return inside ? 0.0 : nearest;
 }
 
+// An interval of one axis where the starting grid is made finer than the sites' law asks: the
+// contact zone's footprint, so that the boxes bisection starts from there are no flatter than
+// kZoneBoxAspect (zone_windows). Sizes grow by `growth` per element outside [lo, hi].
+struct AxisWindow {
+  double lo = 0.0, hi = 0.0, fine = 0.0, growth = 2.0;
+};
+
 // The top layer around each needle's first contact (its outline, or its whole end face when
 // the outline is unknown), with elements of at most `size` (m; 0: no zone):
 // FidelityOverrides::contact_zone_size_m.
@@ -90,7 +100,8 @@ ContactZone contact_zone(const TissueBlockSpec& spec) {
   ContactZone zone;
   if (!spec.overrides.contact_zone_size_m || spec.layers.empty()) return zone;
   zone.size = *spec.overrides.contact_zone_size_m;
-  zone.radius = 3.0 * std::max(zone.size, spec.criterion_length);
+  zone.radius = spec.overrides.contact_zone_reach.value_or(kContactZoneReach) *
+                std::max(zone.size, spec.criterion_length);
   zone.depth = std::min(spec.layers.front().thickness, 2.0 * zone.radius);
   return zone;
 }
@@ -123,6 +134,40 @@ double refinement_target(const Eigen::Vector3d& p, const std::vector<NeedleSite>
     }
   }
   return size;
+}
+
+// Bisection keeps the shape of the box it starts from, so a zone bisected out of the starting
+// grid's flat top-layer boxes (a needle radius or more wide, the layer's thickness high) ends in
+// cells as flat, many more than the zone's size asks (measured: 4-8 um wide, 0.25-0.5 um high
+// for a 6 um zone in paper A's skin). Over the zone's footprint the starting grid is therefore made
+// at most kZoneBoxAspect times wider than its top cell is high, graded back at the sizing's growth;
+// those lines cross the whole block, where the cells stay within the grid's aspect cap.
+constexpr double kZoneBoxAspect = 2.0;
+
+std::array<std::vector<AxisWindow>, 2> zone_windows(const TissueBlockSpec& spec,
+                                                    const ContactZone& zone,
+                                                    const std::vector<double>& z,
+                                                    const MeshSizing& lateral) {
+  std::array<std::vector<AxisWindow>, 2> windows;
+  if (zone.size <= 0.0 || z.size() < 2) return windows;
+  const double top_cell = z[z.size() - 1] - z[z.size() - 2];
+  const double fine = kZoneBoxAspect * top_cell;
+  if (fine >= lateral.fine_size) return windows;
+  for (const NeedleSite& site : spec.sites) {
+    Eigen::Vector2d lo(site.x - site.radius, site.y - site.radius),
+        hi(site.x + site.radius, site.y + site.radius);
+    if (!site.first_contact.empty()) {
+      lo = hi = site.first_contact.front();
+      for (const Eigen::Vector2d& q : site.first_contact) {
+        lo = lo.cwiseMin(q);
+        hi = hi.cwiseMax(q);
+      }
+    }
+    for (int a = 0; a < 2; ++a)
+      windows[static_cast<std::size_t>(a)].push_back(
+          {lo[a] - zone.radius, hi[a] + zone.radius, fine, lateral.growth});
+  }
+  return windows;
 }
 
 // Places nodes on [lo, hi] so that each interval spans about one local element size, by
@@ -250,11 +295,14 @@ std::vector<double> tips_clear_of(const std::vector<double>& sites, const std::v
 // the half >= 0 is then exactly a half model's axis.
 std::vector<double> lateral_coordinates(double half, const std::vector<double>& centres,
                                         const std::vector<double>& tips, const MeshSizing& sizing,
-                                        double clearance, bool* symmetric) {
+                                        double clearance, const std::vector<AxisWindow>& windows,
+                                        bool* symmetric) {
   auto size_at = [&](double x) {
     double size = sizing.max_size;
     for (double c : centres)
       size = std::min(size, graded_size(std::abs(x - c) - sizing.fine_half_width, sizing));
+    for (const AxisWindow& w : windows)
+      size = std::min(size, w.fine + (w.growth - 1.0) * std::max({0.0, w.lo - x, x - w.hi}));
     return size;
   };
   std::vector<double> sorted = centres;
@@ -468,11 +516,11 @@ void mark_fixed_nodes(TetMesh& mesh, const Eigen::Vector3d& lo, const Eigen::Vec
 // meshes exactly its share of the full mesh.
 std::vector<double> half_axis(double half_size, const std::vector<double>& sites,
                               const std::vector<double>& tips, const MeshSizing& sizing,
-                              double clearance, bool half, const std::string& name,
-                              std::vector<char>* mirrored) {
+                              double clearance, const std::vector<AxisWindow>& windows, bool half,
+                              const std::string& name, std::vector<char>* mirrored) {
   bool symmetric = false;
   std::vector<double> axis =
-      lateral_coordinates(half_size, sites, tips, sizing, clearance, &symmetric);
+      lateral_coordinates(half_size, sites, tips, sizing, clearance, windows, &symmetric);
   *mirrored = mirrored_cells(axis, sites);
   if (!half) return axis;
   if (!symmetric)
@@ -624,10 +672,15 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   // the grid actually built: on a coarser base grid a tip line a quarter of the fine size from
   // a site line would leave a sliver cell that bisection cannot improve.
   const double clearance = 0.25 * base.fine_size;
+  const ContactZone zone = contact_zone(spec);
+  const std::array<std::vector<AxisWindow>, 2> windows =
+      levels > 0 ? zone_windows(spec, zone, z, lateral) : std::array<std::vector<AxisWindow>, 2>{};
   std::array<std::vector<char>, 2> mirrored;
   std::array<std::vector<double>, 3> axes = {
-      half_axis(spec.size_x / 2, cx, tip_x, lateral, clearance, spec.half_x, "x", &mirrored[0]),
-      half_axis(spec.size_y / 2, cy, tip_y, lateral, clearance, spec.half_y, "y", &mirrored[1]),
+      half_axis(spec.size_x / 2, cx, tip_x, lateral, clearance, windows[0], spec.half_x, "x",
+                &mirrored[0]),
+      half_axis(spec.size_y / 2, cy, tip_y, lateral, clearance, windows[1], spec.half_y, "y",
+                &mirrored[1]),
       std::move(z)};
   TetMesh mesh;
   mesh.order = spec.order;
@@ -655,7 +708,6 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
     split_cells(axes, cell_layer, mirrored[0], mirrored[1],
                 [&](const std::array<int, 4>& path, int layer) { add_element(mesh, path, layer); });
   } else {
-    const ContactZone zone = contact_zone(spec);
     TetBisection bisection(std::move(mesh.nodes));
     split_cells(
         axes, cell_layer, mirrored[0], mirrored[1],

@@ -341,44 +341,79 @@ TEST(TissueMesh, RefinementReachesTheTipSizeAtTheSiteWithFewerNodes) {
 }
 
 // The convergence study's contact zone (docs/model.md, "Tissue block and mesh"): the top layer
-// within 3 max(size, L) of the first contact is bisected down to the size; elsewhere the mesh
-// is refined only as before (more nodes, every zone element no wider than the size).
-TEST(TissueMesh, AContactZoneRefinesTheTopLayerAroundTheFirstContactOnly) {
-  const Eigen::Vector2d contact(-115e-6, 0.0);
+// within reach x max(size, L) of the first contact is bisected down to the size; elsewhere the
+// mesh is refined only as before (more nodes, every zone element no wider than the size).
+TissueBlockSpec zoned_skin(const Eigen::Vector2d& contact) {
   auto spec = refined_skin(2);
   spec.sites.front().tip = contact;
   spec.sites.front().first_contact = {contact};
   spec.criterion_length = 10e-6;
+  return spec;
+}
+
+// Bounding boxes (largest extent, and height over largest extent) of the layer-0 elements whose
+// centroid lies within `reach` of `contact` (laterally).
+struct NearBoxes {
+  double widest = 0.0;
+  double flattest = 1.0;
+};
+NearBoxes boxes_near(const TetMesh& m, const Eigen::Vector2d& contact, double reach) {
+  NearBoxes near;
+  for (std::size_t e = 0; e < m.elements.size(); ++e) {
+    if (m.element_layer[e] != 0) continue;
+    Eigen::Vector3d lo = m.nodes[static_cast<std::size_t>(m.elements[e][0])], hi = lo, mid;
+    mid.setZero();
+    for (int a = 0; a < 4; ++a) {
+      const Eigen::Vector3d& p = m.nodes[static_cast<std::size_t>(m.elements[e][a])];
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+      mid += 0.25 * p;
+    }
+    if ((mid.head<2>() - contact).norm() > reach) continue;
+    near.widest = std::max(near.widest, (hi - lo).maxCoeff());
+    near.flattest = std::min(near.flattest, (hi - lo).z() / (hi - lo).maxCoeff());
+  }
+  return near;
+}
+
+TEST(TissueMesh, AContactZoneRefinesTheTopLayerAroundTheFirstContactOnly) {
+  const Eigen::Vector2d contact(-115e-6, 0.0);
+  auto spec = zoned_skin(contact);
   const TetMesh plain = generate_tissue_mesh(spec);
   spec.overrides.contact_zone_size_m = 8e-6;
+  spec.overrides.contact_zone_reach = 3.0;
   const TetMesh zoned = generate_tissue_mesh(spec);
-  // Bounding-box extent of the layer-0 elements whose centroid lies within `reach` of the
-  // contact (laterally), largest of them.
-  auto widest_near = [&](const TetMesh& m, double reach) {
-    double widest = 0.0;
-    for (std::size_t e = 0; e < m.elements.size(); ++e) {
-      if (m.element_layer[e] != 0) continue;
-      Eigen::Vector3d lo = m.nodes[static_cast<std::size_t>(m.elements[e][0])], hi = lo, mid;
-      mid.setZero();
-      for (int a = 0; a < 4; ++a) {
-        const Eigen::Vector3d& p = m.nodes[static_cast<std::size_t>(m.elements[e][a])];
-        lo = lo.cwiseMin(p);
-        hi = hi.cwiseMax(p);
-        mid += 0.25 * p;
-      }
-      if ((mid.head<2>() - contact).norm() <= reach)
-        widest = std::max(widest, (hi - lo).maxCoeff());
-    }
-    return widest;
-  };
   const double zone_radius = 3.0 * 10e-6;
-  EXPECT_LE(widest_near(zoned, zone_radius - 8e-6), 8e-6 * (1.0 + 1e-9));
-  EXPECT_GT(widest_near(plain, zone_radius - 8e-6), 8e-6);
+  EXPECT_LE(boxes_near(zoned, contact, zone_radius - 8e-6).widest, 8e-6 * (1.0 + 1e-9));
+  EXPECT_GT(boxes_near(plain, contact, zone_radius - 8e-6).widest, 8e-6);
   EXPECT_GT(zoned.nodes.size(), plain.nodes.size());
-  // Far from the contact (beyond the zone's grading) the top layer is the plain mesh's.
-  EXPECT_DOUBLE_EQ(widest_near(zoned, 1500e-6), widest_near(plain, 1500e-6));
+  // Far from the contact the top layer is no coarser than the plain mesh's (the zone's grid
+  // lines cross the block, so it may be finer there).
+  EXPECT_LE(boxes_near(zoned, contact, 1500e-6).widest,
+            boxes_near(plain, contact, 1500e-6).widest * (1.0 + 1e-12));
   spec.overrides.contact_zone_size_m = -1.0;
   EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
+  spec.overrides.contact_zone_size_m = 8e-6;
+  spec.overrides.contact_zone_reach = 0.0;
+  EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
+}
+
+// Bisection keeps the shape of the box it starts from: out of the plain grid's top-layer boxes
+// (about 115-170 um wide, 20 um high) a 3 um zone was cut into cells 16 times wider than high.
+// The zone's own grid lines start it from boxes at most twice as wide as high, so its cells keep
+// that shape (a quarter: a Kuhn tetrahedron's box halves one direction at a time) and it costs
+// a fraction of the nodes (docs/model.md, "Tissue block and mesh").
+TEST(TissueMesh, AContactZonesCellsAreNoFlatterThanTheBoxesItStartsFrom) {
+  const Eigen::Vector2d contact(-115e-6, 0.0);
+  auto spec = zoned_skin(contact);
+  spec.overrides.contact_zone_size_m = 3e-6;
+  const TetMesh zoned = generate_tissue_mesh(spec);
+  const NearBoxes inside = boxes_near(zoned, contact, 10e-6 - 3e-6);
+  EXPECT_LE(inside.widest, 3e-6 * (1.0 + 1e-9));
+  EXPECT_GE(inside.flattest, 0.25 - 1e-9);
+  // The default reach is one criterion length; three hold (3/1)^2 times the footprint.
+  spec.overrides.contact_zone_reach = 3.0;
+  EXPECT_GT(generate_tissue_mesh(spec).nodes.size(), 2 * zoned.nodes.size());
 }
 
 TEST(TissueMesh, RefinedMeshIsMirrorSymmetricAndItsQuarterIsThePositivePart) {

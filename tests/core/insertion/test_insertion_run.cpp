@@ -491,17 +491,31 @@ const Reduction* find_reduction(const InsertionRun& run, const std::string& name
 // two meshes' difference too (1.3 %, a review's measurement). A 15-degree cone in a 12 mm block
 // of paper A's skin, pressed 50 um (before its puncture): the measured effect is the change
 // between the cut run and the same run on the whole block, to round-off.
-TEST(ScenePlanner, AReductionIsMeasuredOnTheMeshOfTheRunItChecks) {
+// A 15-degree cone of 230 um in paper A's skin (block side, insertion depth, fidelity), under
+// the stress criterion.
+Scene skin_cone_scene(const std::string& side, const std::string& depth,
+                      const std::string& fidelity) {
   const std::string text =
-      "[tissue]\nsize = [\"12 mm\", \"12 mm\", \"1150 um\"]\n" + kPaperASkinLayers +
+      "[tissue]\nsize = [\"" + side + "\", \"" + side + "\", \"1150 um\"]\n" + kPaperASkinLayers +
       "[[needles]]\nname = \"cone\"\ngeometry = { plugin = \"cone\", diameter = \"230 um\" }\n"
-      "[insertion]\ndepth = \"50 um\"\n[model]\nfidelity = \"fast\"\n"
+      "[insertion]\ndepth = \"" +
+      depth + "\"\n[model]\nfidelity = \"" + fidelity +
+      "\"\n"
       "criterion = \"stress\"\noutputs = [\"puncture\"]\n";
-  const Scene scene = parse_scene(text, "cone.toml");
+  return parse_scene(text, "cone.toml");
+}
+
+PreparedNeedle skin_cone() {
   PreparedNeedle cone;
   cone.name = "cone";
   cone.mesh = test::cone_needle(15.0 * std::numbers::pi / 180.0, 115e-6, 1e-3);
   cone.axisymmetric = fe::AxisymmetricNeedle::cone(15.0 * std::numbers::pi / 180.0, 115e-6);
+  return cone;
+}
+
+TEST(ScenePlanner, AReductionIsMeasuredOnTheMeshOfTheRunItChecks) {
+  const Scene scene = skin_cone_scene("12 mm", "50 um", "fast");
+  const PreparedNeedle cone = skin_cone();
   InsertionRunOptions options = fast();
   options.criterion = PunctureCriterion::Stress;
   const InsertionRun cut_run = run_insertion(scene, {cone}, options);
@@ -515,6 +529,40 @@ TEST(ScenePlanner, AReductionIsMeasuredOnTheMeshOfTheRunItChecks) {
   const RunPoint& b = whole.needles.front().curve.back();
   ASSERT_DOUBLE_EQ(a.depth_m, b.depth_m);
   EXPECT_NEAR(*cut->measured_effect, std::abs(a.force_N - b.force_N) / b.force_N, 1e-9);
+}
+
+// The 3-D model converges under a pointed tip in skin once it resolves what the axisymmetric
+// model resolves at standard (docs/validation.md, "The 3-D model under a point load, resolved"):
+// the ball under the tip (the convergence study's contact zone, cells of L/4 = 2.5 um) and the
+// stratum corneum's bending away from it (fine's growth, 1.35). A 15-degree cone of 230 um in
+// paper A's skin: the axisymmetric depth at standard is converged to 1 % (65.4 um against 65.0
+// at L/32); here 64.6 um, and the 3-D quarter model 63.5 um (-1.7 %; the bench's 64-segment
+// plugin cone: 64.4 against 65.4 um). The bounds: 3 % on the depth (the measured 1.5-2.2 % over
+// L/4, L/8 and zone reaches of 1-3 L, plus the axisymmetric model's own 1 %) and 2 % on the
+// force (measured +0.7 %). The zone at standard's growth 1.8 reads 60.2 um (-8 %) and no zone
+// 71.2 um (+9 %): this test fails on either.
+TEST(ScenePlanner,
+     AThreeDConeWithAQuarterLengthContactZonePuncturesSkinWhereTheAxisymmetricOneDoes) {
+  const Scene scene = skin_cone_scene("3000 um", "200 um", "standard");
+  PreparedNeedle cone = skin_cone();
+  cone.mirror_symmetric_x0 = cone.mirror_symmetric_y0 = true;
+  InsertionRunOptions axisymmetric;
+  axisymmetric.fidelity = fe::Fidelity::Standard;
+  axisymmetric.criterion = PunctureCriterion::Stress;
+  InsertionRunOptions three_d = axisymmetric;
+  three_d.model = PreModel::Full3d;
+  three_d.overrides.growth = 1.35;
+  three_d.overrides.contact_zone_size_m = 3e-6;
+  const InsertionRun axi = run_insertion(scene, {cone}, axisymmetric);
+  const InsertionRun block = run_insertion(scene, {cone}, three_d);
+  ASSERT_TRUE(axi.axisymmetric);
+  ASSERT_FALSE(block.axisymmetric);
+  const auto& a = axi.needles.front().puncture;
+  const auto& b = block.needles.front().puncture;
+  ASSERT_TRUE(a && b);
+  ASSERT_FALSE(a->at_first_contact || b->at_first_contact);
+  EXPECT_NEAR(b->depth_m / a->depth_m, 1.0, 0.03) << a->depth_m << " " << b->depth_m;
+  EXPECT_NEAR(b->force_N / a->force_N, 1.0, 0.02) << a->force_N << " " << b->force_N;
 }
 
 TEST(ScenePlanner, DomainCutAroundTheNeedleKeepsTheAxisymmetricForceWithinTheTolerance) {

@@ -23,11 +23,19 @@ struct FidelityOverrides {
   /// (default_refinement_levels).
   std::optional<int> refinement_levels;
   /// 3-D tissue with refinement levels: the top layer around each needle's first contact (its
-  /// lowest points) is bisected down to this element size, within three times the larger of it
-  /// and the criterion length of that contact (docs/model.md, "Tissue block and mesh"; a
-  /// convergence study's knob, unset in every fidelity; without refinement levels, none).
+  /// lowest points) is bisected down to this element size, within contact_zone_reach times the
+  /// larger of it and the criterion length of that contact (docs/model.md, "Tissue block and
+  /// mesh"; a convergence study's knob, unset in every fidelity; without refinement levels, none).
   std::optional<double> contact_zone_size_m;
+  /// The contact zone's lateral reach beyond the first contact, in multiples of the larger of
+  /// its size and the criterion length (unset: kContactZoneReach).
+  std::optional<double> contact_zone_reach;
 };
+
+/// Default contact_zone_reach: one criterion length around the first contact holds the ball
+/// under the tip where the stress criterion peaks (docs/validation.md, "Lateral convergence of
+/// the 3-D model under a point load").
+inline constexpr double kContactZoneReach = 1.0;
 
 /// Largest refinement_levels: each level halves the element size along the needle's path, and
 /// 2^6 = 64 is far beyond any useful grading.
