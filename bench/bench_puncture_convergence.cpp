@@ -6,7 +6,7 @@
 // Run on demand, never from ctest (finer: several minutes and several GB per needle):
 //   bench_puncture_convergence [--criterion penetration|pressure|energy|stress]
 //       [--no-finer] [--finest] [--refine N] [--tissue silicone|skin] [--frictionless] [--model3d]
-//       [--contact-zone UM] [--zone-reach K] [--resolution N]
+//       [--contact-zone UM] [--zone-reach K] [--tip-size UM] [--resolution N]
 //       [--level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]]... [sharp_bevel] [blunt_bevel]
 //       [cylinder] [cone]   (none: sharp_bevel; cone: a solid 15-degree cone, 230 um, in the
 //       sharp bevel's scene)
@@ -17,7 +17,9 @@
 // top layer around the needle's first contact bisected to UM micrometres in the 3-D model
 // (FidelityOverrides::contact_zone_size_m, docs/validation.md "The stress criterion in skin");
 // --zone-reach K: its lateral reach in multiples of max(UM, the criterion length)
-// (contact_zone_reach); --resolution N: the needle plugin's polygon segments (default 64).
+// (contact_zone_reach); --tip-size UM: inside the zone, elements graded down to UM toward a
+// pointed first contact (contact_zone_tip_size_m); --resolution N: the needle plugin's polygon
+// segments (default 64).
 // --level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS] (repeatable): run these levels instead of
 // the fidelities (errors are against the last one listed; --refine does not apply; SPACINGS are
 // TET10 node spacings per radius), each the given fidelity with its tip size, growth,
@@ -67,6 +69,7 @@ struct Options {
   std::optional<double>
       contact_zone_m;                // --contact-zone UM: FidelityOverrides::contact_zone_size_m
   std::optional<double> zone_reach;  // --zone-reach K: FidelityOverrides::contact_zone_reach
+  std::optional<double> tip_size_m;  // --tip-size UM: FidelityOverrides::contact_zone_tip_size_m
   std::optional<int> resolution;     // --resolution N: the plugin's segments
   std::vector<std::string> needles;
   // --level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]: levels of one's own instead of the
@@ -143,6 +146,8 @@ Options parse(int argc, char** argv) {
       o.full3d = true;
     } else if (a == "--contact-zone" && i + 1 < argc) {
       o.contact_zone_m = std::atof(argv[++i]) * 1e-6;
+    } else if (a == "--tip-size" && i + 1 < argc) {
+      o.tip_size_m = std::atof(argv[++i]) * 1e-6;
     } else if (a == "--zone-reach" && i + 1 < argc) {
       o.zone_reach = std::atof(argv[++i]);
     } else if (a == "--resolution" && i + 1 < argc) {
@@ -168,7 +173,7 @@ Options parse(int argc, char** argv) {
     } else {
       std::cerr << "usage: bench_puncture_convergence [--criterion C] [--no-finer] [--finest] "
                    "[--refine N] [--tissue silicone|skin] [--frictionless] [--model3d] "
-                   "[--contact-zone UM] [--zone-reach K] [--resolution N] "
+                   "[--contact-zone UM] [--zone-reach K] [--tip-size UM] [--resolution N] "
                    "[--level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]]... [sharp_bevel] "
                    "[blunt_bevel] "
                    "[cylinder] [cone]\n";
@@ -196,6 +201,7 @@ std::vector<Level> levels(const Scene& scene, const PreparedNeedle& needle, cons
     r.overrides.refinement_levels = o.refine;
     r.overrides.contact_zone_size_m = o.contact_zone_m;
     r.overrides.contact_zone_reach = o.zone_reach;
+    r.overrides.contact_zone_tip_size_m = o.tip_size_m;
     if (o.full3d) r.model = PreModel::Full3d;
     return r;
   };

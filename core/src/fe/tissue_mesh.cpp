@@ -48,6 +48,10 @@ void validate(const TissueBlockSpec& spec) {
   if (spec.overrides.contact_zone_reach && (!(*spec.overrides.contact_zone_reach > 0.0) ||
                                             !(*spec.overrides.contact_zone_reach <= 100.0)))
     bad_spec("overrides.contact_zone_reach", "must be in (0, 100]");
+  if (spec.overrides.contact_zone_tip_size_m &&
+      (!(*spec.overrides.contact_zone_tip_size_m > 0.0) ||
+       !std::isfinite(*spec.overrides.contact_zone_tip_size_m)))
+    bad_spec("overrides.contact_zone_tip_size_m", "must be positive and finite");
   for (const NeedleSite& site : spec.sites) {
     if (!(site.radius > 0.0)) bad_spec("needle radius", "must be positive");
     if (std::abs(site.x) >= spec.size_x / 2 || std::abs(site.y) >= spec.size_y / 2)
@@ -92,19 +96,25 @@ struct AxisWindow {
 // FidelityOverrides::contact_zone_size_m.
 struct ContactZone {
   double size = 0.0;
-  double radius = 0.0;  ///< m, lateral reach beyond the outline (or beyond the needle's radius)
-  double depth = 0.0;   ///< m, below the surface
+  double tip_size = 0.0;  ///< m, at a pointed first contact (0: no grading toward it)
+  double radius = 0.0;    ///< m, lateral reach beyond the outline (or beyond the needle's radius)
+  double depth = 0.0;     ///< m, below the surface
 };
 
 ContactZone contact_zone(const TissueBlockSpec& spec) {
   ContactZone zone;
   if (!spec.overrides.contact_zone_size_m || spec.layers.empty()) return zone;
   zone.size = *spec.overrides.contact_zone_size_m;
+  zone.tip_size = std::min(zone.size, spec.overrides.contact_zone_tip_size_m.value_or(0.0));
   zone.radius = spec.overrides.contact_zone_reach.value_or(kContactZoneReach) *
                 std::max(zone.size, spec.criterion_length);
   zone.depth = std::min(spec.layers.front().thickness, 2.0 * zone.radius);
   return zone;
 }
+
+// Element size over distance to a pointed first contact inside the contact zone: each element
+// about as wide as half its distance from the tip.
+constexpr double kTipGrading = 0.5;
 
 // Element size wanted at p (m) when the grid is refined along the needles' paths: the fine size
 // within fine_half_width of a needle's axis and above the insertion depth, growing by `growth`
@@ -131,6 +141,13 @@ double refinement_target(const Eigen::Vector3d& p, const std::vector<NeedleSite>
                                       : distance_to_outline(p.head<2>(), site.first_contact)) -
           zone.radius;
       size = std::min(size, graded_size(std::max(lateral, under), graded));
+      // Toward a pointed first contact the contact patch is far smaller than the ball: the size
+      // halves with the distance down to the tip size (a geometric grading, about 2 000 nodes
+      // per halving in paper A's skin; docs/model.md, "Tissue block and mesh").
+      if (zone.tip_size > 0.0 && site.first_contact.size() == 1) {
+        const double d = std::hypot((p.head<2>() - site.first_contact.front()).norm(), p.z());
+        size = std::min(size, std::max(zone.tip_size, kTipGrading * d));
+      }
     }
   }
   return size;

@@ -416,6 +416,52 @@ TEST(TissueMesh, AContactZonesCellsAreNoFlatterThanTheBoxesItStartsFrom) {
   EXPECT_GT(generate_tissue_mesh(spec).nodes.size(), 2 * zoned.nodes.size());
 }
 
+// Toward a pointed first contact the zone grades down to contact_zone_tip_size_m: each element
+// no wider than half its distance from the tip (or the tip size), so the tip's contact patch,
+// far smaller than the criterion's ball, is resolved at a few thousand nodes more
+// (docs/model.md, "Tissue block and mesh"). A flat first contact gets no such grading.
+TEST(TissueMesh, AContactZoneGradesDownToItsTipSizeTowardAPointedFirstContact) {
+  const Eigen::Vector2d contact(-115e-6, 0.0);
+  auto spec = zoned_skin(contact);
+  spec.overrides.contact_zone_size_m = 6e-6;
+  const TetMesh zoned = generate_tissue_mesh(spec);
+  spec.overrides.contact_zone_tip_size_m = 0.5e-6;
+  const TetMesh graded = generate_tissue_mesh(spec);
+  // Bisection halves a 40 um box: 0.5 um asks for 0.3125 um at the tip's node.
+  double finest = 1.0;
+  bool every_element_within_its_bound = true;
+  for (std::size_t e = 0; e < graded.elements.size(); ++e) {
+    Eigen::Vector3d lo = graded.nodes[static_cast<std::size_t>(graded.elements[e][0])], hi = lo,
+                    mid = Eigen::Vector3d::Zero();
+    for (int a = 0; a < 4; ++a) {
+      const Eigen::Vector3d& p = graded.nodes[static_cast<std::size_t>(graded.elements[e][a])];
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+      mid += 0.25 * p;
+    }
+    const double extent = (hi - lo).maxCoeff();
+    finest = std::min(finest, extent);
+    const double from_tip = std::hypot((mid.head<2>() - contact).norm(), mid.z());
+    if (graded.element_layer[e] == 0 && from_tip < 6e-6 &&
+        extent > std::max(0.5e-6, 0.5 * from_tip) * (1.0 + 1e-9))
+      every_element_within_its_bound = false;
+  }
+  EXPECT_TRUE(every_element_within_its_bound);
+  EXPECT_LE(finest, 0.5e-6);
+  EXPECT_GT(finest, 0.25e-6);
+  EXPECT_GT(graded.nodes.size(), zoned.nodes.size());
+  EXPECT_LT(graded.nodes.size(), zoned.nodes.size() + 20000);
+  // A flat first contact: the tip size changes nothing.
+  spec.sites.front().first_contact = {contact, contact + Eigen::Vector2d(0.0, 20e-6),
+                                      contact + Eigen::Vector2d(-20e-6, 10e-6)};
+  spec.overrides.contact_zone_tip_size_m.reset();
+  const std::size_t flat = generate_tissue_mesh(spec).nodes.size();
+  spec.overrides.contact_zone_tip_size_m = 0.5e-6;
+  EXPECT_EQ(generate_tissue_mesh(spec).nodes.size(), flat);
+  spec.overrides.contact_zone_tip_size_m = 0.0;
+  EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
+}
+
 TEST(TissueMesh, RefinedMeshIsMirrorSymmetricAndItsQuarterIsThePositivePart) {
   TissueBlockSpec spec = refined_skin(2);
   const TetMesh full = generate_tissue_mesh(spec);

@@ -533,16 +533,17 @@ TEST(ScenePlanner, AReductionIsMeasuredOnTheMeshOfTheRunItChecks) {
 
 // The 3-D model converges under a pointed tip in skin once it resolves what the axisymmetric
 // model resolves at standard (docs/validation.md, "The 3-D model under a point load, resolved"):
-// the ball under the tip (the convergence study's contact zone, cells of L/4 = 2.5 um) and the
-// stratum corneum's bending away from it (fine's growth, 1.35). A 15-degree cone of 230 um in
-// paper A's skin: the axisymmetric depth at standard is converged to 1 % (65.4 um against 65.0
-// at L/32); here 64.6 um, and the 3-D quarter model 63.5 um (-1.7 %; the bench's 64-segment
-// plugin cone: 64.4 against 65.4 um). The bounds: 3 % on the depth (the measured 1.5-2.2 % over
-// L/4, L/8 and zone reaches of 1-3 L, plus the axisymmetric model's own 1 %) and 2 % on the
-// force (measured +0.7 %). The zone at standard's growth 1.8 reads 60.2 um (-8 %) and no zone
-// 71.2 um (+9 %): this test fails on either.
-TEST(ScenePlanner,
-     AThreeDConeWithAQuarterLengthContactZonePuncturesSkinWhereTheAxisymmetricOneDoes) {
+// the ball under the tip (the convergence study's contact zone, cells of L/2 = 5 um), the tip's
+// own contact patch (graded down to 0.3 um toward it) and the stratum corneum's bending away
+// from it (fine's growth, 1.35). A 15-degree cone of 230 um in paper A's skin: the
+// axisymmetric depth at standard is converged to 1 % (65.4 um against 65.0 at L/32 for the
+// plugin's cone); here 64.6 um, and the 3-D quarter model 63.7 um (-1.3 %), 5.61 against
+// 5.52 mN (+1.5 %). Bounds: 3 % on the depth (the study's 3-D cone reads 64.0-64.4 um over
+// zones of L/2 and L/4 and tip sizes of 0.3-0.6 um, the axisymmetric model's own 1 %, and the
+// 48-segment cone here against the bench's 64) and 2.5 % on the force (measured +0.7 to
+// +1.5 % over the same zones). The same grid without the tip's grading reads 62.3 um, at
+// standard's growth 1.8 58.1 um (-10 %), and standard without a zone 71.2 um (+9 %).
+TEST(ScenePlanner, AThreeDConeWithAResolvedTipPuncturesSkinWhereTheAxisymmetricOneDoes) {
   const Scene scene = skin_cone_scene("3000 um", "200 um", "standard");
   PreparedNeedle cone = skin_cone();
   cone.mirror_symmetric_x0 = cone.mirror_symmetric_y0 = true;
@@ -552,7 +553,8 @@ TEST(ScenePlanner,
   InsertionRunOptions three_d = axisymmetric;
   three_d.model = PreModel::Full3d;
   three_d.overrides.growth = 1.35;
-  three_d.overrides.contact_zone_size_m = 3e-6;
+  three_d.overrides.contact_zone_size_m = 6e-6;
+  three_d.overrides.contact_zone_tip_size_m = 0.3e-6;
   const InsertionRun axi = run_insertion(scene, {cone}, axisymmetric);
   const InsertionRun block = run_insertion(scene, {cone}, three_d);
   ASSERT_TRUE(axi.axisymmetric);
@@ -562,7 +564,7 @@ TEST(ScenePlanner,
   ASSERT_TRUE(a && b);
   ASSERT_FALSE(a->at_first_contact || b->at_first_contact);
   EXPECT_NEAR(b->depth_m / a->depth_m, 1.0, 0.03) << a->depth_m << " " << b->depth_m;
-  EXPECT_NEAR(b->force_N / a->force_N, 1.0, 0.02) << a->force_N << " " << b->force_N;
+  EXPECT_NEAR(b->force_N / a->force_N, 1.0, 0.025) << a->force_N << " " << b->force_N;
 }
 
 TEST(ScenePlanner, DomainCutAroundTheNeedleKeepsTheAxisymmetricForceWithinTheTolerance) {

@@ -30,6 +30,10 @@ struct FidelityOverrides {
   /// The contact zone's lateral reach beyond the first contact, in multiples of the larger of
   /// its size and the criterion length (unset: kContactZoneReach).
   std::optional<double> contact_zone_reach;
+  /// Within the contact zone, toward a pointed first contact (one lowest point): elements no
+  /// wider than half their distance from it, down to this size (m; unset: no such grading), so
+  /// the tip's own contact patch is resolved (docs/model.md, "Tissue block and mesh").
+  std::optional<double> contact_zone_tip_size_m;
 };
 
 /// Default contact_zone_reach: one criterion length around the first contact holds the ball
