@@ -10,6 +10,8 @@
 #include <string>
 #include <utility>
 
+#include <nlohmann/json.hpp>
+
 #include "run_mneedle.h"
 
 namespace {
@@ -691,6 +693,28 @@ TEST(SceneCheck, RefusesNeedlesThatDoNotFitOrShareTissueAsEveryRunDoes) {
             std::string::npos)
       << wide.err;
   EXPECT_EQ(run_mneedle("scene check '" + (dir / "good.toml").string() + "'").exit_code, 0);
+  fs::remove_all(dir);
+}
+
+// The convergence study's contact zone is a scene's [model] keys (docs/scene.md): lengths with
+// their unit, shown back in SI; a tip size without its zone is one line naming file, line and key.
+TEST(SceneCheck, AContactZoneIsReadWithItsUnitsAndATipSizeAloneIsRefused) {
+  const fs::path dir = fs::temp_directory_path() / ("mneedle_zone_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  write_file(dir / "zone.toml", kTissue + kNeedle + kInsertion +
+                                    "\n[model]\ncontact_zone = \"6 um\"\n"
+                                    "contact_zone_tip = \"0.3 um\"\n");
+  write_file(dir / "tip.toml",
+             kTissue + kNeedle + kInsertion + "\n[model]\ncontact_zone_tip = \"0.3 um\"\n");
+  const auto zone = run_mneedle("scene check '" + (dir / "zone.toml").string() + "' --json");
+  ASSERT_EQ(zone.exit_code, 0) << zone.err;
+  const auto model = nlohmann::json::parse(zone.out)["model"];
+  EXPECT_DOUBLE_EQ(model["contact_zone_m"].get<double>(), 6e-6);
+  EXPECT_DOUBLE_EQ(model["contact_zone_tip_m"].get<double>(), 0.3e-6);
+  const auto tip = run_mneedle("scene check '" + (dir / "tip.toml").string() + "'");
+  EXPECT_NE(tip.exit_code, 0);
+  EXPECT_NE(tip.err.find("tip.toml:"), std::string::npos) << tip.err;
+  EXPECT_NE(tip.err.find("model.contact_zone_tip"), std::string::npos) << tip.err;
   fs::remove_all(dir);
 }
 

@@ -766,6 +766,12 @@ ModelOptions read_model(std::optional<Table> t, const Tissue& tissue) {
                                                                  {"free", CrackFaces::Free}})
                       .value_or(m.crack_faces);
   m.mesh_refinement = t->optional_count("mesh_refinement", 0, kMaxMeshRefinement);
+  m.contact_zone = t->optional_positive("contact_zone", Dimension::Length);
+  m.contact_zone_tip = t->optional_positive("contact_zone_tip", Dimension::Length);
+  if (m.contact_zone_tip && !m.contact_zone)
+    t->fail_key("contact_zone_tip", "grades the contact zone: give contact_zone too");
+  if (m.contact_zone_tip && m.contact_zone && *m.contact_zone_tip > *m.contact_zone)
+    t->fail_key("contact_zone_tip", "must not exceed contact_zone");
   t->finish();
   return m;
 }

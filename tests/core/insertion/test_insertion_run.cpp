@@ -491,17 +491,18 @@ const Reduction* find_reduction(const InsertionRun& run, const std::string& name
 // two meshes' difference too (1.3 %, a review's measurement). A 15-degree cone in a 12 mm block
 // of paper A's skin, pressed 50 um (before its puncture): the measured effect is the change
 // between the cut run and the same run on the whole block, to round-off.
-// A 15-degree cone of 230 um in paper A's skin (block side, insertion depth, fidelity), under
-// the stress criterion.
+// A 15-degree cone of 230 um in paper A's skin (block side, insertion depth, fidelity, more
+// [model] keys), under the stress criterion.
 Scene skin_cone_scene(const std::string& side, const std::string& depth,
-                      const std::string& fidelity) {
+                      const std::string& fidelity, const std::string& model_keys = "") {
   const std::string text =
       "[tissue]\nsize = [\"" + side + "\", \"" + side + "\", \"1150 um\"]\n" + kPaperASkinLayers +
       "[[needles]]\nname = \"cone\"\ngeometry = { plugin = \"cone\", diameter = \"230 um\" }\n"
       "[insertion]\ndepth = \"" +
       depth + "\"\n[model]\nfidelity = \"" + fidelity +
       "\"\n"
-      "criterion = \"stress\"\noutputs = [\"puncture\"]\n";
+      "criterion = \"stress\"\noutputs = [\"puncture\"]\n" +
+      model_keys;
   return parse_scene(text, "cone.toml");
 }
 
@@ -544,7 +545,10 @@ TEST(ScenePlanner, AReductionIsMeasuredOnTheMeshOfTheRunItChecks) {
 // +1.5 % over the same zones). The same grid without the tip's grading reads 62.3 um, at
 // standard's growth 1.8 58.1 um (-10 %), and standard without a zone 71.2 um (+9 %).
 TEST(ScenePlanner, AThreeDConeWithAResolvedTipPuncturesSkinWhereTheAxisymmetricOneDoes) {
-  const Scene scene = skin_cone_scene("3000 um", "200 um", "standard");
+  // The zone from the scene's keys (docs/scene.md, [model]), as a user gives it; they reach the
+  // 3-D model only (the axisymmetric run ignores them).
+  const Scene scene = skin_cone_scene("3000 um", "200 um", "standard",
+                                      "contact_zone = \"6 um\"\ncontact_zone_tip = \"0.3 um\"\n");
   PreparedNeedle cone = skin_cone();
   cone.mirror_symmetric_x0 = cone.mirror_symmetric_y0 = true;
   InsertionRunOptions axisymmetric;
@@ -553,8 +557,6 @@ TEST(ScenePlanner, AThreeDConeWithAResolvedTipPuncturesSkinWhereTheAxisymmetricO
   InsertionRunOptions three_d = axisymmetric;
   three_d.model = PreModel::Full3d;
   three_d.overrides.growth = 1.35;
-  three_d.overrides.contact_zone_size_m = 6e-6;
-  three_d.overrides.contact_zone_tip_size_m = 0.3e-6;
   const InsertionRun axi = run_insertion(scene, {cone}, axisymmetric);
   const InsertionRun block = run_insertion(scene, {cone}, three_d);
   ASSERT_TRUE(axi.axisymmetric);

@@ -146,6 +146,16 @@ TEST(Scene, MeshRefinementIsAWholeNumberOfHalvings) {
   EXPECT_EQ(s.model.mesh_refinement, 3);
 }
 
+TEST(Scene, AContactZoneAndItsTipSizeAreLengths) {
+  const Scene s = parse(with("fidelity = \"standard\"",
+                             "fidelity = \"standard\"\ncontact_zone = \"6 um\"\n"
+                             "contact_zone_tip = \"0.3 um\""));
+  EXPECT_DOUBLE_EQ(*s.model.contact_zone, 6e-6);
+  EXPECT_DOUBLE_EQ(*s.model.contact_zone_tip, 0.3e-6);
+  const Scene plain = parse(with("fidelity = \"standard\"", "fidelity = \"standard\""));
+  EXPECT_FALSE(plain.model.contact_zone || plain.model.contact_zone_tip);
+}
+
 TEST(Scene, PlainNumbersAreSi) {
   const Scene s =
       parse(with(R"(size = ["3000 um", "3000 um", "1150 um"])", "size = [0.003, 0.003, 1.15e-3]"));
@@ -353,6 +363,20 @@ TEST(Scene, ShippedSiliconePhantomRoundTrips) {
 TEST(SceneErrors, UnknownUnit) {
   expect_error(with("\"20 um\"", "\"20 uf\""),
                {"test.toml:7:", "tissue.layers[0].thickness", "unknown unit 'uf'"});
+}
+
+TEST(SceneErrors, AContactZoneTipNeedsItsZoneAndFitsInIt) {
+  expect_error(
+      with("fidelity = \"standard\"", "fidelity = \"standard\"\ncontact_zone_tip = \"0.3 um\""),
+      {"test.toml:31:", "model.contact_zone_tip", "give contact_zone too"});
+  expect_error(with("fidelity = \"standard\"",
+                    "fidelity = \"standard\"\ncontact_zone = \"6 um\"\n"
+                    "contact_zone_tip = \"8 um\""),
+               {"model.contact_zone_tip", "must not exceed contact_zone"});
+  expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\ncontact_zone = \"0 um\""),
+               {"test.toml:31:", "model.contact_zone", "must be positive"});
+  expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\ncontact_zone = \"6 s\""),
+               {"test.toml:31:", "model.contact_zone"});
 }
 
 TEST(SceneErrors, MeshRefinementOutsideZeroToSixOrNotAWholeNumber) {

@@ -129,6 +129,12 @@ struct ModelOptions {
   /// 3-D TET10 tissue mesh: halvings of its grid along the needles' paths (docs/model.md,
   /// "Tissue block and mesh"); empty: the fidelity's default (2 at fine, 0 below).
   std::optional<int> mesh_refinement;
+  /// 3-D TET10 tissue mesh: element size (m) in the top layer around each needle's first
+  /// contact, and the size it grades down to toward a pointed one (docs/model.md, "Tissue block
+  /// and mesh", contact zone; docs/validation.md, "The 3-D model under a point load, resolved");
+  /// empty: no zone (every fidelity's default).
+  std::optional<double> contact_zone;
+  std::optional<double> contact_zone_tip;
 
   bool wants(Output o) const;
 };
