@@ -280,6 +280,37 @@ TEST(CmdSimulate, ReadmeSiliconeFigurePuncturesWhereItsCaptionSays) {
   EXPECT_NEAR(p["depth_m"].get<double>(), 0.62e-3, 0.01 * 0.62e-3);
 }
 
+// The README's converged 3-D depth in skin (docs/validation.md, "The 3-D model under a point
+// load, resolved"): paper A's sharp bevel with the scene's contact zone graded down to its tip
+// punctures at 61.1 um at standard (2026-12-05; the study's converged 61.7-62.2 um at fine's
+// growth, standard's 1.8 reads 1-2 % low), where standard alone reads 65.8 um, 7.7 % deeper.
+// Pinned to 1 % (a mesh-converged FE number: a move is a change to explain); the gap to the plain
+// level is asked to stay at least 5 % (the README's "6-12 %"). 15 s, release only.
+TEST(CmdSimulate, ASharpBevelWithItsTipResolvedPuncturesSkinShallowerThanTheShippedLevelReadsIt) {
+  const std::string source =
+      std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/paper_a_skin_sharp_bevel.toml";
+  std::string text = mneedle::test::file_text(source);
+  const std::string key = "fidelity = \"standard\"";
+  ASSERT_NE(text.find(key), std::string::npos);
+  text.replace(text.find(key), key.size(),
+               key + "\ncontact_zone = \"6 um\"\ncontact_zone_tip = \"0.3 um\"");
+  const fs::path file =
+      fs::temp_directory_path() / ("resolved_tip_" + std::to_string(::getpid()) + ".toml");
+  std::ofstream(file) << text;
+  const CommandRun resolved = run_mneedle("simulate '" + file.string() + "' --json");
+  const CommandRun plain = run_mneedle("simulate '" + source + "' --json");
+  fs::remove(file);
+  ASSERT_EQ(resolved.exit_code, 0) << resolved.err;
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  const auto r = nlohmann::json::parse(resolved.out)["needles"][0]["puncture"];
+  const auto q = nlohmann::json::parse(plain.out)["needles"][0]["puncture"];
+  ASSERT_TRUE(r.is_object() && q.is_object());
+  EXPECT_FALSE(r["at_first_contact"].get<bool>());
+  const double d = r["depth_m"].get<double>();
+  EXPECT_NEAR(d, 61.1e-6, 0.01 * 61.1e-6);
+  EXPECT_GT(q["depth_m"].get<double>() / d, 1.05);
+}
+
 // The stress criterion on the analytic path (docs/model.md, "The stress criterion on the analytic
 // path"): the stratum corneum as a plate on the epidermis, pressed at one point by a pointed tip,
 // in series with the tip's own indentation of the layer. Every pointed tip punctures at the same

@@ -52,6 +52,11 @@ void validate(const TissueBlockSpec& spec) {
       (!(*spec.overrides.contact_zone_tip_size_m > 0.0) ||
        !std::isfinite(*spec.overrides.contact_zone_tip_size_m)))
     bad_spec("overrides.contact_zone_tip_size_m", "must be positive and finite");
+  if (!spec.overrides.contact_zone_size_m &&
+      (spec.overrides.contact_zone_reach || spec.overrides.contact_zone_tip_size_m))
+    bad_spec(spec.overrides.contact_zone_reach ? "overrides.contact_zone_reach"
+                                               : "overrides.contact_zone_tip_size_m",
+             "shapes the contact zone: give contact_zone_size_m too");
   for (const NeedleSite& site : spec.sites) {
     if (!(site.radius > 0.0)) bad_spec("needle radius", "must be positive");
     if (std::abs(site.x) >= spec.size_x / 2 || std::abs(site.y) >= spec.size_y / 2)
@@ -143,7 +148,8 @@ double refinement_target(const Eigen::Vector3d& p, const std::vector<NeedleSite>
       size = std::min(size, graded_size(std::max(lateral, under), graded));
       // Toward a pointed first contact the contact patch is far smaller than the ball: the size
       // halves with the distance down to the tip size (a geometric grading, about 2 000 nodes
-      // per halving in paper A's skin; docs/model.md, "Tissue block and mesh").
+      // per halving in paper A's skin), wherever that is finer than the zone's own law (beyond
+      // the zone too when the growth exceeds 1.5; docs/model.md, "Tissue block and mesh").
       if (zone.tip_size > 0.0 && site.first_contact.size() == 1) {
         const double d = std::hypot((p.head<2>() - site.first_contact.front()).norm(), p.z());
         size = std::min(size, std::max(zone.tip_size, kTipGrading * d));
@@ -318,8 +324,10 @@ std::vector<double> lateral_coordinates(double half, const std::vector<double>& 
     double size = sizing.max_size;
     for (double c : centres)
       size = std::min(size, graded_size(std::abs(x - c) - sizing.fine_half_width, sizing));
+    // Built on [0, half] and reflected when symmetric: a window then counts on both sides.
     for (const AxisWindow& w : windows)
-      size = std::min(size, w.fine + (w.growth - 1.0) * std::max({0.0, w.lo - x, x - w.hi}));
+      for (double at : {x, *symmetric ? -x : x})
+        size = std::min(size, w.fine + (w.growth - 1.0) * std::max({0.0, w.lo - at, at - w.hi}));
     return size;
   };
   std::vector<double> sorted = centres;

@@ -901,10 +901,11 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
   InsertionRunOptions options = requested;
   if (!options.overrides.refinement_levels)
     options.overrides.refinement_levels = scene.model.mesh_refinement;
-  if (!options.overrides.contact_zone_size_m) {
+  // Each of the zone's two sizes on its own: an explicit override wins, the scene fills the rest.
+  if (!options.overrides.contact_zone_size_m)
     options.overrides.contact_zone_size_m = scene.model.contact_zone;
+  if (!options.overrides.contact_zone_tip_size_m)
     options.overrides.contact_zone_tip_size_m = scene.model.contact_zone_tip;
-  }
   options.crack_face_contact = scene.model.crack_faces == CrackFaces::Contact;
   check_needle_placement(scene, needles);
   // The pre-puncture model climbs the horizon ladder (docs/model.md, "Pre-puncture horizon"):

@@ -772,6 +772,8 @@ ModelOptions read_model(std::optional<Table> t, const Tissue& tissue) {
     t->fail_key("contact_zone_tip", "grades the contact zone: give contact_zone too");
   if (m.contact_zone_tip && m.contact_zone && *m.contact_zone_tip > *m.contact_zone)
     t->fail_key("contact_zone_tip", "must not exceed contact_zone");
+  if (m.contact_zone && m.mesh_refinement == 0)
+    t->fail_key("contact_zone", "is bisected out of a refined grid: needs mesh_refinement >= 1");
   t->finish();
   return m;
 }

@@ -538,11 +538,11 @@ TEST(ScenePlanner, AReductionIsMeasuredOnTheMeshOfTheRunItChecks) {
 // own contact patch (graded down to 0.3 um toward it) and the stratum corneum's bending away
 // from it (fine's growth, 1.35). A 15-degree cone of 230 um in paper A's skin: the
 // axisymmetric depth at standard is converged to 1 % (65.4 um against 65.0 at L/32 for the
-// plugin's cone); here 64.6 um, and the 3-D quarter model 63.7 um (-1.3 %), 5.61 against
-// 5.52 mN (+1.5 %). Bounds: 3 % on the depth (the study's 3-D cone reads 64.0-64.4 um over
+// plugin's cone); here 64.6 um, and the 3-D quarter model 63.7 um (-1.4 %), 5.61 against
+// 5.52 mN (+1.6 %). Bounds: 3 % on the depth (the study's 3-D cone reads 64.0-64.4 um over
 // zones of L/2 and L/4 and tip sizes of 0.3-0.6 um, the axisymmetric model's own 1 %, and the
 // 48-segment cone here against the bench's 64) and 2.5 % on the force (measured +0.7 to
-// +1.5 % over the same zones). The same grid without the tip's grading reads 62.3 um, at
+// +1.6 % over the same zones). The same grid without the tip's grading reads 62.3 um, at
 // standard's growth 1.8 58.1 um (-10 %), and standard without a zone 71.2 um (+9 %).
 TEST(ScenePlanner, AThreeDConeWithAResolvedTipPuncturesSkinWhereTheAxisymmetricOneDoes) {
   // The zone from the scene's keys (docs/scene.md, [model]), as a user gives it; they reach the

@@ -377,6 +377,9 @@ TEST(SceneErrors, AContactZoneTipNeedsItsZoneAndFitsInIt) {
                {"test.toml:31:", "model.contact_zone", "must be positive"});
   expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\ncontact_zone = \"6 s\""),
                {"test.toml:31:", "model.contact_zone"});
+  expect_error(with("fidelity = \"standard\"",
+                    "fidelity = \"standard\"\nmesh_refinement = 0\ncontact_zone = \"6 um\""),
+               {"model.contact_zone", "needs mesh_refinement >= 1"});
 }
 
 TEST(SceneErrors, MeshRefinementOutsideZeroToSixOrNotAWholeNumber) {

@@ -30,15 +30,16 @@ struct FidelityOverrides {
   /// The contact zone's lateral reach beyond the first contact, in multiples of the larger of
   /// its size and the criterion length (unset: kContactZoneReach).
   std::optional<double> contact_zone_reach;
-  /// Within the contact zone, toward a pointed first contact (one lowest point): elements no
-  /// wider than half their distance from it, down to this size (m; unset: no such grading), so
-  /// the tip's own contact patch is resolved (docs/model.md, "Tissue block and mesh").
+  /// With a contact zone and a pointed first contact (one lowest point): elements no wider than
+  /// half their distance from that point, down to this size (m; unset: no such grading), wherever
+  /// that is finer than the zone's own law, so the tip's own contact patch is resolved
+  /// (docs/model.md, "Tissue block and mesh"). Needs contact_zone_size_m, as does the reach.
   std::optional<double> contact_zone_tip_size_m;
 };
 
 /// Default contact_zone_reach: one criterion length around the first contact holds the ball
-/// under the tip where the stress criterion peaks (docs/validation.md, "Lateral convergence of
-/// the 3-D model under a point load").
+/// under the tip where the stress criterion peaks (docs/validation.md, "The 3-D model under a
+/// point load, resolved").
 inline constexpr double kContactZoneReach = 1.0;
 
 /// Largest refinement_levels: each level halves the element size along the needle's path, and
