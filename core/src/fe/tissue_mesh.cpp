@@ -676,6 +676,11 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   // down to the fine size along the needles' paths only.
   const int levels = spec.overrides.refinement_levels.value_or(
       default_refinement_levels(spec.fidelity, spec.order, spec.criterion_length));
+  // The zone is bisected out of a refined grid: without levels it would be silently nothing.
+  if (spec.overrides.contact_zone_size_m && levels == 0)
+    bad_spec("overrides.contact_zone_size_m",
+             "needs refinement levels (mesh_refinement >= 1; fast without the stress criterion "
+             "and TET4 elements have none by default)");
   MeshSizing base = sizing;
   if (levels > 0) {
     const std::vector<double> z_fine =

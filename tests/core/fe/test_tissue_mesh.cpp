@@ -399,6 +399,10 @@ TEST(TissueMesh, AContactZoneRefinesTheTopLayerAroundTheFirstContactOnly) {
   spec.overrides.contact_zone_size_m = 8e-6;
   spec.overrides.contact_zone_reach = 0.0;
   EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
+  // Without refinement levels there is nothing to bisect the zone out of: an error, not nothing.
+  spec.overrides.contact_zone_reach.reset();
+  spec.overrides.refinement_levels = 0;
+  EXPECT_THROW(generate_tissue_mesh(spec), mneedle::InputError);
 }
 
 // Bisection keeps the shape of the box it starts from: out of the plain grid's top-layer boxes
