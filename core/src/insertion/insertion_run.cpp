@@ -906,6 +906,22 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     options.overrides.contact_zone_size_m = scene.model.contact_zone;
   if (!options.overrides.contact_zone_tip_size_m)
     options.overrides.contact_zone_tip_size_m = scene.model.contact_zone_tip;
+  // A scene's zone is bisected out of a refined grid: say so in the scene's words, before any
+  // mesh is built (the mesh generator refuses it too, in its own).
+  if (scene.model.contact_zone && requested.overrides.contact_zone_size_m == std::nullopt) {
+    const auto& top = scene.tissue.layers;
+    const double length =
+        scene.model.criterion == PunctureCriterion::Stress && !top.empty() && top.front().strength
+            ? top.front().strength->length
+            : 0.0;
+    const int levels = options.overrides.refinement_levels.value_or(fe::default_refinement_levels(
+        options.fidelity, options.overrides.order.value_or(2), length));
+    if (levels == 0)
+      throw InputError(scene.source_name +
+                       ": model.contact_zone: needs a refined 3-D grid, and this run has none "
+                       "(fast without the stress criterion, or TET4 elements); set "
+                       "mesh_refinement = 2 or remove contact_zone");
+  }
   options.crack_face_contact = scene.model.crack_faces == CrackFaces::Contact;
   check_needle_placement(scene, needles);
   // The pre-puncture model climbs the horizon ladder (docs/model.md, "Pre-puncture horizon"):

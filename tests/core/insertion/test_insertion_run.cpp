@@ -569,6 +569,23 @@ TEST(ScenePlanner, AThreeDConeWithAResolvedTipPuncturesSkinWhereTheAxisymmetricO
   EXPECT_NEAR(b->force_N / a->force_N, 1.0, 0.025) << a->force_N << " " << b->force_N;
 }
 
+// A scene's contact zone on a run without refinement levels (here TET4 elements, whose grid has
+// none by default) is refused in one line naming the scene and the key, not silently dropped.
+TEST(ScenePlanner, ASceneContactZoneWithoutARefinedGridIsRefusedNamingTheScene) {
+  const Scene scene = skin_cone_scene("3000 um", "200 um", "fast", "contact_zone = \"6 um\"\n");
+  InsertionRunOptions tet4;
+  tet4.fidelity = fe::Fidelity::Fast;
+  tet4.criterion = PunctureCriterion::Stress;
+  tet4.overrides.order = 1;
+  try {
+    run_insertion(scene, {skin_cone()}, tet4);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("cone.toml: model.contact_zone"), std::string::npos) << message;
+  }
+}
+
 TEST(ScenePlanner, DomainCutAroundTheNeedleKeepsTheAxisymmetricForceWithinTheTolerance) {
   InsertionRunOptions full = fast();
   full.allow_reductions = false;
