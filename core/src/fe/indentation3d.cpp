@@ -56,6 +56,7 @@ constexpr int kMaxCaptureRounds = 60;
 // with the rigid needle (sticking)", has what the group length changed).
 constexpr double kCaptureBisection = 1e-5;
 constexpr double kCaptureGroup = 1e-2;
+constexpr double kCaptureGroupPerSpacing = 0.25;
 constexpr int kMaxNewtonIterations = 40;
 constexpr int kMaxLineSearchHalvings = 6;
 constexpr int kMaxStepCuts = 12;
@@ -67,6 +68,13 @@ constexpr int kMaxContactNewton = 60;
 // Largest size of the watched nodes' rows of the compliance columns (Indentation3d::watch_nodes):
 // 256 MiB, a tenth of what the largest 3-D problems of docs/performance.md hold.
 constexpr double kWatchedRowsBudget = 256.0 * 1024 * 1024;
+// Captured nodes whose watched rows the contact block path keeps (two half solves per node);
+// past them the probe reads the field once per output depth (docs/performance.md, "The contact
+// block").
+constexpr std::size_t kWatchedBlockNodes = 16;
+// Largest dense factor of the contact block (Impl::contact_block_fits): 256 MiB, 3 × 1900
+// surface nodes.
+constexpr double kContactBlockBudget = 256.0 * 1024 * 1024;
 // Crack-face contact: active-set rounds per solve; a pair closes when its faces overlap by more
 // than kCrackGapTolerance x the current depth (round-off of the condensed solve is ~1e-16 of it).
 constexpr int kMaxCrackRounds = 100;   // plus four per pair
@@ -113,6 +121,7 @@ struct Indentation3d::Impl {
   std::unordered_map<int, CachedColumns> column_cache;
   // The smallest needle radius up to the final depth: the length scale of the capture search.
   double capture_radius = std::numeric_limits<double>::infinity();
+  double surface_spacing = std::numeric_limits<double>::infinity();
   std::vector<char> fixed_dof;
   SparseSolver solver{3};  // x, y, z per node: ordered by node
   Eigen::SparseMatrix<double> stiffness;
@@ -226,6 +235,22 @@ struct Indentation3d::Impl {
       }
     }
     captured_by.assign(mesh.nodes.size(), -1);
+    // Half the shortest top-face edge with a candidate on it (a TET10's corner-to-midside
+    // distance): the capture group's bound on a finely meshed surface.
+    for (const auto& face : mesh.top_faces)
+      for (std::size_t a = 0; a < 3; ++a) {
+        const auto p = static_cast<std::size_t>(face[a]);
+        const auto q = static_cast<std::size_t>(face[(a + 1) % 3]);
+        if (candidate_index[p] < 0 && candidate_index[q] < 0) continue;
+        surface_spacing = std::min(surface_spacing, 0.5 * (mesh.nodes[p] - mesh.nodes[q]).norm());
+      }
+  }
+
+  // Nodes entering a needle within this depth of the first entry of an event are captured with
+  // it: kCaptureGroup of the needle's radius, but no more than kCaptureGroupPerSpacing of the
+  // surface's finest spacing, so that a group never spans the nodes of a resolved contact patch.
+  double group_length() const {
+    return std::min(kCaptureGroup * capture_radius, kCaptureGroupPerSpacing * surface_spacing);
   }
 
   // Rows of the sticking path's compliance: the candidates, then the ring.
@@ -280,12 +305,28 @@ struct Indentation3d::Impl {
     apply_dirichlet(&stiffness, fixed_dof);
     timing.assembly_s += seconds_since(start);
     start = Clock::now();
+    if (contact_block_fits()) {
+      std::vector<int> surface = candidates;
+      surface.insert(surface.end(), ring.begin(), ring.end());
+      solver.set_trailing_nodes(std::move(surface));
+    }
     solver.analyze(stiffness);
     solver.factorize(stiffness);
     ++timing.factorizations;
     timing.factorization_s += seconds_since(start);
     if (!solver.ok()) throw SolverError("3-D solve: singular stiffness at depth 0 um");
     linear_factorized = true;
+  }
+
+  // The sticking path's surface rows (candidates, then the ring) eliminated last, so that their
+  // compliance is read from the dense factor of the Schur complement onto them
+  // (docs/performance.md, "The contact block"). Not with crack faces in contact (their gaps need
+  // the whole columns) nor with frictionless contact (other rows), and only while the dense
+  // block stays small.
+  bool contact_block_fits() const {
+    const auto dofs = static_cast<double>(surface_rows());
+    return !frictionless() && !crack_contact() && dofs > 0.0 &&
+           8.0 * dofs * dofs <= kContactBlockBudget;
   }
 
   // K⁻¹ at unit loads on the nodes' three dofs, kept at the surface rows (and the pairs' gaps):
@@ -299,6 +340,36 @@ struct Indentation3d::Impl {
           std::find(missing.begin(), missing.end(), c.node) == missing.end())
         missing.push_back(c.node);
     if (missing.empty()) return;
+    if (solver.has_trailing_block()) {
+      std::vector<Eigen::Index> at;
+      for (int node : missing)
+        for (int j = 0; j < 3; ++j)
+          at.push_back(
+              3 * static_cast<Eigen::Index>(candidate_index[static_cast<std::size_t>(node)]) + j);
+      const Eigen::MatrixXd columns = solver.trailing_columns(at);
+      // The watched rows take half solves (solve_trailing_loads) for the first
+      // kWatchedBlockNodes nodes; past them each output depth reads the field once instead.
+      if (!watched.empty() && !watched_overflow &&
+          column_cache.size() + captured.size() + missing.size() > kWatchedBlockNodes)
+        watched_overflow = true;
+      Eigen::MatrixXd field;
+      if (!watched.empty() && !watched_overflow) {
+        Eigen::MatrixXd unit =
+            Eigen::MatrixXd::Zero(surface_rows(), static_cast<Eigen::Index>(at.size()));
+        for (std::size_t j = 0; j < at.size(); ++j) unit(at[j], static_cast<Eigen::Index>(j)) = 1.0;
+        field = solver.solve_trailing_loads(unit);
+      }
+      for (std::size_t i = 0; i < missing.size(); ++i) {
+        CachedColumns& cached = column_cache[missing[i]];
+        cached.surface = columns.middleCols<3>(3 * static_cast<Eigen::Index>(i));
+        if (field.size() == 0) continue;
+        cached.watched.resize(3 * static_cast<Eigen::Index>(watched.size()), 3);
+        for (std::size_t w = 0; w < watched.size(); ++w)
+          cached.watched.middleRows<3>(3 * static_cast<Eigen::Index>(w)) =
+              field.block<3, 3>(3 * watched[w], 3 * static_cast<Eigen::Index>(i));
+      }
+      return;
+    }
     Eigen::MatrixXd unit =
         Eigen::MatrixXd::Zero(model.dof_count(), 3 * static_cast<Eigen::Index>(missing.size()));
     for (std::size_t i = 0; i < missing.size(); ++i)
@@ -549,7 +620,7 @@ struct Indentation3d::Impl {
       }
       // The event is the first entry; the nodes entering within the group length after it are
       // taken with it, each anchored on the face below (or nearest to) where it is then.
-      const double group = first + kCaptureGroup * capture_radius / std::max(span, 1e-300);
+      const double group = first + group_length() / std::max(span, 1e-300);
       std::vector<CapturedNode> now;
       for (std::size_t i = 0; i < found.size(); ++i) {
         if (entry[i] > group) continue;
@@ -604,6 +675,14 @@ struct Indentation3d::Impl {
       put_pair_load(static_cast<std::size_t>(active_pairs[a]),
                     pair_forces(static_cast<Eigen::Index>(a)), load);
     if (captured.empty()) return load;
+    if (solver.has_trailing_block() && active_pairs.empty()) {
+      // The captured nodes are candidates, hence trailing: half a solve.
+      Eigen::VectorXd trailing = Eigen::VectorXd::Zero(surface_rows());
+      for (std::size_t i = 0; i < captured.size(); ++i)
+        trailing.segment<3>(3 * candidate_index[static_cast<std::size_t>(captured[i].node)]) =
+            multipliers.segment<3>(3 * static_cast<Eigen::Index>(i));
+      return solver.solve_trailing_loads(trailing);
+    }
     return solver.solve(load);
   }
 

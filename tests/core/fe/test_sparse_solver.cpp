@@ -212,4 +212,77 @@ TEST(SparseSolver, ASizeThatIsNoWholeNumberOfNodesIsOrderedByDof) {
   EXPECT_THROW(mneedle::fe::SparseSolver(0), mneedle::SolverError);
 }
 
+// The contact block (docs/performance.md, "The contact block"): nodes eliminated last, K⁻¹ on
+// them read from the dense factor of the Schur complement, must be the columns a sparse solve
+// gives (round-off of a system whose condition number is about 1e3), in the trailing nodes' own
+// numbering, whatever order the nodes are named in.
+TEST(SparseSolver, TrailingColumnsAreTheColumnsOfTheInverseOnTheTrailingNodes) {
+  if (!with_cholmod()) GTEST_SKIP() << "the trailing block is read from CHOLMOD's factor";
+  const SpMat matrix = nodal_system(7, 0.05);
+  const std::vector<int> trailing = {171, 3, 170, 100, 342, 57};
+  mneedle::fe::SparseSolver plain(3), blocked(3);
+  plain.factorize(matrix);
+  blocked.set_trailing_nodes(trailing);
+  blocked.factorize(matrix);
+  ASSERT_TRUE(blocked.has_trailing_block());
+  EXPECT_FALSE(plain.has_trailing_block());
+  const auto t = static_cast<Eigen::Index>(3 * trailing.size());
+  std::vector<Eigen::Index> columns;
+  for (Eigen::Index c = 0; c < t; ++c) columns.push_back((5 * c + 2) % t);  // every one, shuffled
+  const Eigen::MatrixXd block = blocked.trailing_columns(columns);
+  ASSERT_EQ(block.rows(), t);
+  ASSERT_EQ(block.cols(), t);
+  for (Eigen::Index j = 0; j < t; ++j) {
+    const Eigen::Index c = columns[static_cast<std::size_t>(j)];
+    Eigen::VectorXd unit = Eigen::VectorXd::Zero(matrix.rows());
+    unit(3 * trailing[static_cast<std::size_t>(c / 3)] + c % 3) = 1.0;
+    const Eigen::VectorXd x = plain.solve(unit);
+    for (Eigen::Index r = 0; r < t; ++r)
+      EXPECT_NEAR(block(r, j), x(3 * trailing[static_cast<std::size_t>(r / 3)] + r % 3),
+                  1e-12 * x.norm())
+          << "row " << r << ", column " << c;
+  }
+  // A load on the trailing dofs alone: the dense forward solve and CHOLMOD's back substitution
+  // give what a whole solve gives.
+  const Eigen::VectorXd load = Eigen::VectorXd::LinSpaced(t, -1.0, 2.0);
+  Eigen::VectorXd full = Eigen::VectorXd::Zero(matrix.rows());
+  for (Eigen::Index r = 0; r < t; ++r)
+    full(3 * trailing[static_cast<std::size_t>(r / 3)] + r % 3) = load(r);
+  const Eigen::VectorXd x = plain.solve(full);
+  EXPECT_LT((blocked.solve_trailing_loads(load).col(0) - x).norm(), 1e-12 * x.norm());
+  // The whole solve is unchanged by the order.
+  EXPECT_LT((blocked.solve(full) - x).norm(), 1e-12 * x.norm());
+}
+
+TEST(SparseSolver, WithoutATrailingBlockItsColumnsAreRefused) {
+  const SpMat matrix = nodal_system(3, 0.1);
+  mneedle::fe::SparseSolver solver(3);
+  solver.factorize(matrix);
+  EXPECT_FALSE(solver.has_trailing_block());
+  EXPECT_THROW(solver.trailing_columns({0}), mneedle::SolverError);
+  EXPECT_THROW(solver.solve_trailing_loads(Eigen::VectorXd::Ones(3)), mneedle::SolverError);
+  // A node named twice or out of range: ordered without the list. An empty list clears it.
+  solver.set_trailing_nodes({1, 5, 5});
+  solver.analyze(matrix);
+  solver.factorize(matrix);
+  EXPECT_FALSE(solver.has_trailing_block());
+  EXPECT_EQ(solver.ordered_by_node(), with_cholmod());
+  solver.set_trailing_nodes({0, 99});
+  solver.analyze(matrix);
+  solver.factorize(matrix);
+  EXPECT_FALSE(solver.has_trailing_block());
+  EXPECT_EQ(solver.ordered_by_node(), with_cholmod());
+  if (!with_cholmod()) return;
+  solver.set_trailing_nodes({4, 2});
+  solver.analyze(matrix);
+  solver.factorize(matrix);
+  ASSERT_TRUE(solver.has_trailing_block());
+  EXPECT_THROW(solver.trailing_columns({6}), mneedle::SolverError);  // 2 nodes: 6 dofs
+  EXPECT_THROW(solver.solve_trailing_loads(Eigen::VectorXd::Ones(5)), mneedle::SolverError);
+  solver.set_trailing_nodes({});
+  solver.analyze(matrix);
+  solver.factorize(matrix);
+  EXPECT_FALSE(solver.has_trailing_block());
+}
+
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "mneedle/base/error.h"
@@ -299,6 +300,53 @@ TEST(StressProbe, AveragedTipStressMovesLessUnderRefinementThanTheLocalValue) {
   const double local_change = std::abs(local_fine / local_coarse - 1.0);
   EXPECT_LT(mean_change, 0.25);
   EXPECT_GT(local_change, 2.0 * mean_change);
+}
+
+// The probe's centres are its layer's nodes within reach, thinned where the mesh is finer than a
+// tenth of the averaging length (stress_probe.cpp, kCentreSpacingPerLength): on a mesh no finer
+// than that every node is a centre; on a finer one no two centres are closer than L/10, every
+// node left out lies within L/10 of a centre, and the deepest nodes (a bent layer's underside,
+// where its tension peaks) are kept first.
+std::vector<Eigen::Vector3d> layer_nodes_in_reach(const TetMesh& mesh, double radius) {
+  std::vector<char> in_layer(mesh.nodes.size(), 0);
+  for (std::size_t e = 0; e < mesh.elements.size(); ++e)
+    if (mesh.element_layer[e] == 0)
+      for (int a = 0; a < mesh.nodes_per_element(); ++a)
+        in_layer[static_cast<std::size_t>(mesh.elements[e][a])] = 1;
+  std::vector<Eigen::Vector3d> out;
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n)
+    if (in_layer[n] && mesh.nodes[n].head<2>().norm() <= radius) out.push_back(mesh.nodes[n]);
+  return out;
+}
+
+TEST(StressProbe, CentresAreTheLayersNodesSpacedNoCloserThanATenthOfTheLength) {
+  const TetMesh mesh = two_layer_block(2, 0.3);
+  const double radius = 0.3e-3;
+  const std::vector<Eigen::Vector3d> nodes = layer_nodes_in_reach(mesh, radius);
+  // 40 um against a mesh whose nodes are tens of micrometres apart: all of them.
+  const PeakStressProbe every(mesh, {{0.0, 0.0}}, {radius}, 1e-3, 40e-6, 0);
+  EXPECT_EQ(every.centres().size(), nodes.size());
+  // 0.5 mm: centres at least 50 um apart, more than the nodes' spacing near the site.
+  const double length = 0.5e-3, spacing = 0.1 * length;
+  const PeakStressProbe thinned(mesh, {{0.0, 0.0}}, {radius}, 1e-3, length, 0);
+  const std::vector<Eigen::Vector3d> centres = thinned.centres();
+  ASSERT_LT(centres.size(), nodes.size());
+  ASSERT_GT(centres.size(), 10u);
+  for (std::size_t i = 0; i < centres.size(); ++i)
+    for (std::size_t j = i + 1; j < centres.size(); ++j)
+      EXPECT_GE((centres[i] - centres[j]).norm(), spacing);
+  double deepest = 0.0;
+  for (const Eigen::Vector3d& x : nodes) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3d& c : centres) nearest = std::min(nearest, (c - x).norm());
+    EXPECT_LT(nearest, spacing);
+    deepest = std::min(deepest, x.z());
+  }
+  int deep_nodes = 0, deep_centres = 0;
+  for (const Eigen::Vector3d& x : nodes) deep_nodes += x.z() == deepest ? 1 : 0;
+  for (const Eigen::Vector3d& c : centres) deep_centres += c.z() == deepest ? 1 : 0;
+  EXPECT_GT(deep_centres, 0);
+  EXPECT_LE(deep_centres, deep_nodes);
 }
 
 }  // namespace

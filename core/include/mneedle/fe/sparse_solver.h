@@ -5,6 +5,7 @@
 #include <Eigen/Sparse>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace mneedle::fe {
 
@@ -45,6 +46,24 @@ class SparseSolver {
   bool ordered_by_node() const;
   /// Nonzeros of the last CHOLMOD Cholesky factor (its fill); 0 for the other factorisations.
   double factor_nonzeros() const;
+
+  /// Nodes whose dofs the factorisation eliminates last, in this order (docs/performance.md,
+  /// "The contact block"): the factor's trailing block is then the dense Cholesky factor of K's
+  /// Schur complement onto those dofs, and K⁻¹ on them (trailing_columns) costs two dense
+  /// triangular solves of that size instead of a sparse solve. Takes effect at the next
+  /// analyze(); an empty list clears it, and so does a list that names a node twice or one out
+  /// of range. Only a nodal ordering (ordered_by_node) honours it.
+  void set_trailing_nodes(std::vector<int> nodes);
+  /// True when the last factorize() gave the Cholesky factor with the trailing nodes last.
+  bool has_trailing_block() const;
+  /// Columns of K⁻¹ restricted to the trailing dofs (rows and columns numbered b·i + d for the
+  /// i-th trailing node's d-th dof, b = dofs_per_node). Throws SolverError without a trailing
+  /// block.
+  Eigen::MatrixXd trailing_columns(const std::vector<Eigen::Index>& columns) const;
+  /// K⁻¹ B for loads on the trailing dofs alone (each column of `loads` in their numbering), in
+  /// the original numbering: the forward substitution is the dense block's, so it costs about
+  /// half a solve_many(). Throws SolverError without a trailing block.
+  Eigen::MatrixXd solve_trailing_loads(const Eigen::MatrixXd& loads) const;
 
  private:
   struct Impl;
