@@ -287,7 +287,7 @@ TEST(CmdSimulate, ReadmeSiliconeFigurePuncturesWhereItsCaptionSays) {
 // capture event took every node entering within 1.15 um of depth with it (110 nodes at the first
 // contact; now no group spans more than a quarter of the surface's finest spacing, and 85 nodes
 // are captured over 74 events). Pinned to 1 % (a mesh-converged FE number: a move is a change to
-// explain); the gap to the plain level is asked to stay at least 5 % (the README's "5-11 %").
+// explain); the gap to the plain level is asked to stay at least 5 % (7 % measured).
 // 6 s, release only.
 TEST(CmdSimulate, ASharpBevelWithItsTipResolvedPuncturesSkinShallowerThanTheShippedLevelReadsIt) {
   const std::string source =
