@@ -525,6 +525,69 @@ TEST(TissueMesh, RefinedMeshIsMirrorSymmetricAndItsQuarterIsThePositivePart) {
   expect_mirror_symmetric_with_exact_quarter(refined_skin(2));
 }
 
+// The fine level resolves one pointed tip under a criterion length on its own: a contact zone of
+// 1.2 L graded down to 0.12 L at the tip (docs/model.md, "Tissue block and mesh"), the same mesh
+// as the overrides give. Not at standard, not without a criterion length, not under a flat end,
+// not for two needles; a zone the scene or the caller sets replaces it.
+// The largest bounding-box extent of the layer-0 elements with a corner at the surface point
+// `contact`.
+double widest_at(const TetMesh& m, const Eigen::Vector2d& contact) {
+  double widest = 0.0;
+  for (std::size_t e = 0; e < m.elements.size(); ++e) {
+    if (m.element_layer[e] != 0) continue;
+    bool touches = false;
+    Eigen::Vector3d lo = m.nodes[static_cast<std::size_t>(m.elements[e][0])], hi = lo;
+    for (int a = 0; a < 4; ++a) {
+      const Eigen::Vector3d& p = m.nodes[static_cast<std::size_t>(m.elements[e][a])];
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+      touches = touches || ((p.head<2>() - contact).norm() < 1e-12 && std::abs(p.z()) < 1e-12);
+    }
+    if (touches) widest = std::max(widest, (hi - lo).maxCoeff());
+  }
+  return widest;
+}
+
+TEST(TissueMesh, TheFineLevelGradesItsMeshDownToAPointedTip) {
+  const Eigen::Vector2d contact(-115e-6, 0.0);
+  auto spec = zoned_skin(contact);
+  spec.fidelity = Fidelity::Fine;
+  spec.overrides.refinement_levels.reset();
+  const TetMesh fine = generate_tissue_mesh(spec);
+  auto asked = spec;
+  asked.overrides.contact_zone_size_m = 12e-6;
+  asked.overrides.contact_zone_tip_size_m = 1.2e-6;
+  const TetMesh same = generate_tissue_mesh(asked);
+  ASSERT_EQ(fine.nodes.size(), same.nodes.size());
+  for (std::size_t n = 0; n < fine.nodes.size(); ++n) ASSERT_EQ(fine.nodes[n], same.nodes[n]);
+  // Elements at the tip as fine as 0.12 L asks (bisection of a 40 um box: 0.625 um cells, whose
+  // tetrahedra span up to 1.25 um).
+  const double at_tip = widest_at(fine, contact);
+  EXPECT_GT(at_tip, 0.0);
+  EXPECT_LE(at_tip, 2.0 * 1.2e-6);
+  // An explicit zone replaces it.
+  asked.overrides.contact_zone_size_m = 24e-6;
+  asked.overrides.contact_zone_tip_size_m.reset();
+  EXPECT_GT(widest_at(generate_tissue_mesh(asked), contact), 4.0 * at_tip);
+  // Standard, no criterion length, a flat first contact, two needles: fine's plain mesh.
+  auto standard = spec;
+  standard.fidelity = Fidelity::Standard;
+  EXPECT_GT(widest_at(generate_tissue_mesh(standard), contact), 4.0 * at_tip);
+  auto no_length = spec;
+  no_length.criterion_length = 0.0;
+  EXPECT_GT(widest_at(generate_tissue_mesh(no_length), contact), 4.0 * at_tip);
+  auto flat = spec;
+  flat.sites.front().first_contact = {contact, contact + Eigen::Vector2d(0.0, 20e-6),
+                                      contact + Eigen::Vector2d(-20e-6, 10e-6)};
+  EXPECT_GT(widest_at(generate_tissue_mesh(flat), contact), 4.0 * at_tip);
+  auto two = spec;
+  two.sites.push_back(two.sites.front());
+  two.sites.back().x = 600e-6;
+  two.sites.back().tip = contact + Eigen::Vector2d(600e-6, 0.0);
+  two.sites.back().first_contact = {contact + Eigen::Vector2d(600e-6, 0.0)};
+  EXPECT_GT(widest_at(generate_tissue_mesh(two), contact), 4.0 * at_tip);
+}
+
 // The contact zone's own grid lines and its grading toward the tip keep a symmetric needle's
 // mesh symmetric, so the half and quarter models stay exact with a zone (a cone's tip on the
 // axis).
