@@ -203,6 +203,7 @@ struct SparseSolver::Impl {
   // dense factor of the Schur complement onto them after a successful Cholesky.
   std::vector<int> trailing_nodes;
   bool trailing_ordered = false;
+  std::size_t trailing_dofs = 0;  // of the last analysis (a later set_trailing_nodes waits)
   Eigen::MatrixXd trailing_factor;
 };
 
@@ -304,6 +305,7 @@ void SparseSolver::analyze(const Eigen::SparseMatrix<double>& matrix) {
   if (matrix.rows() != matrix.cols()) throw SolverError("sparse solver: matrix is not square");
   impl_->permuted = false;
   impl_->trailing_ordered = false;
+  impl_->trailing_dofs = 0;
   bool trailing_lost = false;
   {
     // CHOLMOD's ordering may call METIS, whose random numbers come from one generator per
@@ -343,6 +345,7 @@ void SparseSolver::analyze(const Eigen::SparseMatrix<double>& matrix) {
     const std::vector<int> given = trailing ? dof_order : std::vector<int>{};
     impl_->cholesky.analyze(matrix, std::move(dof_order));
     impl_->trailing_ordered = trailing && impl_->cholesky.ends_with(given, trailing_dofs);
+    impl_->trailing_dofs = impl_->trailing_ordered ? trailing_dofs : 0;
     trailing_lost = trailing && !impl_->trailing_ordered;
 #else
     impl_->cholesky.analyzePattern(matrix);
@@ -358,6 +361,7 @@ void SparseSolver::analyze(const Eigen::SparseMatrix<double>& matrix) {
     // paid for it buys nothing, so the matrix is ordered again without them.
     std::vector<int> nodes = std::move(impl_->trailing_nodes);
     impl_->trailing_nodes.clear();
+    --impl_->analyses;  // one analysis, as the caller sees it
     analyze(matrix);
     impl_->trailing_nodes = std::move(nodes);
   }
@@ -376,8 +380,7 @@ void SparseSolver::factorize(const Eigen::SparseMatrix<double>& input) {
     impl_->active = Active::Cholesky;
 #ifdef MNEEDLE_HAVE_CHOLMOD
     if (impl_->trailing_ordered)
-      impl_->trailing_factor = impl_->cholesky.trailing_block(
-          static_cast<std::size_t>(impl_->dofs_per_node) * impl_->trailing_nodes.size());
+      impl_->trailing_factor = impl_->cholesky.trailing_block(impl_->trailing_dofs);
 #endif
     return;
   }

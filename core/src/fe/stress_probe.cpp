@@ -300,14 +300,14 @@ long long cell_key(const Cell& c) {
 // Centres closer than this fraction of the averaging length are thinned (spaced_centres): the
 // averaged stress varies over L, and on a contact zone's sub-micrometre elements every node a
 // centre made the probe 60 % of a run. On paper A's skin with a resolved tip, spacings of 0, L/20,
-// L/10 and L/5 gave the same puncture depth to 14 digits; no shipped level's mesh is fine enough
-// to lose a centre (docs/model.md, "Tip stress").
+// L/10 and L/5 gave the same puncture depth to 14 digits; fast's and standard's meshes are not
+// fine enough to lose a centre, fine's own contact zone is (docs/model.md, "Tip stress").
 constexpr double kCentreSpacingPerLength = 0.1;
 
 // The nodes kept as centres where the mesh is finer than `spacing`: taken deepest first (a layer's
-// underside, where a bent layer's tension peaks, keeps all it has up to the spacing), then by x
-// and y, each dropped when a kept one lies within `spacing` of it. Independent of the nodes'
-// numbering; on a mesh no finer than `spacing` every node stays.
+// underside, where a bent layer's tension peaks, keeps all it has up to the spacing), then
+// nearest the planes x = 0 and y = 0, each dropped when a kept one lies within `spacing` of it.
+// Independent of the nodes' numbering; on a mesh no finer than `spacing` every node stays.
 std::vector<int> spaced_centres(const TetMesh& mesh, std::vector<int> nodes, double spacing) {
   const auto at = [&](int node) -> const Eigen::Vector3d& {
     return mesh.nodes[static_cast<std::size_t>(node)];
@@ -315,8 +315,13 @@ std::vector<int> spaced_centres(const TetMesh& mesh, std::vector<int> nodes, dou
   std::sort(nodes.begin(), nodes.end(), [&](int a, int b) {
     const Eigen::Vector3d &p = at(a), &q = at(b);
     if (p.z() != q.z()) return p.z() < q.z();
-    if (p.x() != q.x()) return p.x() < q.x();
+    // Nearest the planes x = 0 and y = 0 first, a mirror pair one after the other: a half or
+    // quarter model keeps the mirror images of what the whole block keeps near its planes, up to
+    // the pairs closer than `spacing` across a plane (docs/model.md, "Tip stress").
+    if (std::abs(p.y()) != std::abs(q.y())) return std::abs(p.y()) < std::abs(q.y());
+    if (std::abs(p.x()) != std::abs(q.x())) return std::abs(p.x()) < std::abs(q.x());
     if (p.y() != q.y()) return p.y() < q.y();
+    if (p.x() != q.x()) return p.x() < q.x();
     return a < b;
   });
   std::unordered_map<long long, std::vector<int>> kept_in;
@@ -398,10 +403,16 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
   }
   std::sort(nodes_.begin(), nodes_.end());
   nodes_.erase(std::unique(nodes_.begin(), nodes_.end()), nodes_.end());
+  // Thinned among the nodes within reach of a site only, so that a node outside every search
+  // radius never displaces one inside.
   std::vector<int> centre_nodes;
-  for (std::size_t i = 0; i < mesh.nodes.size(); ++i)
-    if (candidate_node[i] && mesh.nodes[i].z() >= -search_depth_m)
-      centre_nodes.push_back(static_cast<int>(i));
+  for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
+    if (!candidate_node[i] || mesh.nodes[i].z() < -search_depth_m) continue;
+    bool within = false;
+    for (std::size_t s = 0; s < sites_xy.size() && !within; ++s)
+      within = (mesh.nodes[i].head<2>() - sites_xy[s]).norm() <= search_radius_m[s];
+    if (within) centre_nodes.push_back(static_cast<int>(i));
+  }
   centre_nodes = spaced_centres(mesh, std::move(centre_nodes), kCentreSpacingPerLength * length_m);
   for (int node : centre_nodes) {
     const auto i = static_cast<std::size_t>(node);

@@ -111,13 +111,21 @@ struct ContactZone {
 // the tip's contact, and read paper A's sharp bevel in skin 8-9 % deep where standard reads it
 // 3-4 % deep; with this zone it reads 62.7 um against the study's converged 63.4-63.8 um, and a
 // zone of 0.6 L or a tip of 0.06 L read the same to 0.1 % (docs/validation.md, "The 3-D model
-// under a point load, resolved"). One needle only: an array would carry one per needle.
+// under a point load, resolved"). One needle only: an array would carry one per needle. Only
+// where the level's mesh resolves L (kTipElementsPerCriterionLength within standard's spacings
+// per radius, as in skin): an L far below the needle (the silicone scenes' 0.15 um) would ask
+// for a zone of nanometres.
 constexpr double kFineZonePerLength = 1.2;
 constexpr double kFineTipPerLength = 0.12;
+constexpr double kMostSpacingsForFineZone = 5.5;
 
 bool fine_resolves_the_tip(const TissueBlockSpec& spec) {
-  return spec.fidelity == Fidelity::Fine && spec.criterion_length > 0.0 && spec.order == 2 &&
-         spec.sites.size() == 1 && spec.sites.front().first_contact.size() == 1;
+  if (spec.fidelity != Fidelity::Fine || !(spec.criterion_length > 0.0) || spec.order != 2 ||
+      spec.sites.size() != 1 || spec.sites.front().first_contact.size() != 1)
+    return false;
+  const double spacings =
+      2.0 * spec.sites.front().radius / (kTipElementsPerCriterionLength * spec.criterion_length);
+  return spacings <= kMostSpacingsForFineZone;
 }
 
 ContactZone contact_zone(const TissueBlockSpec& spec) {
@@ -125,7 +133,10 @@ ContactZone contact_zone(const TissueBlockSpec& spec) {
   if (spec.layers.empty()) return zone;
   if (spec.overrides.contact_zone_size_m) {
     zone.size = *spec.overrides.contact_zone_size_m;
-    zone.tip_size = std::min(zone.size, spec.overrides.contact_zone_tip_size_m.value_or(0.0));
+    // At fine a zone given without a tip size keeps fine's own grading toward a pointed tip.
+    const double fine_tip =
+        fine_resolves_the_tip(spec) ? kFineTipPerLength * spec.criterion_length : 0.0;
+    zone.tip_size = std::min(zone.size, spec.overrides.contact_zone_tip_size_m.value_or(fine_tip));
   } else if (fine_resolves_the_tip(spec)) {
     zone.size = kFineZonePerLength * spec.criterion_length;
     zone.tip_size = kFineTipPerLength * spec.criterion_length;

@@ -527,8 +527,9 @@ TEST(TissueMesh, RefinedMeshIsMirrorSymmetricAndItsQuarterIsThePositivePart) {
 
 // The fine level resolves one pointed tip under a criterion length on its own: a contact zone of
 // 1.2 L graded down to 0.12 L at the tip (docs/model.md, "Tissue block and mesh"), the same mesh
-// as the overrides give. Not at standard, not without a criterion length, not under a flat end,
-// not for two needles; a zone the scene or the caller sets replaces it.
+// as the overrides give. Not at standard, not without a criterion length or with one the level
+// cannot resolve, not under a flat end, not for two needles; a zone the scene or the caller sets
+// replaces it (keeping fine's tip grading unless a tip size is set too).
 // The largest bounding-box extent of the layer-0 elements with a corner at the surface point
 // `contact`.
 double widest_at(const TetMesh& m, const Eigen::Vector2d& contact) {
@@ -565,10 +566,17 @@ TEST(TissueMesh, TheFineLevelGradesItsMeshDownToAPointedTip) {
   const double at_tip = widest_at(fine, contact);
   EXPECT_GT(at_tip, 0.0);
   EXPECT_LE(at_tip, 2.0 * 1.2e-6);
-  // An explicit zone replaces it.
+  // A zone asked for at fine keeps fine's grading toward the tip unless a tip size is given too.
   asked.overrides.contact_zone_size_m = 24e-6;
   asked.overrides.contact_zone_tip_size_m.reset();
+  EXPECT_LE(widest_at(generate_tissue_mesh(asked), contact), 2.0 * 1.2e-6);
+  asked.overrides.contact_zone_tip_size_m = 24e-6;
   EXPECT_GT(widest_at(generate_tissue_mesh(asked), contact), 4.0 * at_tip);
+  // A criterion length far below what the level resolves (the silicone scenes' 0.15 um against
+  // a 115 um needle): no zone of nanometres.
+  auto tiny = spec;
+  tiny.criterion_length = 0.15e-6;
+  EXPECT_GT(widest_at(generate_tissue_mesh(tiny), contact), 4.0 * at_tip);
   // Standard, no criterion length, a flat first contact, two needles: fine's plain mesh.
   auto standard = spec;
   standard.fidelity = Fidelity::Standard;

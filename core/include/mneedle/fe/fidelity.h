@@ -25,13 +25,15 @@ struct FidelityOverrides {
   /// 3-D tissue with refinement levels: the top layer around each needle's first contact (its
   /// lowest points) is bisected down to this element size, within contact_zone_reach times the
   /// larger of it and the criterion length of that contact (docs/model.md, "Tissue block and
-  /// mesh"; a convergence study's knob, unset in every fidelity; without refinement levels, none).
+  /// mesh"; unset at every fidelity, but fine takes its own under one pointed tip with a
+  /// criterion length; without refinement levels, none).
   std::optional<double> contact_zone_size_m;
   /// The contact zone's lateral reach beyond the first contact, in multiples of the larger of
   /// its size and the criterion length (unset: kContactZoneReach).
   std::optional<double> contact_zone_reach;
   /// With a contact zone and a pointed first contact (one lowest point): elements no wider than
-  /// half their distance from that point, down to this size (m; unset: no such grading), wherever
+  /// half their distance from that point, down to this size (m; unset: none, but fine's own tip
+  /// size where fine takes its own zone), wherever
   /// that is finer than the zone's own law, so the tip's own contact patch is resolved
   /// (docs/model.md, "Tissue block and mesh"). Needs contact_zone_size_m, as does the reach.
   std::optional<double> contact_zone_tip_size_m;
