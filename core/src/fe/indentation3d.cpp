@@ -325,7 +325,7 @@ struct Indentation3d::Impl {
   // block stays small.
   bool contact_block_fits() const {
     const auto dofs = static_cast<double>(surface_rows());
-    return !frictionless() && !crack_contact() && dofs > 0.0 &&
+    return options.contact_block && !frictionless() && !crack_contact() && dofs > 0.0 &&
            8.0 * dofs * dofs <= kContactBlockBudget;
   }
 
@@ -1442,6 +1442,10 @@ const Timing3d& Indentation3d::timing() const {
 
 std::string Indentation3d::solver_backend() const {
   return impl_->solver.backend();
+}
+
+bool Indentation3d::uses_contact_block() const {
+  return impl_->solver.has_trailing_block();
 }
 
 InpExport Indentation3d::write_inp(const std::string& path,

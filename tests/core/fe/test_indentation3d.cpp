@@ -234,6 +234,49 @@ TEST(Indentation3d, WatchedDisplacementEqualsTheFieldsRows) {
   EXPECT_THROW(fresh.watch_nodes({static_cast<int>(mesh.nodes.size())}), mneedle::InputError);
 }
 
+// The contact block (docs/performance.md, "The contact block") against compliance columns from
+// sparse solves: the same forces, strain energy, field and watched rows at every depth, to the
+// round-off of two factorisations in two orders (1e-9 relative), on a cone that captures node after
+// node; the watched rows either way equal to the field's.
+TEST(Indentation3d, TheContactBlockGivesWhatSparseSolvesGive) {
+  const TetMesh mesh =
+      punch_mesh(homogeneous_block(MaterialModel::Linear, 1e5, 0.4, 400e-6, 300e-6), 100e-6, 20e-6,
+                 2, Fidelity::Fast);
+  std::vector<int> nodes;
+  for (std::size_t n = 0; n < mesh.nodes.size(); n += 7) nodes.push_back(static_cast<int>(n));
+  // A punch takes its whole face at first contact, and more nodes as its rim sinks.
+  for (const Needle3d& needle : {Needle3d{"punch", cylinder_needle(100e-6, 1e-3), 0.0, 0.0}}) {
+    SCOPED_TRACE(needle.name);
+    Indentation3dOptions sparse;
+    sparse.contact_block = false;
+    Indentation3d blocked(mesh, {needle}, 20e-6), plain(mesh, {needle}, 20e-6, sparse);
+    blocked.watch_nodes(nodes);
+    plain.watch_nodes(nodes);
+    int captured = 0;
+    for (double depth : {5e-6, 12e-6, 20e-6}) {
+      const Step3d a = blocked.advance_to(depth), b = plain.advance_to(depth);
+      SCOPED_TRACE(depth);
+      ASSERT_GT(b.needles[0].force_N, 0.0);
+      EXPECT_NEAR(a.needles[0].force_N, b.needles[0].force_N, 1e-9 * b.needles[0].force_N);
+      EXPECT_NEAR(a.strain_energy_J, b.strain_energy_J, 1e-9 * b.strain_energy_J);
+      EXPECT_EQ(a.needles[0].captured_nodes, b.needles[0].captured_nodes);
+      captured = b.needles[0].captured_nodes;
+      const Eigen::VectorXd u = plain.displacement();
+      EXPECT_LE((blocked.displacement() - u).norm(), 1e-9 * u.norm());
+      const Eigen::VectorXd wa = blocked.watched_displacement(), wb = plain.watched_displacement();
+      EXPECT_LE((wa - wb).norm(), 1e-9 * wb.norm());
+      for (std::size_t w = 0; w < nodes.size(); ++w)
+        EXPECT_LE(
+            (wb.segment<3>(3 * static_cast<Eigen::Index>(w)) - u.segment<3>(3 * nodes[w])).norm(),
+            1e-10 * u.norm());
+    }
+    // The comparison covers capture events and the watched rows' switch past 16 nodes.
+    EXPECT_GT(captured, 16);
+    EXPECT_TRUE(blocked.uses_contact_block());
+    EXPECT_FALSE(plain.uses_contact_block());
+  }
+}
+
 TEST(Indentation3d, SimulateThreeDimensionalReportsMeshAndCurve) {
   TissueBlockSpec block;
   block.size_x = block.size_y = 1000e-6;

@@ -79,6 +79,11 @@ struct Timing3d {
 struct Indentation3dOptions {
   ContactMode contact = ContactMode::Sticking;
   double tolerance = 1e-8;  ///< Newton: free residual / reaction force
+  /// Linear sticking contact: the surface rows eliminated last, their compliance read from the
+  /// dense factor of the Schur complement (docs/performance.md, "The contact block"), where it
+  /// fits. False: every compliance column from a sparse solve (the same numbers to round-off;
+  /// for comparisons).
+  bool contact_block = true;
 };
 
 /// What write_inp wrote: the depth, and the sum of the tissue's internal forces at the
@@ -142,6 +147,9 @@ class Indentation3d {
   Eigen::VectorXd watched_displacement() const;
   const Timing3d& timing() const;
   std::string solver_backend() const;
+  /// True when the linear sticking path reads its compliance from the contact block
+  /// (Indentation3dOptions::contact_block, and the block fits).
+  bool uses_contact_block() const;
   /// Writes the problem of the last depth as a CalculiX/Abaqus deck (fe/inp_writer.h): mesh,
   /// linear layers, fixed faces, mirror planes and every captured node's displacement
   /// prescribed. Sticking contact only (InputError otherwise); `comment` as "** " lines.
