@@ -191,16 +191,25 @@ TEST(Indentation3d, RejectsShrinkingDepthAndMissingNeedles) {
   EXPECT_THROW(run.advance_to(1e-6), mneedle::InputError);
 }
 
+// A soft linear block meshed for a 100 um punch, and a sample of its nodes to watch.
+TetMesh soft_punch_block() {
+  return punch_mesh(homogeneous_block(MaterialModel::Linear, 1e5, 0.4, 400e-6, 300e-6), 100e-6,
+                    20e-6, 2, Fidelity::Fast);
+}
+
+std::vector<int> every_seventh_node(const TetMesh& mesh) {
+  std::vector<int> nodes;
+  for (std::size_t n = 0; n < mesh.nodes.size(); n += 7) nodes.push_back(static_cast<int>(n));
+  return nodes;
+}
+
 // Watched nodes (the stress probe's): their displacement from the kept rows of the compliance
 // columns equals the whole field's rows to round-off (1e-10 of the largest) at every step with
 // sticking contact, and is read from the field with frictionless contact; watching is set before
 // the first depth or not at all.
 TEST(Indentation3d, WatchedDisplacementEqualsTheFieldsRows) {
-  const TetMesh mesh =
-      punch_mesh(homogeneous_block(MaterialModel::Linear, 1e5, 0.4, 400e-6, 300e-6), 100e-6, 20e-6,
-                 2, Fidelity::Fast);
-  std::vector<int> nodes;
-  for (std::size_t n = 0; n < mesh.nodes.size(); n += 7) nodes.push_back(static_cast<int>(n));
+  const TetMesh mesh = soft_punch_block();
+  const std::vector<int> nodes = every_seventh_node(mesh);
   for (ContactMode contact : {ContactMode::Sticking, ContactMode::Frictionless}) {
     Indentation3dOptions options;
     options.contact = contact;
@@ -236,14 +245,11 @@ TEST(Indentation3d, WatchedDisplacementEqualsTheFieldsRows) {
 
 // The contact block (docs/performance.md, "The contact block") against compliance columns from
 // sparse solves: the same forces, strain energy, field and watched rows at every depth, to the
-// round-off of two factorisations in two orders (1e-9 relative), on a cone that captures node after
-// node; the watched rows either way equal to the field's.
+// round-off of two factorisations in two orders (1e-9 relative), over a punch's capture events;
+// the watched rows either way equal to the field's.
 TEST(Indentation3d, TheContactBlockGivesWhatSparseSolvesGive) {
-  const TetMesh mesh =
-      punch_mesh(homogeneous_block(MaterialModel::Linear, 1e5, 0.4, 400e-6, 300e-6), 100e-6, 20e-6,
-                 2, Fidelity::Fast);
-  std::vector<int> nodes;
-  for (std::size_t n = 0; n < mesh.nodes.size(); n += 7) nodes.push_back(static_cast<int>(n));
+  const TetMesh mesh = soft_punch_block();
+  const std::vector<int> nodes = every_seventh_node(mesh);
   // A punch takes its whole face at first contact, and more nodes as its rim sinks.
   for (const Needle3d& needle : {Needle3d{"punch", cylinder_needle(100e-6, 1e-3), 0.0, 0.0}}) {
     SCOPED_TRACE(needle.name);
