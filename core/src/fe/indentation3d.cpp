@@ -68,6 +68,9 @@ constexpr int kMaxContactNewton = 60;
 // Largest size of the watched nodes' rows of the compliance columns (Indentation3d::watch_nodes):
 // 256 MiB, a tenth of what the largest 3-D problems of docs/performance.md hold.
 constexpr double kWatchedRowsBudget = 256.0 * 1024 * 1024;
+// Nodes whose compliance columns one sparse solve computes (the path without the contact block):
+// 64 nodes of a 450 000-dof mesh hold 0.7 GB of unit loads and as much of columns.
+constexpr std::size_t kColumnChunkNodes = 64;
 // Captured nodes whose watched rows the contact block path keeps (two half solves per node);
 // past them the probe reads the field once per output depth (docs/performance.md, "The contact
 // block").
@@ -370,31 +373,37 @@ struct Indentation3d::Impl {
       }
       return;
     }
-    Eigen::MatrixXd unit =
-        Eigen::MatrixXd::Zero(model.dof_count(), 3 * static_cast<Eigen::Index>(missing.size()));
-    for (std::size_t i = 0; i < missing.size(); ++i)
-      for (int j = 0; j < 3; ++j)
-        unit(3 * missing[i] + j, 3 * static_cast<Eigen::Index>(i) + j) = 1.0;
-    const Eigen::MatrixXd columns = solver.solve_many(unit);
-    for (std::size_t i = 0; i < missing.size(); ++i) {
-      CachedColumns& cached = column_cache[missing[i]];
-      cached.watched.resize(watched_overflow ? 0 : 3 * static_cast<Eigen::Index>(watched.size()),
-                            3);
-      for (std::size_t w = 0; w < watched.size() && !watched_overflow; ++w)
-        cached.watched.middleRows<3>(3 * static_cast<Eigen::Index>(w)) =
-            columns.block<3, 3>(3 * watched[w], 3 * static_cast<Eigen::Index>(i));
-      cached.surface.resize(surface_rows(), 3);
-      for (std::size_t c = 0; c < candidates.size() + ring.size(); ++c) {
-        const int node = c < candidates.size() ? candidates[c] : ring[c - candidates.size()];
-        cached.surface.middleRows<3>(3 * static_cast<Eigen::Index>(c)) =
-            columns.block<3, 3>(3 * node, 3 * static_cast<Eigen::Index>(i));
-      }
-      if (!crack_contact()) continue;
-      cached.gaps.resize(static_cast<Eigen::Index>(pairs.size()), 3);
-      for (std::size_t p = 0; p < pairs.size(); ++p)
+    // In chunks of kColumnChunkNodes: the unit loads and their columns are dofs x 3 per node
+    // (a flat end under a fine zone finds hundreds of nodes at once, tens of GB in one block).
+    for (std::size_t first = 0; first < missing.size(); first += kColumnChunkNodes) {
+      const std::size_t count = std::min(kColumnChunkNodes, missing.size() - first);
+      Eigen::MatrixXd unit =
+          Eigen::MatrixXd::Zero(model.dof_count(), 3 * static_cast<Eigen::Index>(count));
+      for (std::size_t i = 0; i < count; ++i)
         for (int j = 0; j < 3; ++j)
-          cached.gaps(static_cast<Eigen::Index>(p), j) =
-              gap_of(p, columns.col(3 * static_cast<Eigen::Index>(i) + j));
+          unit(3 * missing[first + i] + j, 3 * static_cast<Eigen::Index>(i) + j) = 1.0;
+      const Eigen::MatrixXd columns = solver.solve_many(unit);
+      unit.resize(0, 0);
+      for (std::size_t i = 0; i < count; ++i) {
+        CachedColumns& cached = column_cache[missing[first + i]];
+        const auto at = 3 * static_cast<Eigen::Index>(i);
+        cached.watched.resize(watched_overflow ? 0 : 3 * static_cast<Eigen::Index>(watched.size()),
+                              3);
+        for (std::size_t w = 0; w < watched.size() && !watched_overflow; ++w)
+          cached.watched.middleRows<3>(3 * static_cast<Eigen::Index>(w)) =
+              columns.block<3, 3>(3 * watched[w], at);
+        cached.surface.resize(surface_rows(), 3);
+        for (std::size_t c = 0; c < candidates.size() + ring.size(); ++c) {
+          const int node = c < candidates.size() ? candidates[c] : ring[c - candidates.size()];
+          cached.surface.middleRows<3>(3 * static_cast<Eigen::Index>(c)) =
+              columns.block<3, 3>(3 * node, at);
+        }
+        if (!crack_contact()) continue;
+        cached.gaps.resize(static_cast<Eigen::Index>(pairs.size()), 3);
+        for (std::size_t p = 0; p < pairs.size(); ++p)
+          for (int j = 0; j < 3; ++j)
+            cached.gaps(static_cast<Eigen::Index>(p), j) = gap_of(p, columns.col(at + j));
+      }
     }
   }
 
