@@ -87,9 +87,9 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
 // The README's claim on the same table at the finer levels: "`standard` and `fine` read each
 // within 6 % of these". Measured 2026-12-05 (standard / fine, um): cone 65.44 / 65.79, sharp
 // bevel 65.76 / 62.75, blunt bevel 101.79 / 104.51, cylinder 141.43 / 140.52; the largest gap to
-// fast is the cylinder's -5.1 % at fine (the sharp bevel's -4.1 %). Fine resolves the sharp bevel's tip since
-// 2026-12-06 (it read 68.97 um, +5.5 %, before; docs/model.md, "Tissue block and mesh"). Each
-// level is also pinned to 1 % of its own reading, so that a move inside the 6 % is seen and
+// fast is the cylinder's -5.1 % at fine (the sharp bevel's -4.1 %). Fine resolves the sharp bevel's
+// tip since 2026-12-06 (it read 68.97 um, +5.5 %, before; docs/model.md, "Tissue block and mesh").
+// Each level is also pinned to 1 % of its own reading, so that a move inside the 6 % is seen and
 // explained.
 TEST(ScreenCommand, ReadmeMainJobReadsWithinSixPercentOfFastAtStandardAndFine) {
   const std::map<std::string, double> fast = {{"cone", 62.8e-6},

@@ -283,12 +283,12 @@ TEST(CmdSimulate, ReadmeSiliconeFigurePuncturesWhereItsCaptionSays) {
 // The README's resolved 3-D depth in skin (docs/validation.md, "The 3-D model under a point load,
 // resolved"): paper A's sharp bevel with the scene's contact zone graded down to its tip punctures
 // at 61.47 um at standard (2026-12-05; the study's converged 63.4-63.8 um at fine's growth,
-// standard's 1.8 reads 3-4 % low), where standard alone reads 65.8 um, 7 % deeper. It read 61.09 um while a
-// capture event took every node entering within 1.15 um of depth with it (110 nodes at the first
-// contact; now no group spans more than a quarter of the surface's finest spacing, and 85 nodes
-// are captured over 74 events). Pinned to 1 % (a mesh-converged FE number: a move is a change to
-// explain); the gap to the plain level is asked to stay at least 5 % (7 % measured).
-// 6 s, release only.
+// standard's 1.8 reads 3-4 % low), where standard alone reads 65.8 um, 7 % deeper. It read 61.09 um
+// while a capture event took every node entering within 1.15 um of depth with it (110 nodes at the
+// first contact; now no group spans more than a quarter of the surface's finest spacing, and 85
+// nodes are captured over 74 events). Pinned to 1 % (a mesh-converged FE number: a move is a change
+// to explain); the gap to the plain level is asked to stay at least 5 % (7 % measured). 8 s,
+// release only.
 TEST(CmdSimulate, ASharpBevelWithItsTipResolvedPuncturesSkinShallowerThanTheShippedLevelReadsIt) {
   const std::string source =
       std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/paper_a_skin_sharp_bevel.toml";

@@ -117,7 +117,8 @@ struct ContactZone {
 // for a zone of nanometres.
 constexpr double kFineZonePerLength = 1.2;
 constexpr double kFineTipPerLength = 0.12;
-constexpr double kMostSpacingsForFineZone = 5.5;
+// The most node spacings per radius a criterion length can ask for: standard's (TET10).
+constexpr double kMostSpacingsForLength = 5.5;
 
 bool fine_resolves_the_tip(const TissueBlockSpec& spec) {
   if (spec.fidelity != Fidelity::Fine || !(spec.criterion_length > 0.0) || spec.order != 2 ||
@@ -125,7 +126,7 @@ bool fine_resolves_the_tip(const TissueBlockSpec& spec) {
     return false;
   const double spacings =
       2.0 * spec.sites.front().radius / (kTipElementsPerCriterionLength * spec.criterion_length);
-  return spacings <= kMostSpacingsForFineZone;
+  return spacings <= kMostSpacingsForLength;
 }
 
 ContactZone contact_zone(const TissueBlockSpec& spec) {
@@ -612,11 +613,6 @@ std::string to_string(Fidelity fidelity) {
   }
   return "fine";
 }
-
-namespace {
-// The most node spacings per radius a criterion length can ask for: standard's (TET10).
-constexpr double kMostSpacingsForLength = 5.5;
-}  // namespace
 
 int default_refinement_levels(Fidelity fidelity, int order, double criterion_length) {
   // TET10 only: TET4 stiffens on the refined grid's coarser far field. Fast keeps the plain
