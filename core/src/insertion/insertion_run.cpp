@@ -476,15 +476,18 @@ void check_layer_merge(const RunPlan& plan, const PreparedNeedle& needle, const 
 }
 
 // The domain cut's truncation error, measured with the axisymmetric model (the needle itself, or
-// for the 3-D model the first needle's body of revolution): the force at the reduced run's last
-// step on the cut and on the full domain. Above the fidelity's tolerance the cut is undone and
-// the pre-puncture model runs again on the full block.
-void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
-                      const std::vector<SectionArea>& areas, const InsertionRunOptions& options,
-                      double crack_depth, PreResult& reduced, std::vector<Reduction>& reductions) {
+// for the 3-D model the first needle's body of revolution): the force at `depth` on the cut and on
+// the full domain. Above the fidelity's tolerance the cut is undone (plan's block set back to the
+// scene's) and false is returned. For the 3-D model this runs before the 3-D model, at the rung's
+// horizon: the rung's mesh is then a function of the needle, the tissue and the rung alone (not of
+// where the criterion fired or of the requested depth), and a rejected cut costs no 3-D solve.
+bool measure_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
+                        const std::vector<SectionArea>& areas, const InsertionRunOptions& options,
+                        double depth, std::optional<double> f_cut,
+                        std::vector<Reduction>& reductions) {
   auto cut = std::find_if(reductions.begin(), reductions.end(),
                           [](const Reduction& r) { return r.name == "domain_cut"; });
-  if (cut == reductions.end() || reduced.needles[0].points.empty()) return;
+  if (cut == reductions.end() || !(depth > 0.0)) return true;
   PreparedNeedle proxy = needles[0];
   if (!proxy.axisymmetric)
     proxy.axisymmetric = equivalent_axisymmetric_needle(proxy.mesh, 1.05 * plan.horizon_m);
@@ -497,7 +500,7 @@ void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
     probe.axisymmetric_radius_m = fe::equal_area_radius(std::sqrt(size_x * size_y));
     probe.stop_at_crossing = false;  // same depth steps and mesh rule, no early stop
     probe.vtu_directory.clear();
-    probe.depth_m = reduced.needles[0].points.back().depth_m;
+    probe.depth_m = depth;
     return run_axisymmetric(probe, proxy, areas[0], proxy_options, 0.0)
         .needles[0]
         .points.back()
@@ -509,14 +512,14 @@ void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
   // planner", domain_cut). For the axisymmetric model the proxy is the run's own model on the full
   // block, so its failure is the run's.
   std::optional<std::string> unmeasured;
-  double f_full = 0.0, f_cut = 0.0;
-  if (plan.pre == PreKind::Axisymmetric) {
+  double f_full = 0.0, f_reduced = 0.0;
+  if (f_cut) {
     f_full = reference_on(plan.full_block_x_m, plan.full_block_y_m);
-    f_cut = reduced.needles[0].points.back().force_N;
+    f_reduced = *f_cut;
   } else {
     try {
       f_full = reference_on(plan.full_block_x_m, plan.full_block_y_m);
-      f_cut = reference_on(plan.block_x_m, plan.block_y_m);
+      f_reduced = reference_on(plan.block_x_m, plan.block_y_m);
     } catch (const SolverError& e) {
       unmeasured = e.what();
     }
@@ -525,15 +528,26 @@ void check_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needles,
     cut->name += "_rejected";
     cut->detail += "; its effect could not be measured (the axisymmetric proxy: " + *unmeasured +
                    "): the full block was used";
-  } else if (keep_reduction(*cut, f_cut, f_full, options, "the full block was used")) {
-    return;
+  } else if (keep_reduction(*cut, f_reduced, f_full, options, "the full block was used")) {
+    return true;
   }
   plan.block_x_m = plan.full_block_x_m;
   plan.block_y_m = plan.full_block_y_m;
   plan.axisymmetric_radius_m = fe::equal_area_radius(std::sqrt(plan.block_x_m * plan.block_y_m));
-  reduced = plan.pre == PreKind::Axisymmetric
-                ? run_axisymmetric(plan, needles[0], areas[0], options, crack_depth)
-                : run_3d(plan, needles, areas, options, crack_depth);
+  return false;
+}
+
+// The axisymmetric model measures its own cut after its run, at the run's last step (the run is
+// the cut model's force; a rejected cut re-runs it on the full block, which is cheap).
+void check_axisymmetric_domain_cut(RunPlan& plan, const PreparedNeedle& needle,
+                                   const SectionArea& area, const InsertionRunOptions& options,
+                                   double crack_depth, PreResult& reduced,
+                                   std::vector<Reduction>& reductions) {
+  if (reduced.needles[0].points.empty()) return;
+  const RunPoint& last = reduced.needles[0].points.back();
+  if (measure_domain_cut(plan, {needle}, {area}, options, last.depth_m, last.force_N, reductions))
+    return;
+  reduced = run_axisymmetric(plan, needle, area, options, crack_depth);
 }
 
 double axisymmetric_tip_size(const RunPlan& plan, const PreparedNeedle& needle,
@@ -809,8 +823,9 @@ PreResult run_pre(RunPlan& plan, const Scene& scene, const std::vector<PreparedN
     case PreKind::Full3d:
       if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
         run.crack_depth_m = crack_depth_for(plan.needle_radius_m, tip_size_3d(plan, options));
+      measure_domain_cut(plan, needles, areas, options, plan.horizon_m, std::nullopt,
+                         run.reductions);
       pre = run_3d(plan, needles, areas, options, run.crack_depth_m);
-      check_domain_cut(plan, needles, areas, options, run.crack_depth_m, pre, run.reductions);
       if (plan.half_model || plan.mirror_x) run.reductions.push_back(mirror_reduction(plan));
       break;
     case PreKind::Axisymmetric:
@@ -820,7 +835,8 @@ PreResult run_pre(RunPlan& plan, const Scene& scene, const std::vector<PreparedN
       pre = run_axisymmetric(plan, needles[0], areas[0], options, run.crack_depth_m);
       check_layer_merge(plan, needles[0], areas[0], options, run.crack_depth_m, pre,
                         run.reductions);
-      check_domain_cut(plan, needles, areas, options, run.crack_depth_m, pre, run.reductions);
+      check_axisymmetric_domain_cut(plan, needles[0], areas[0], options, run.crack_depth_m, pre,
+                                    run.reductions);
       break;
     case PreKind::Analytic:
       pre = run_analytic(plan, scene, needles, areas);

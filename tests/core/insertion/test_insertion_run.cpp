@@ -622,6 +622,34 @@ TEST(ScenePlanner, DomainCutOfThe3dBlockIsMeasuredAndUndoneAboveTheTolerance) {
   EXPECT_LT(std::abs(fa - fb) / fb, 0.02) << fa << " vs " << fb;
 }
 
+// The 3-D model's cut is decided before its run, at the rung's horizon (docs/model.md, "Scene
+// planner"): a rejected cut costs no second 3-D solve, and the rung's mesh does not depend on
+// how deep the run was asked to go. A punch 30 or 50 um into the 12 mm block: both requests are
+// on the first rung (100 um), so the cut's measured effect is the same number, and the strict
+// tolerance's full-block run factorises as often as the cut run.
+TEST(ScenePlanner, DomainCutOfThe3dBlockIsDecidedAtTheRungsHorizonBeforeThe3dRun) {
+  InsertionRunOptions cut3d = fast();
+  cut3d.model = PreModel::Full3d;
+  InsertionRunOptions strict = cut3d;
+  strict.reduction_tolerance = 1e-12;
+  const Scene shallow = parse_scene(scene_text("", "", kOnePunch, "[\"puncture\", \"force_curve\"]",
+                                               "[\"12 mm\", \"12 mm\", \"1150 um\"]", "30 um"),
+                                    "wide_30um.toml");
+  const InsertionRun a = run_insertion(wide_block_scene(), {punch("punch", 115e-6)}, cut3d);
+  const InsertionRun b = run_insertion(shallow, {punch("punch", 115e-6)}, cut3d);
+  const InsertionRun c = run_insertion(wide_block_scene(), {punch("punch", 115e-6)}, strict);
+  const Reduction* cut_a = find_reduction(a, "domain_cut");
+  const Reduction* cut_b = find_reduction(b, "domain_cut");
+  ASSERT_NE(cut_a, nullptr);
+  ASSERT_NE(cut_b, nullptr);
+  ASSERT_TRUE(cut_a->measured_effect && cut_b->measured_effect);
+  EXPECT_EQ(*cut_a->measured_effect, *cut_b->measured_effect);
+  EXPECT_EQ(a.nodes, b.nodes);
+  ASSERT_NE(find_reduction(c, "domain_cut_rejected"), nullptr);
+  EXPECT_GT(c.nodes, a.nodes);
+  EXPECT_EQ(c.seconds_by_stage.factorizations, a.seconds_by_stage.factorizations);
+}
+
 TEST(ScenePlanner, DomainCutOfATet4BlockIsMeasuredByTheAxisymmetricProxyInItsOwnElements) {
   // Linear tetrahedra asked of the 3-D model: the axisymmetric proxy that measures the cut has
   // 6-node triangles only and must not be asked for order 1 (it threw, ending the run).
