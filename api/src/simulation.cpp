@@ -136,6 +136,7 @@ nlohmann::json run_json(const InsertionRun& run, const Scene& scene) {
           {"loads", resolved_loads_json(scene)},
           {"pre_puncture_horizon_m", run.horizon_m},
           {"pre_puncture_step_m", run.first_step_m},
+          {"pre_puncture_rungs_m", run.rungs_m},
           {"energy_check", energy_check_json(run.energy_check)},
           {"peak_memory_bytes", run.peak_memory_bytes},
           {"seconds_by_stage", seconds_by_stage_json(run.seconds_by_stage)},

@@ -858,6 +858,47 @@ bool every_needle_crossed(const RunPlan& plan, const PreResult& pre) {
   });
 }
 
+// The rung the 3-D model's ladder starts on (docs/model.md, "Pre-puncture horizon"): one below
+// the rung that covers the closed-form model's crossing (the deepest needle's), so the rungs a
+// puncture cannot be on are not built. The closed form is asked on a horizon fixed by the
+// tissue's thickness, never by the requested depth, so the start is a property of the needle and
+// the tissue too. Where the closed form has no answer (the energy criterion, a needle that does
+// not cross, a plate contact that does not hold) the ladder starts at rung 0, as without it.
+int first_rung(const Scene& scene, const std::vector<PreparedNeedle>& needles,
+               const std::vector<SectionArea>& areas, const InsertionRunOptions& options) {
+  RunPlan probe = detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(0));
+  if (!options.start_from_closed_form || !probe.threshold || probe.pre != PreKind::Full3d ||
+      probe.threshold->criterion == PunctureCriterion::Energy)
+    return 0;
+  probe.pre = PreKind::Analytic;
+  // The deepest rung inside the block (the closed form holds above the block's bottom only).
+  const int inside = detail::rung_covering(scene.tissue.size[2]) - 1;
+  if (inside < 0) return 0;
+  probe.horizon_m = detail::pre_puncture_horizon(inside);
+  probe.depth_m = probe.horizon_m;
+  PreResult closed_form;
+  try {
+    closed_form = run_analytic(probe, scene, needles, areas);
+  } catch (const InputError&) {
+    return 0;
+  } catch (const SolverError&) {
+    return 0;
+  }
+  double deepest = 0.0;
+  for (const PreSeries& series : closed_form.needles) {
+    std::vector<double> depths, values;
+    for (const CriterionSample& c : series.samples) {
+      depths.push_back(c.depth_m);
+      values.push_back(criterion_value(probe.threshold->criterion, c));
+    }
+    const auto crossing = first_crossing(depths, values, probe.threshold->threshold, series.resolve,
+                                         probe.horizon_m * 1e-9);
+    if (!crossing) return 0;
+    deepest = std::max(deepest, crossing->depth_m);
+  }
+  return std::max(0, detail::rung_covering(deepest) - 1);
+}
+
 }  // namespace
 
 void check_needle_placement(const Scene& scene, const std::vector<PreparedNeedle>& needles) {
@@ -981,11 +1022,15 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     }
     PreResult pre;
     // Without a criterion nothing can fire early: the rung covering the depth is the answer.
-    for (int rung = plan.threshold ? 0 : last_rung; rung <= last_rung; ++rung) {
+    const int start = plan.threshold
+                          ? std::min(first_rung(scene, needles, areas, options), last_rung)
+                          : last_rung;
+    for (int rung = start; rung <= last_rung; ++rung) {
       plan = detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(rung));
       plan.seconds = &run.seconds_by_stage;
       run.reductions = plan.reductions;
       pre = run_pre(plan, scene, needles, areas, options, run);
+      run.rungs_m.push_back(plan.horizon_m);
       if (every_needle_crossed(plan, pre)) break;
     }
     run.horizon_m = plan.horizon_m;

@@ -218,22 +218,35 @@ TEST(InsertionRun, PunctureDoesNotDependOnTheRequestedDepthAxisymmetric) {
   EXPECT_EQ(a.nodes, b.nodes);
 }
 
+// A sharp 30-degree bevel of 230 um and the given length, on the half 3-D model.
+PreparedNeedle half_model_bevel(double length_m) {
+  PreparedNeedle bevel;
+  bevel.name = "bevel";
+  bevel.mesh = test::bevel_needle(115e-6, M_PI / 6, length_m);
+  bevel.mirror_symmetric_y0 = true;
+  return bevel;
+}
+
+// The silicone block of scene_text with the pressure criterion at `critical_pressure`.
+Scene pressure_scene(const std::string& critical_pressure, const std::string& size,
+                     const std::string& depth) {
+  const std::string fracture =
+      "[tissue.fracture]\ntoughness = \"19 J/m^2\"\ncritical_pressure = \"" + critical_pressure +
+      "\"\n";
+  return parse_scene(
+      scene_text("", fracture, kOnePunch, "[\"puncture\", \"force_curve\"]", size, depth),
+      "bevel.toml");
+}
+
 TEST(InsertionRun, PunctureDoesNotDependOnTheRequestedDepth3d) {
   // A sharp bevel in silicone on the half 3-D model. Its F / A_sec falls from the first step
   // (0.49 MPa at 10 um: the tip node carries the force) to about 0.2 MPa at 60 um and rises
   // past it (0.42 MPa at 400 um): 0.5 MPa is crossed on the rising branch, on the 800 um rung.
-  PreparedNeedle bevel;
-  bevel.name = "bevel";
-  bevel.mesh = test::bevel_needle(115e-6, M_PI / 6, 1e-3);
-  bevel.mirror_symmetric_y0 = true;
-  const std::string fracture =
-      "[tissue.fracture]\ntoughness = \"19 J/m^2\"\ncritical_pressure = \"0.5 MPa\"\n";
+  const PreparedNeedle bevel = half_model_bevel(1e-3);
   auto at_depth = [&](const std::string& depth) {
     return run_insertion(
-        parse_scene(scene_text("", fracture, kOnePunch, "[\"puncture\", \"force_curve\"]",
-                               "[\"1500 um\", \"1500 um\", \"1500 um\"]", depth),
-                    "bevel.toml"),
-        {bevel}, fast());
+        pressure_scene("0.5 MPa", "[\"1500 um\", \"1500 um\", \"1500 um\"]", depth), {bevel},
+        fast());
   };
   const InsertionRun a = at_depth("600 um");
   const InsertionRun b = at_depth("900 um");
@@ -243,6 +256,30 @@ TEST(InsertionRun, PunctureDoesNotDependOnTheRequestedDepth3d) {
               1e-12 * b.needles[0].puncture->depth_m);
   EXPECT_NEAR(a.needles[0].puncture->force_N, b.needles[0].puncture->force_N,
               1e-12 * b.needles[0].puncture->force_N);
+}
+
+// The 3-D model's ladder starts one rung below the rung covering the closed form's crossing
+// (docs/model.md, "Pre-puncture horizon"). The rungs it skips are rungs that would not have
+// fired: the same puncture, to round-off, as the ladder climbed from rung 0, for fewer
+// factorisations. Paper A's sharp bevel (0.663 MPa on F / A_sec) in a 0.2 MPa block at fast: the
+// closed form crosses on the 800 um rung, so the 3-D model runs the 400 and 800 um rungs (2
+// factorisations) instead of all four; it punctures at 601 um on both paths.
+TEST(InsertionRun, TheLadderSkipsOnlyRungsBelowTheClosedFormsCrossing) {
+  const PreparedNeedle bevel = half_model_bevel(2e-3);
+  const Scene scene = pressure_scene("0.663 MPa", "[\"3 mm\", \"3 mm\", \"2 mm\"]", "1 mm");
+  InsertionRunOptions from_zero = fast();
+  from_zero.start_from_closed_form = false;
+  const InsertionRun a = run_insertion(scene, {bevel}, fast());
+  const InsertionRun b = run_insertion(scene, {bevel}, from_zero);
+  ASSERT_TRUE(a.needles[0].puncture && b.needles[0].puncture);
+  EXPECT_EQ(a.needles[0].puncture->depth_m, b.needles[0].puncture->depth_m);
+  EXPECT_EQ(a.needles[0].puncture->force_N, b.needles[0].puncture->force_N);
+  EXPECT_EQ(a.horizon_m, b.horizon_m);
+  EXPECT_LT(a.seconds_by_stage.factorizations, b.seconds_by_stage.factorizations);
+  EXPECT_EQ(a.rungs_m, (std::vector<double>{400e-6, 800e-6}));
+  EXPECT_EQ(b.rungs_m, (std::vector<double>{100e-6, 200e-6, 400e-6, 800e-6}));
+  // The case stays the one described (a regression pin at the printed precision, 601.1 um).
+  EXPECT_NEAR(a.needles[0].puncture->depth_m, 601e-6, 1e-6);
 }
 
 TEST(InsertionRun, CriterionAboveThresholdAtTheFirstStepIsFlaggedAtFirstContact) {

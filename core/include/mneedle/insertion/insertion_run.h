@@ -46,6 +46,10 @@ struct InsertionRunOptions {
   bool crack_face_contact = true;
   PreModel model = PreModel::Auto;
   bool allow_reductions = true;  ///< half models, layer merging
+  /// The 3-D model's ladder starts one rung below the closed form's crossing (docs/model.md,
+  /// "Pre-puncture horizon"); false climbs it from rung 0 (to check that the skipped rungs would
+  /// not have fired).
+  bool start_from_closed_form = true;
   /// Largest relative force change a measured reduction may cause; empty: from the fidelity
   /// (fast 5 %, standard 2 %, fine 1 %).
   std::optional<double> reduction_tolerance;
@@ -166,6 +170,9 @@ struct InsertionRun {
   /// of 100 um x 2^k, the first whose run fired the criterion or covered the requested depth.
   double horizon_m = 0.0;
   double first_step_m = 0.0;  ///< the pre-puncture model's depth step on that rung
+  /// Every rung's horizon that ran, in order: rung 0 up, or for the 3-D model from one rung
+  /// below the closed form's crossing (docs/model.md, "Pre-puncture horizon").
+  std::vector<double> rungs_m;
   // Mesh summary of the FE stage (zeros when none ran).
   int nodes = 0;
   int elements = 0;
