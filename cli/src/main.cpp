@@ -1,11 +1,14 @@
 #include <CLI/CLI.hpp>
 
+#include <cstdlib>
 #include <exception>
 #include <iostream>
+#include <new>
 #include <string>
 
 #include "commands.h"
 #include "mneedle/base/error.h"
+#include "mneedle/base/memory.h"
 #include "run_provenance.h"
 
 int main(int argc, char** argv) {
@@ -53,6 +56,15 @@ int main(int argc, char** argv) {
     } catch (const mneedle::InputError&) {
       if (!asks_help) throw;
     }
+    // A memory budget below the machine's (docs/cli.md, "Environment"): a factorisation that
+    // cannot fit in it is refused before it is allocated.
+    if (const char* limit = std::getenv("MNEEDLE_MEMORY_LIMIT"); limit != nullptr && *limit) {
+      try {
+        mneedle::set_memory_limit_bytes(mneedle::parse_memory_size(limit));
+      } catch (const mneedle::InputError& e) {
+        throw mneedle::InputError(std::string("MNEEDLE_MEMORY_LIMIT: ") + e.what());
+      }
+    }
     app.parse(argc, argv);
   } catch (const mneedle::cli::QuietExit& e) {
     return e.status;
@@ -66,6 +78,11 @@ int main(int argc, char** argv) {
     return 1;
   } catch (const mneedle::SolverError& e) {
     std::cerr << "mneedle: error: " << e.what() << "\n";
+    return 3;
+  } catch (const std::bad_alloc&) {
+    // Not a bug: the run asked for more memory than the machine gave (docs/cli.md, "Exit status").
+    std::cerr << "mneedle: error: out of memory: this run needs more than the machine has; a "
+                 "coarser fidelity, a smaller contact zone or fewer refinement levels needs less\n";
     return 3;
   } catch (const std::exception& e) {
     std::cerr << "mneedle: internal error: " << e.what()

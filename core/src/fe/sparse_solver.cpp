@@ -4,11 +4,15 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <iomanip>
 #include <mutex>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "mneedle/base/error.h"
+#include "mneedle/base/memory.h"
 
 #ifdef MNEEDLE_HAVE_CHOLMOD
 #include <sys/mman.h>
@@ -90,6 +94,14 @@ class Cholesky {
   bool factorize(const Eigen::SparseMatrix<double>& matrix) {
     cholmod_sparse a = Eigen::viewAsCholmod(matrix.selfadjointView<Eigen::Lower>());
     return cholmod_factorize(&a, factor_, &common_) != 0 && factor_->minor == factor_->n;
+  }
+
+  // Bytes the numeric factor will hold once factorised: its values (xsize doubles for a
+  // supernodal factor; the predicted nonzeros otherwise). The symbolic part is already held.
+  double factor_bytes() const {
+    if (factor_ == nullptr) return 0.0;
+    const double values = factor_->is_super ? static_cast<double>(factor_->xsize) : common_.lnz;
+    return values * sizeof(double);
   }
 
   // True when the factor's last `count` columns are the last `count` dofs of `order`: CHOLMOD
@@ -299,6 +311,27 @@ Eigen::SparseMatrix<double> permuted(
   return transposed.transpose();
 }
 
+// A factor that cannot fit in the memory left is refused before it is allocated, with what it
+// needs and what there is (docs/performance.md, "Memory"): otherwise the allocation fails deep
+// in CHOLMOD (read as "not positive definite") or the machine swaps for minutes.
+[[maybe_unused]] void check_factor_fits(double factor_bytes, Eigen::Index unknowns) {
+  const std::optional<std::size_t> room = available_memory_bytes();
+  if (!room || factor_bytes <= static_cast<double>(*room)) return;
+  auto size = [](double bytes) {
+    std::ostringstream out;
+    if (bytes < 1024.0 * 1024.0 * 1024.0)
+      out << std::fixed << std::setprecision(0) << bytes / (1024.0 * 1024.0) << " MiB";
+    else
+      out << std::fixed << std::setprecision(2) << bytes / (1024.0 * 1024.0 * 1024.0) << " GiB";
+    return out.str();
+  };
+  throw SolverError("sparse solver: the factor of " + std::to_string(unknowns) +
+                    " unknowns needs " + size(factor_bytes) + ", more than the " +
+                    size(static_cast<double>(*room)) +
+                    " of memory left to this process; a coarser fidelity, a smaller contact "
+                    "zone or fewer mesh refinement levels needs less");
+}
+
 }  // namespace
 
 void SparseSolver::analyze(const Eigen::SparseMatrix<double>& matrix) {
@@ -364,7 +397,11 @@ void SparseSolver::analyze(const Eigen::SparseMatrix<double>& matrix) {
     --impl_->analyses;  // one analysis, as the caller sees it
     analyze(matrix);
     impl_->trailing_nodes = std::move(nodes);
+    return;
   }
+#ifdef MNEEDLE_HAVE_CHOLMOD
+  check_factor_fits(impl_->cholesky.factor_bytes(), matrix.rows());
+#endif
 }
 
 void SparseSolver::factorize(const Eigen::SparseMatrix<double>& input) {

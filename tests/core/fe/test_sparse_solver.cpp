@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "mneedle/base/error.h"
+#include "mneedle/base/memory.h"
 
 namespace {
 
@@ -36,6 +37,33 @@ TEST(SparseSolver, SolvesSpdSystemToRoundoff) {
   ASSERT_TRUE(solver.ok());
   EXPECT_NE(solver.backend().find("llt"), std::string::npos);
   EXPECT_LT((solver.solve(rhs) - expected).norm(), 1e-9 * expected.norm());
+}
+
+// A factor that cannot fit in the memory left is refused at the analysis, before CHOLMOD
+// allocates it, with what it needs and what there is (docs/performance.md, "Memory").
+TEST(SparseSolver, AFactorThatCannotFitIsRefusedBeforeItIsAllocated) {
+  const SpMat matrix = shifted_laplacian(200, 0.01);
+  mneedle::fe::SparseSolver solver;
+  solver.factorize(matrix);
+  if (solver.backend() != "cholmod-supernodal-llt") GTEST_SKIP() << "the check is CHOLMOD's";
+  struct Budget {  // the process's limit, removed whatever the test does
+    Budget() { mneedle::set_memory_limit_bytes(1); }
+    ~Budget() { mneedle::set_memory_limit_bytes(std::nullopt); }
+  };
+  {
+    const Budget budget;
+    mneedle::fe::SparseSolver refused;
+    try {
+      refused.analyze(matrix);
+      FAIL() << "expected a SolverError";
+    } catch (const mneedle::SolverError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("the factor of 200 unknowns needs"), std::string::npos) << what;
+      EXPECT_NE(what.find("more than the 0 MiB of memory left"), std::string::npos) << what;
+    }
+  }
+  mneedle::fe::SparseSolver fits;  // the same matrix once the memory is there
+  EXPECT_NO_THROW(fits.analyze(matrix));
 }
 
 TEST(SparseSolver, ReusesSymbolicAnalysisForSamePattern) {

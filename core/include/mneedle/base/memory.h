@@ -1,12 +1,36 @@
 #pragma once
-// The process's memory use as the operating system counts it, for run reports.
+// The process's memory use and the memory left to it, as the operating system counts them: for
+// run reports, and for refusing a factorisation that cannot fit (docs/performance.md, "Memory").
 
 #include <cstddef>
+#include <optional>
+#include <string_view>
 
 namespace mneedle {
 
 /// Peak resident set of this process so far (bytes): getrusage's ru_maxrss. It covers the whole
 /// process, so a report of one run is exact only when the process did nothing bigger before.
 std::size_t peak_memory_bytes();
+
+/// Memory this process may still take (bytes): the smaller of the kernel's MemAvailable
+/// (/proc/meminfo), the room left under its cgroup's memory.max (cgroup v2) and the limit set
+/// with set_memory_limit_bytes, of those that are known; nullopt when none is.
+std::optional<std::size_t> available_memory_bytes();
+
+/// A limit of this process's own below what the machine has (tests; a user's budget); nullopt
+/// removes it. Process-wide.
+void set_memory_limit_bytes(std::optional<std::size_t> bytes);
+
+/// "<number> <unit>" in bytes, the unit one of B, kB, MB, GB, TB (powers of 1000) or KiB, MiB,
+/// GiB, TiB (powers of 1024). Throws InputError naming the text for anything else (a number
+/// without a unit among them).
+std::size_t parse_memory_size(std::string_view text);
+
+/// MemAvailable of a /proc/meminfo text, in bytes; nullopt when absent or malformed.
+std::optional<std::size_t> meminfo_available_bytes(std::string_view meminfo);
+
+/// Room under a cgroup v2 limit: memory.max's text ("max" = no limit) less memory.current's;
+/// nullopt when there is no limit or either text is malformed. 0 when the group is at its limit.
+std::optional<std::size_t> cgroup_room_bytes(std::string_view max, std::string_view current);
 
 }  // namespace mneedle

@@ -1,0 +1,68 @@
+#include "mneedle/base/memory.h"
+
+#include <gtest/gtest.h>
+
+#include "mneedle/base/error.h"
+
+namespace {
+
+using mneedle::available_memory_bytes;
+using mneedle::cgroup_room_bytes;
+using mneedle::meminfo_available_bytes;
+using mneedle::parse_memory_size;
+using mneedle::set_memory_limit_bytes;
+
+TEST(Memory, MeminfoAvailableIsReadInKibibytes) {
+  const auto bytes = meminfo_available_bytes(
+      "MemTotal:       23839628 kB\nMemFree:  100 kB\nMemAvailable:    2048 kB\nBuffers: 1 kB\n");
+  ASSERT_TRUE(bytes.has_value());
+  EXPECT_EQ(*bytes, 2048u * 1024u);
+}
+
+TEST(Memory, MeminfoWithoutAvailableOrItsUnitIsUnknown) {
+  EXPECT_FALSE(meminfo_available_bytes("MemTotal: 100 kB\n").has_value());
+  EXPECT_FALSE(meminfo_available_bytes("MemAvailable: 100\n").has_value());
+  EXPECT_FALSE(meminfo_available_bytes("MemAvailable: lots kB\n").has_value());
+  EXPECT_FALSE(meminfo_available_bytes("").has_value());
+}
+
+TEST(Memory, CgroupRoomIsItsLimitLessItsUse) {
+  EXPECT_EQ(cgroup_room_bytes("1000\n", "400\n"), std::optional<std::size_t>(600));
+  EXPECT_EQ(cgroup_room_bytes("100\n", "400\n"), std::optional<std::size_t>(0));
+  EXPECT_FALSE(cgroup_room_bytes("max\n", "400\n").has_value());  // no limit
+  EXPECT_FALSE(cgroup_room_bytes("", "").has_value());            // not on cgroup v2
+}
+
+TEST(Memory, SizesNeedOneOfTheByteUnits) {
+  EXPECT_EQ(parse_memory_size("4 GiB"), 4ull * 1024 * 1024 * 1024);
+  EXPECT_EQ(parse_memory_size("1.5 GB"), 1500000000ull);
+  EXPECT_EQ(parse_memory_size("512MiB"), 512ull * 1024 * 1024);
+  EXPECT_EQ(parse_memory_size("  100 B "), 100ull);
+  for (const char* bad : {"4", "4 gb", "4 GiBs", "GiB", "-1 GiB", "0 MB", "nan MB", "1e30 TB"})
+    EXPECT_THROW(parse_memory_size(bad), mneedle::InputError) << bad;
+  try {
+    parse_memory_size("300");
+  } catch (const mneedle::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'300': no unit"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Memory, AProcessLimitCapsTheMemoryLeft) {
+  const auto machine = available_memory_bytes();
+  ASSERT_TRUE(machine.has_value());  // Linux: /proc/meminfo is always there
+  EXPECT_GT(*machine, 0u);
+  // A budget below what the process already holds leaves nothing; without it the machine's
+  // memory is back.
+  set_memory_limit_bytes(1);
+  const auto capped = available_memory_bytes();
+  set_memory_limit_bytes(std::nullopt);
+  EXPECT_EQ(capped, std::optional<std::size_t>(0));
+  ASSERT_TRUE(available_memory_bytes().has_value());
+  EXPECT_GT(*available_memory_bytes(), 0u);
+}
+
+TEST(Memory, PeakMemoryIsTheProcesssResidentPeak) {
+  EXPECT_GT(mneedle::peak_memory_bytes(), 1u << 20);  // a test binary holds more than 1 MiB
+}
+
+}  // namespace
