@@ -866,37 +866,60 @@ bool every_needle_crossed(const RunPlan& plan, const PreResult& pre) {
 // not cross, a plate contact that does not hold) the ladder starts at rung 0, as without it.
 int first_rung(const Scene& scene, const std::vector<PreparedNeedle>& needles,
                const std::vector<SectionArea>& areas, const InsertionRunOptions& options) {
-  RunPlan probe = detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(0));
-  if (!options.start_from_closed_form || !probe.threshold || probe.pre != PreKind::Full3d ||
-      probe.threshold->criterion == PunctureCriterion::Energy)
+  const RunPlan rung0 =
+      detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(0));
+  // The pressure and penetration criteria only: the closed form has no energy release rate,
+  // and its stress criterion (a plate on the layer beneath) fires within the first rungs in skin
+  // while costing a tenth of a second of Bessel integrals to ask.
+  if (!options.start_from_closed_form || !rung0.threshold || rung0.pre != PreKind::Full3d ||
+      (rung0.threshold->criterion != PunctureCriterion::Pressure &&
+       rung0.threshold->criterion != PunctureCriterion::Penetration))
     return 0;
-  probe.pre = PreKind::Analytic;
   // The deepest rung inside the block (the closed form holds above the block's bottom only).
   const int inside = detail::rung_covering(scene.tissue.size[2]) - 1;
-  if (inside < 0) return 0;
-  probe.horizon_m = detail::pre_puncture_horizon(inside);
-  probe.depth_m = probe.horizon_m;
-  PreResult closed_form;
+  // An optional saving must never end a run: any failure of the closed form starts at rung 0.
   try {
-    closed_form = run_analytic(probe, scene, needles, areas);
-  } catch (const InputError&) {
-    return 0;
-  } catch (const SolverError&) {
-    return 0;
-  }
-  double deepest = 0.0;
-  for (const PreSeries& series : closed_form.needles) {
-    std::vector<double> depths, values;
-    for (const CriterionSample& c : series.samples) {
-      depths.push_back(c.depth_m);
-      values.push_back(criterion_value(probe.threshold->criterion, c));
+    // The closed form climbs its own ladder, with the 3-D rungs' steps, to the first rung on
+    // which every needle crosses: a shallow puncture costs one short closed-form run.
+    for (int k = 0; k <= inside; ++k) {
+      RunPlan probe =
+          detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(k));
+      probe.pre = PreKind::Analytic;
+      probe.depth_m = probe.horizon_m;
+      const PreResult closed_form = run_analytic(probe, scene, needles, areas);
+      double deepest = 0.0;
+      bool every = true;
+      for (const PreSeries& series : closed_form.needles) {
+        std::vector<double> depths, values;
+        for (const CriterionSample& c : series.samples) {
+          depths.push_back(c.depth_m);
+          values.push_back(criterion_value(probe.threshold->criterion, c));
+        }
+        // Interpolated between the steps, not bisected: the start needs the rung, not the depth.
+        const auto crossing = first_crossing(depths, values, probe.threshold->threshold);
+        every = every && crossing.has_value();
+        if (crossing) deepest = std::max(deepest, crossing->depth_m);
+      }
+      if (every) return std::max(0, detail::rung_covering(deepest) - 1);
     }
-    const auto crossing = first_crossing(depths, values, probe.threshold->threshold, series.resolve,
-                                         probe.horizon_m * 1e-9);
-    if (!crossing) return 0;
-    deepest = std::max(deepest, crossing->depth_m);
+    return 0;
+  } catch (const std::exception&) {
+    return 0;
   }
-  return std::max(0, detail::rung_covering(deepest) - 1);
+}
+
+// The depth of the first step at or above the threshold, deepest over the needles (the
+// crossing lies between that step and the one before it); 0 when a needle has none.
+double deepest_first_crossing(const RunPlan& plan, const PreResult& pre) {
+  double deepest = 0.0;
+  for (const PreSeries& s : pre.needles) {
+    const auto at = std::find_if(s.samples.begin(), s.samples.end(), [&](const CriterionSample& c) {
+      return criterion_value(plan.threshold->criterion, c) >= plan.threshold->threshold;
+    });
+    if (at == s.samples.end()) return 0.0;
+    deepest = std::max(deepest, at->depth_m);
+  }
+  return deepest;
 }
 
 }  // namespace
@@ -1022,17 +1045,31 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     }
     PreResult pre;
     // Without a criterion nothing can fire early: the rung covering the depth is the answer.
-    const int start = plan.threshold
-                          ? std::min(first_rung(scene, needles, areas, options), last_rung)
-                          : last_rung;
-    for (int rung = start; rung <= last_rung; ++rung) {
-      plan = detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(rung));
-      plan.seconds = &run.seconds_by_stage;
-      run.reductions = plan.reductions;
-      pre = run_pre(plan, scene, needles, areas, options, run);
-      run.rungs_m.push_back(plan.horizon_m);
-      if (every_needle_crossed(plan, pre)) break;
-    }
+    const int first = plan.threshold ? first_rung(scene, needles, areas, options) : last_rung;
+    int fired = -1;
+    auto climb = [&](int from) {
+      // A start above the rung covering the depth still runs (its run stops at the depth): the
+      // rung a run uses never depends on how deep it was asked to go.
+      for (int rung = from; rung <= std::max(last_rung, from); ++rung) {
+        plan = detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(rung));
+        plan.seconds = &run.seconds_by_stage;
+        run.reductions = plan.reductions;
+        pre = run_pre(plan, scene, needles, areas, options, run);
+        run.rungs_m.push_back(plan.horizon_m);
+        if (every_needle_crossed(plan, pre)) {
+          fired = rung;
+          break;
+        }
+      }
+    };
+    climb(first);
+    // The start rung fired where the rung below it reaches (at first contact, say, where a mesh
+    // spike under the tip is no closed form's): the rungs skipped might have fired, so the ladder
+    // climbs from rung 0 as without the closed form (docs/model.md, "Pre-puncture horizon").
+    if (first > 0 && fired == first &&
+        deepest_first_crossing(plan, pre) <=
+            detail::pre_puncture_horizon(first - 1) * (1.0 + 1e-12))
+      climb(0);
     run.horizon_m = plan.horizon_m;
     run.first_step_m = plan.horizon_m / std::max(plan.steps, 1);
     run.models_run.push_back(pre.model);

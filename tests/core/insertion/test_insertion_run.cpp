@@ -282,6 +282,47 @@ TEST(InsertionRun, TheLadderSkipsOnlyRungsBelowTheClosedFormsCrossing) {
   EXPECT_NEAR(a.needles[0].puncture->depth_m, 601e-6, 1e-6);
 }
 
+// The start rung fired within the rung below it (docs/model.md, "Pre-puncture horizon"): the
+// rungs skipped might have fired, so the ladder climbs from rung 0 and the answer is the climb's.
+// The bevel of PunctureDoesNotDependOnTheRequestedDepth3d at 0.25 MPa: the closed form crosses
+// on the 400 um rung, so the ladder starts on the 200 um rung, which fires below 100 um (its
+// F / A_sec dips to 0.2 MPa only at 60 um); rung 0 fires at its first step, 10 um.
+TEST(InsertionRun, TheLadderClimbsFromRungZeroWhenItsStartFiresWithinTheRungBelow) {
+  const PreparedNeedle bevel = half_model_bevel(1e-3);
+  const Scene scene =
+      pressure_scene("0.25 MPa", "[\"1500 um\", \"1500 um\", \"1500 um\"]", "900 um");
+  InsertionRunOptions from_zero = fast();
+  from_zero.start_from_closed_form = false;
+  const InsertionRun a = run_insertion(scene, {bevel}, fast());
+  const InsertionRun b = run_insertion(scene, {bevel}, from_zero);
+  ASSERT_TRUE(a.needles[0].puncture && b.needles[0].puncture);
+  EXPECT_EQ(a.rungs_m, (std::vector<double>{200e-6, 100e-6}));
+  EXPECT_EQ(a.needles[0].puncture->depth_m, b.needles[0].puncture->depth_m);
+  EXPECT_TRUE(a.needles[0].puncture->at_first_contact);
+}
+
+// A start above the rung covering the requested depth still runs (its run stops at the depth),
+// so the rung, and the answer, do not depend on the depth asked. The same bevel at 0.3 MPa starts
+// on the 400 um rung: nothing within 50 um, and 238 um asked 300 or 900 um deep. (Climbed from
+// rung 0 it fires at first contact, 10 um, on a tip spike of the 100 um rung's mesh: the limit
+// docs/model.md states.)
+TEST(InsertionRun, AStartAboveTheRequestedDepthStillRunsSoTheAnswerDoesNotDependOnIt) {
+  const PreparedNeedle bevel = half_model_bevel(1e-3);
+  auto at_depth = [&](const std::string& depth) {
+    return run_insertion(
+        pressure_scene("0.3 MPa", "[\"1500 um\", \"1500 um\", \"1500 um\"]", depth), {bevel},
+        fast());
+  };
+  const InsertionRun shallow = at_depth("50 um");
+  const InsertionRun a = at_depth("300 um");
+  const InsertionRun b = at_depth("900 um");
+  EXPECT_EQ(shallow.rungs_m, (std::vector<double>{400e-6}));
+  EXPECT_FALSE(shallow.needles[0].puncture.has_value());
+  ASSERT_TRUE(a.needles[0].puncture && b.needles[0].puncture);
+  EXPECT_EQ(a.needles[0].puncture->depth_m, b.needles[0].puncture->depth_m);
+  EXPECT_NEAR(a.needles[0].puncture->depth_m, 238e-6, 1e-6);  // measured 238.07 um
+}
+
 TEST(InsertionRun, CriterionAboveThresholdAtTheFirstStepIsFlaggedAtFirstContact) {
   // 1 kPa is below the flat punch's F / A_sec at the first step: fired on contact.
   const InsertionRun run = run_insertion(
@@ -508,8 +549,8 @@ TEST(ScenePlanner, MergeThatChangesTheForceBeyondTheToleranceIsUndone) {
   EXPECT_NEAR(a.needles[0].curve.back().force_N, b.needles[0].curve.back().force_N, 1e-15);
 }
 
-// A 12 mm block under a 230 um punch pressed 50 um: the planner keeps 10 (a + d) = 1650 um
-// around the needle (3.3 mm square) and measures what the cut changes.
+// A 12 mm block under a 230 um punch pressed 50 um: on the 100 um rung the planner keeps
+// 10 (a + H) = 2150 um around the needle (4.3 mm square) and measures what the cut changes.
 Scene wide_block_scene() {
   return parse_scene(scene_text("", "", kOnePunch, "[\"puncture\", \"force_curve\"]",
                                 "[\"12 mm\", \"12 mm\", \"1150 um\"]", "50 um"),

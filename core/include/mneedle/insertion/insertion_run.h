@@ -170,8 +170,10 @@ struct InsertionRun {
   /// of 100 um x 2^k, the first whose run fired the criterion or covered the requested depth.
   double horizon_m = 0.0;
   double first_step_m = 0.0;  ///< the pre-puncture model's depth step on that rung
-  /// Every rung's horizon that ran, in order: rung 0 up, or for the 3-D model from one rung
-  /// below the closed form's crossing (docs/model.md, "Pre-puncture horizon").
+  /// Every rung's horizon that ran, in order (docs/model.md, "Pre-puncture horizon"): from rung 0
+  /// up; for the 3-D model from one rung below the closed form's crossing (and from rung 0 again
+  /// when that start fired within the rung below it); without a criterion, the rung covering the
+  /// requested depth alone.
   std::vector<double> rungs_m;
   // Mesh summary of the FE stage (zeros when none ran).
   int nodes = 0;
