@@ -1,6 +1,8 @@
 #include "needle/off_check.h"
 
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <regex>
 #include <sstream>
 #include <vector>
@@ -35,6 +37,13 @@ std::vector<Line> content_lines(const std::string& bytes) {
 bool is_count(const std::string& token) {
   return !token.empty() && token.size() <= 18 &&
          token.find_first_not_of("0123456789") == std::string::npos;
+}
+
+bool is_number(const std::string& token) {
+  if (token.empty()) return false;
+  char* end = nullptr;
+  const double value = std::strtod(token.c_str(), &end);
+  return end == token.c_str() + token.size() && std::isfinite(value);
 }
 
 }  // namespace
@@ -77,6 +86,37 @@ void check_structure(const std::filesystem::path& file, const std::string& bytes
     fail(file, "OFF header declares " + std::to_string(vertices) + " vertices and " +
                    std::to_string(faces) + " faces but the data has " + std::to_string(data_lines) +
                    " lines");
+  // Every vertex line holds three coordinates and every face line its corner count (3 or more)
+  // and that many indices of declared vertices: assimp reads a word where an index belongs as
+  // some number and crashed on such a face in a later step (a fuzzer's input).
+  for (std::uint64_t v = 0; v < vertices; ++v) {
+    const Line& line = lines[header_end + v];
+    std::istringstream tokens(line.text);
+    std::string token;
+    for (int axis = 0; axis < 3; ++axis)
+      if (!(tokens >> token) || !is_number(token))
+        fail(file, "OFF line " + std::to_string(line.number) + ": vertex " + std::to_string(v) +
+                       " needs three finite coordinates" +
+                       (token.empty() ? std::string() : " ('" + token + "' is not one)"));
+  }
+  for (std::uint64_t f = 0; f < faces; ++f) {
+    const Line& line = lines[header_end + vertices + f];
+    std::istringstream tokens(line.text);
+    std::string token;
+    const std::string where =
+        "OFF line " + std::to_string(line.number) + ": face " + std::to_string(f) + ": ";
+    if (!(tokens >> token) || !is_count(token) || std::stoull(token) < 3)
+      fail(file, where + "'" + token + "' is not a corner count (a whole number >= 3)");
+    const std::uint64_t corners = std::stoull(token);
+    for (std::uint64_t c = 0; c < corners; ++c) {
+      token.clear();
+      if (!(tokens >> token) || !is_count(token) || std::stoull(token) >= vertices)
+        fail(file, where + (token.empty() ? std::string("fewer indices than its ") +
+                                                std::to_string(corners) + " corners"
+                                          : "'" + token + "' is not the index of one of its " +
+                                                std::to_string(vertices) + " vertices"));
+    }
+  }
 }
 
 }  // namespace mneedle::off

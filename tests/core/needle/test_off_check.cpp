@@ -1,4 +1,5 @@
-// OFF header counts checked before assimp, which allocates for every declared vertex first.
+// OFF structure checked before assimp: the header's counts (assimp allocates for every declared
+// vertex first), each vertex's coordinates and each face's indices.
 #include "needle/off_check.h"
 
 #include <gtest/gtest.h>
@@ -47,6 +48,28 @@ TEST(OffCheck, MissingOrNonIntegerCountsAreRefusedWithTheirLine) {
             ">= 0)");
   EXPECT_NE(error_of("OFF\n3 1e30 0\n" + kTriangleData).find("'1e30'"), std::string::npos);
   EXPECT_NE(error_of("OFF\n99999999999999999999 1 0\n" + kTriangleData).find("is not a vertex"),
+            std::string::npos);
+}
+
+// A fuzzer's input that crashed assimp in a later step: a face line with a word where its
+// fourth index belongs (tests/fuzz/corpus/mesh_regressions/off_face_index_is_a_word).
+TEST(OffCheck, AFaceMustListItsCornerCountAndThatManyIndicesOfDeclaredVertices) {
+  EXPECT_EQ(error_of("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 vertex\n"),
+            "m.off: OFF line 6: face 0: 'vertex' is not the index of one of its 3 vertices");
+  EXPECT_EQ(error_of("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"),
+            "m.off: OFF line 6: face 0: '3' is not the index of one of its 3 vertices");
+  EXPECT_EQ(error_of("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n"),
+            "m.off: OFF line 6: face 0: fewer indices than its 3 corners");
+  EXPECT_EQ(error_of("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n"),
+            "m.off: OFF line 6: face 0: '2' is not a corner count (a whole number >= 3)");
+  // Colours after the indices are the format's own and pass.
+  EXPECT_EQ(error_of("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 255 0 0\n"), "");
+}
+
+TEST(OffCheck, AVertexMustHoldThreeFiniteCoordinates) {
+  EXPECT_EQ(error_of("OFF\n3 1 0\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n"),
+            "m.off: OFF line 4: vertex 1 needs three finite coordinates ('0' is not one)");
+  EXPECT_NE(error_of("OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n").find("('nan' is not one)"),
             std::string::npos);
 }
 
