@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "skin_scene.h"
@@ -55,12 +56,21 @@ inline CommandRun run_mneedle(const std::string& arguments) {
 }
 
 /// write_skin_scene_with_criterion (skin_scene.h) into the temp folder, one file per process and
-/// criterion.
+/// criterion, removed when the process ends (the test files hold it in constants).
 inline std::string skin_scene_with_criterion(const std::string& criterion) {
-  return write_skin_scene_with_criterion(criterion, std::filesystem::temp_directory_path() /
-                                                        ("mneedle_skin_" + criterion + "_" +
-                                                         std::to_string(::getpid()) + ".toml"))
-      .string();
+  struct RemovedAtExit {
+    std::vector<std::filesystem::path> files;
+    ~RemovedAtExit() {
+      std::error_code ignored;
+      for (const auto& f : files) std::filesystem::remove(f, ignored);
+    }
+  };
+  static RemovedAtExit written;
+  const std::filesystem::path file = write_skin_scene_with_criterion(
+      criterion, std::filesystem::temp_directory_path() /
+                     ("mneedle_skin_" + criterion + "_" + std::to_string(::getpid()) + ".toml"));
+  written.files.push_back(file);
+  return file.string();
 }
 
 #ifdef MNEEDLE_MPIEXEC
