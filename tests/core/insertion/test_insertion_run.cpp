@@ -258,12 +258,12 @@ TEST(InsertionRun, PunctureDoesNotDependOnTheRequestedDepth3d) {
               1e-12 * b.needles[0].puncture->force_N);
 }
 
-// The 3-D model's ladder starts one rung below the rung covering the closed form's crossing
-// (docs/model.md, "Pre-puncture horizon"). The rungs it skips are rungs that would not have
-// fired: the same puncture, to round-off, as the ladder climbed from rung 0, for fewer
+// The 3-D model's ladder starts on the rung covering the closed form's crossing over its margin
+// of 1.5 (docs/model.md, "Pre-puncture horizon"). The rungs it skips are rungs that would not
+// have fired: the same puncture, to round-off, as the ladder climbed from rung 0, for fewer
 // factorisations. Paper A's sharp bevel (0.663 MPa on F / A_sec) in a 0.2 MPa block at fast: the
-// closed form crosses on the 800 um rung, so the 3-D model runs the 400 and 800 um rungs (2
-// factorisations) instead of all four; it punctures at 601 um on both paths.
+// 3-D model runs the 800 um rung alone (1 factorisation) instead of all four; it punctures at
+// 601 um on both paths.
 TEST(InsertionRun, TheLadderSkipsOnlyRungsBelowTheClosedFormsCrossing) {
   const PreparedNeedle bevel = half_model_bevel(2e-3);
   const Scene scene = pressure_scene("0.663 MPa", "[\"3 mm\", \"3 mm\", \"2 mm\"]", "1 mm");
@@ -276,7 +276,7 @@ TEST(InsertionRun, TheLadderSkipsOnlyRungsBelowTheClosedFormsCrossing) {
   EXPECT_EQ(a.needles[0].puncture->force_N, b.needles[0].puncture->force_N);
   EXPECT_EQ(a.horizon_m, b.horizon_m);
   EXPECT_LT(a.seconds_by_stage.factorizations, b.seconds_by_stage.factorizations);
-  EXPECT_EQ(a.rungs_m, (std::vector<double>{400e-6, 800e-6}));
+  EXPECT_EQ(a.rungs_m, (std::vector<double>{800e-6}));
   EXPECT_EQ(b.rungs_m, (std::vector<double>{100e-6, 200e-6, 400e-6, 800e-6}));
   // The case stays the one described (a regression pin at the printed precision, 601.1 um).
   EXPECT_NEAR(a.needles[0].puncture->depth_m, 601e-6, 1e-6);
@@ -284,9 +284,9 @@ TEST(InsertionRun, TheLadderSkipsOnlyRungsBelowTheClosedFormsCrossing) {
 
 // The start rung fired within the rung below it (docs/model.md, "Pre-puncture horizon"): the
 // rungs skipped might have fired, so the ladder climbs from rung 0 and the answer is the climb's.
-// The bevel of PunctureDoesNotDependOnTheRequestedDepth3d at 0.25 MPa: the closed form crosses
-// on the 400 um rung, so the ladder starts on the 200 um rung, which fires below 100 um (its
-// F / A_sec dips to 0.2 MPa only at 60 um); rung 0 fires at its first step, 10 um.
+// The bevel of PunctureDoesNotDependOnTheRequestedDepth3d at 0.25 MPa: the ladder starts on the
+// 400 um rung, which fires below 200 um (the closed form has no dip; this F / A_sec dips to
+// 0.2 MPa only at 60 um); rung 0 fires at its first step, 10 um.
 TEST(InsertionRun, TheLadderClimbsFromRungZeroWhenItsStartFiresWithinTheRungBelow) {
   const PreparedNeedle bevel = half_model_bevel(1e-3);
   const Scene scene =
@@ -296,7 +296,7 @@ TEST(InsertionRun, TheLadderClimbsFromRungZeroWhenItsStartFiresWithinTheRungBelo
   const InsertionRun a = run_insertion(scene, {bevel}, fast());
   const InsertionRun b = run_insertion(scene, {bevel}, from_zero);
   ASSERT_TRUE(a.needles[0].puncture && b.needles[0].puncture);
-  EXPECT_EQ(a.rungs_m, (std::vector<double>{200e-6, 100e-6}));
+  EXPECT_EQ(a.rungs_m, (std::vector<double>{400e-6, 100e-6}));
   EXPECT_EQ(a.needles[0].puncture->depth_m, b.needles[0].puncture->depth_m);
   EXPECT_TRUE(a.needles[0].puncture->at_first_contact);
 }
