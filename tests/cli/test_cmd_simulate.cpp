@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <utility>
 
 namespace {
 
@@ -289,29 +290,54 @@ TEST(CmdSimulate, ReadmeSiliconeFigurePuncturesWhereItsCaptionSays) {
 // nodes are captured over 74 events). Pinned to 1 % (a mesh-converged FE number: a move is a change
 // to explain); the gap to the plain level is asked to stay at least 5 % (7 % measured). 8 s,
 // release only.
-TEST(CmdSimulate, ASharpBevelWithItsTipResolvedPuncturesSkinShallowerThanTheShippedLevelReadsIt) {
-  const std::string source =
-      std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/paper_a_skin_sharp_bevel.toml";
+// `simulate --json` of a shipped skin scene with `zone_keys` added to its [model] table (after
+// its fidelity), and of the scene as shipped: each run's first puncture.
+std::pair<nlohmann::json, nlohmann::json> punctures_with_zone(const std::string& scene,
+                                                              const std::string& zone_keys,
+                                                              const std::string& arguments) {
+  const std::string source = std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/" + scene;
   std::string text = mneedle::test::file_text(source);
   const std::string key = "fidelity = \"standard\"";
-  ASSERT_NE(text.find(key), std::string::npos);
-  text.replace(text.find(key), key.size(),
-               key + "\ncontact_zone = \"6 um\"\ncontact_zone_tip = \"0.3 um\"");
+  EXPECT_NE(text.find(key), std::string::npos);
+  if (text.find(key) == std::string::npos) return {};
+  text.replace(text.find(key), key.size(), key + "\n" + zone_keys);
   const fs::path file =
-      fs::temp_directory_path() / ("resolved_tip_" + std::to_string(::getpid()) + ".toml");
+      fs::temp_directory_path() / ("zone_" + std::to_string(::getpid()) + ".toml");
   std::ofstream(file) << text;
-  const CommandRun resolved = run_mneedle("simulate '" + file.string() + "' --json");
-  const CommandRun plain = run_mneedle("simulate '" + source + "' --json");
+  const CommandRun zoned = run_mneedle("simulate '" + file.string() + "' --json " + arguments);
+  const CommandRun plain = run_mneedle("simulate '" + source + "' --json " + arguments);
   fs::remove(file);
-  ASSERT_EQ(resolved.exit_code, 0) << resolved.err;
-  ASSERT_EQ(plain.exit_code, 0) << plain.err;
-  const auto r = nlohmann::json::parse(resolved.out)["needles"][0]["puncture"];
-  const auto q = nlohmann::json::parse(plain.out)["needles"][0]["puncture"];
+  EXPECT_EQ(zoned.exit_code, 0) << zoned.err;
+  EXPECT_EQ(plain.exit_code, 0) << plain.err;
+  if (zoned.exit_code != 0 || plain.exit_code != 0) return {};
+  return {nlohmann::json::parse(zoned.out)["needles"][0]["puncture"],
+          nlohmann::json::parse(plain.out)["needles"][0]["puncture"]};
+}
+
+TEST(CmdSimulate, ASharpBevelWithItsTipResolvedPuncturesSkinShallowerThanTheShippedLevelReadsIt) {
+  const auto [r, q] =
+      punctures_with_zone("paper_a_skin_sharp_bevel.toml",
+                          "contact_zone = \"6 um\"\ncontact_zone_tip = \"0.3 um\"", "");
   ASSERT_TRUE(r.is_object() && q.is_object());
   EXPECT_FALSE(r["at_first_contact"].get<bool>());
   const double d = r["depth_m"].get<double>();
   EXPECT_NEAR(d, 61.47e-6, 0.01 * 61.47e-6);
   EXPECT_GT(q["depth_m"].get<double>() / d, 1.05);
+}
+
+// The blunt bevel's flat meets the stratum corneum along an edge: with a 6 um zone over the
+// whole flat it punctures about a fifth shallower than the shipped level reads it (README;
+// docs/validation.md, "Fifth measurement": 80-85 um against 100-104 um at every level). At fast
+// (62 088 nodes, about 2.6 GB): measured 2026-12-06, 82.67 um against the shipped 100.03 um
+// (1.21 x); pinned to 1 % like every README number, and the shipped level at least 15 % deeper.
+TEST(CmdSimulate, ABluntBevelWithItsFlatResolvedPuncturesSkinAFifthShallowerThanTheShippedLevel) {
+  const auto [r, q] = punctures_with_zone("paper_a_skin_blunt_bevel.toml",
+                                          "contact_zone = \"6 um\"", "--fidelity fast");
+  ASSERT_TRUE(r.is_object() && q.is_object());
+  const double d = r["depth_m"].get<double>();
+  EXPECT_FALSE(r["at_first_contact"].get<bool>());
+  EXPECT_NEAR(d, 82.67e-6, 0.01 * 82.67e-6);
+  EXPECT_GT(q["depth_m"].get<double>() / d, 1.15);
 }
 
 // The stress criterion on the analytic path (docs/model.md, "The stress criterion on the analytic
