@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
       try {
         mneedle::set_memory_limit_bytes(mneedle::parse_memory_size(limit));
       } catch (const mneedle::InputError& e) {
-        throw mneedle::InputError(std::string("MNEEDLE_MEMORY_LIMIT: ") + e.what());
+        if (!asks_help) throw mneedle::InputError(std::string("MNEEDLE_MEMORY_LIMIT: ") + e.what());
       }
     }
     app.parse(argc, argv);

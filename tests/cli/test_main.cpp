@@ -695,6 +695,11 @@ TEST(WorkLimits, AFactorAboveTheMemoryLimitEndsTheRunInOneLineBeforeItIsAllocate
   EXPECT_EQ(unitless.exit_code, 1) << unitless.err;
   EXPECT_NE(unitless.err.find("MNEEDLE_MEMORY_LIMIT: '300': no unit"), std::string::npos)
       << unitless.err;
+  // Help is still there with a bad limit in the environment (as with SOURCE_DATE_EPOCH).
+  EXPECT_EQ(mneedle::test::run_command("MNEEDLE_MEMORY_LIMIT=300 '" +
+                                       mneedle::test::mneedle_binary() + "' --help")
+                .exit_code,
+            0);
 }
 
 }  // namespace

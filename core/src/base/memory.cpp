@@ -9,6 +9,7 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <utility>
 
@@ -38,12 +39,10 @@ std::string read_text(const char* path) {
 
 // This process's cgroup v2 folder ("0::/path" in /proc/self/cgroup), empty when not on v2.
 std::string own_cgroup() {
-  const std::string text = read_text("/proc/self/cgroup");
-  const auto at = text.find("0::");
-  if (at == std::string::npos) return {};
-  std::string path = text.substr(at + 3);
-  path = path.substr(0, path.find('\n'));
-  return "/sys/fs/cgroup" + path;
+  std::istringstream lines(read_text("/proc/self/cgroup"));
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("0::", 0) == 0) return "/sys/fs/cgroup" + line.substr(3);
+  return {};
 }
 
 // The resident set now (bytes): /proc/self/statm's second field, in pages.
@@ -84,6 +83,7 @@ std::size_t parse_memory_size(std::string_view text) {
     if (unit == name) {
       const double bytes = value * scale;
       if (bytes >= 1e18) throw InputError(quoted + ": larger than any machine's memory");
+      if (bytes < 1.0) throw InputError(quoted + ": less than a byte");
       return static_cast<std::size_t>(bytes);
     }
   throw InputError(
@@ -105,11 +105,26 @@ std::optional<std::size_t> meminfo_available_bytes(std::string_view meminfo) {
   return *kib * 1024;
 }
 
-std::optional<std::size_t> cgroup_room_bytes(std::string_view max, std::string_view current) {
+std::optional<std::size_t> cgroup_room_bytes(std::string_view max, std::string_view current,
+                                             std::string_view stat) {
   const auto limit = parse_count(max);  // "max" does not parse: no limit
   const auto used = parse_count(current);
   if (!limit || !used) return std::nullopt;
-  return *limit > *used ? *limit - *used : 0;
+  // memory.current counts the group's page cache, which the kernel drops on demand: a container
+  // that has just compiled the project sits near its limit with little of it held.
+  std::size_t cache = 0;
+  for (const std::string_view key : {"active_file ", "inactive_file "}) {
+    for (std::size_t at = stat.find(key); at != std::string_view::npos;
+         at = stat.find(key, at + 1)) {
+      if (at != 0 && stat[at - 1] != '\n') continue;  // a key at a line's start only
+      std::string_view value = stat.substr(at + key.size());
+      value = value.substr(0, value.find('\n'));
+      if (const auto bytes = parse_count(value)) cache += *bytes;
+      break;
+    }
+  }
+  const std::size_t held = *used > cache ? *used - cache : 0;
+  return *limit > held ? *limit - held : 0;
 }
 
 std::optional<std::size_t> available_memory_bytes() {
@@ -120,7 +135,8 @@ std::optional<std::size_t> available_memory_bytes() {
   const std::string group = own_cgroup();
   if (!group.empty())
     take(cgroup_room_bytes(read_text((group + "/memory.max").c_str()),
-                           read_text((group + "/memory.current").c_str())));
+                           read_text((group + "/memory.current").c_str()),
+                           read_text((group + "/memory.stat").c_str())));
   if (const std::size_t limit = g_limit.load(); limit > 0) {
     // The process's own budget counts what it holds now against it.
     const std::size_t held = resident_bytes();

@@ -1051,30 +1051,33 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     PreResult pre;
     // Without a criterion nothing can fire early: the rung covering the depth is the answer.
     const int first = plan.threshold ? first_rung(scene, needles, areas, options) : last_rung;
-    int fired = -1;
-    auto climb = [&](int from) {
+    // Climbs from `from`; with `decide`, first asks whether the start rung fired where the rung
+    // below it reaches (at first contact, say, on a mesh spike under the tip that no closed form
+    // has): then the rungs skipped might have fired, and it returns true without climbing on.
+    auto climb = [&](int from, bool decide) {
       // A start above the rung covering the depth still runs (its run stops at the depth): the
       // rung a run uses never depends on how deep it was asked to go.
       for (int rung = from; rung <= std::max(last_rung, from); ++rung) {
         plan = detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(rung));
         plan.seconds = &run.seconds_by_stage;
         run.reductions = plan.reductions;
+        const bool deciding = decide && rung == from && from > 0;
+        const double below = deciding ? detail::pre_puncture_horizon(from - 1) : 0.0;
+        // The decision sees the start rung as deep as the rung below reaches, whatever depth was
+        // asked; the answer is then cut at that depth as always.
+        if (deciding) plan.depth_m = std::max(plan.depth_m, below);
         pre = run_pre(plan, scene, needles, areas, options, run);
         run.rungs_m.push_back(plan.horizon_m);
-        if (every_needle_crossed(plan, pre)) {
-          fired = rung;
-          break;
+        if (deciding) {
+          plan.depth_m = scene.insertion.depth;
+          const double crossed = deepest_first_crossing(plan, pre);
+          if (crossed > 0.0 && crossed <= below * (1.0 + 1e-12)) return true;
         }
+        if (every_needle_crossed(plan, pre)) break;
       }
+      return false;
     };
-    climb(first);
-    // The start rung fired where the rung below it reaches (at first contact, say, where a mesh
-    // spike under the tip is no closed form's): the rungs skipped might have fired, so the ladder
-    // climbs from rung 0 as without the closed form (docs/model.md, "Pre-puncture horizon").
-    if (first > 0 && fired == first &&
-        deepest_first_crossing(plan, pre) <=
-            detail::pre_puncture_horizon(first - 1) * (1.0 + 1e-12))
-      climb(0);
+    if (climb(first, true)) climb(0, false);  // docs/model.md, "Pre-puncture horizon"
     run.horizon_m = plan.horizon_m;
     run.first_step_m = plan.horizon_m / std::max(plan.steps, 1);
     run.models_run.push_back(pre.model);

@@ -16,6 +16,11 @@ namespace {
   throw InputError(file.string() + ": " + problem);
 }
 
+constexpr std::size_t kMaxLine = 4096;  // assimp 5.2's line buffer, its terminator included
+
+// Most corners assimp's OFF reader takes in one face (it drops larger ones, leaving a hole).
+constexpr std::uint64_t kMostCorners = 9;
+
 // The file's lines with comments ('#' to the end of the line) removed and blank lines dropped;
 // each keeps its line number for the error message.
 struct Line {
@@ -23,13 +28,24 @@ struct Line {
   std::string text;
 };
 
-std::vector<Line> content_lines(const std::string& bytes) {
+// Lines end where assimp's OFF reader ends them (IsLineEnd: '\n', '\r' or '\f'), so that the
+// check reads the faces assimp reads; a "\r\n" pair is one end.
+std::vector<Line> content_lines(const std::filesystem::path& file, const std::string& bytes) {
   std::vector<Line> lines;
-  std::istringstream in(bytes);
-  std::string text;
-  for (std::size_t number = 1; std::getline(in, text); ++number) {
+  std::size_t number = 1;
+  for (std::size_t start = 0; start <= bytes.size();) {
+    std::size_t end = bytes.find_first_of("\n\r\f", start);
+    if (end == std::string::npos) end = bytes.size();
+    // assimp copies a line into a 4096-byte buffer and goes on reading the rest as the next line.
+    if (end - start >= kMaxLine)
+      fail(file, "OFF line " + std::to_string(number) + " is longer than " +
+                     std::to_string(kMaxLine - 1) + " characters");
+    std::string text = bytes.substr(start, end - start);
     text = text.substr(0, text.find('#'));
-    if (text.find_first_not_of(" \t\r\f\v") != std::string::npos) lines.push_back({number, text});
+    if (text.find_first_not_of(" \t\v") != std::string::npos) lines.push_back({number, text});
+    if (end + 1 < bytes.size() && bytes[end] == '\r' && bytes[end + 1] == '\n') ++end;
+    start = end + 1;
+    ++number;
   }
   return lines;
 }
@@ -49,7 +65,7 @@ bool is_number(const std::string& token) {
 }  // namespace
 
 void check_structure(const std::filesystem::path& file, const std::string& bytes) {
-  const std::vector<Line> lines = content_lines(bytes);
+  const std::vector<Line> lines = content_lines(file, bytes);
   // The header's tokens may share a line or not ("OFF 3 1 0" or "OFF\n3 1 0"): read tokens until
   // the counts are complete, remembering which line the last of them is on.
   static const std::regex keyword("(ST)?C?N?4?(n)?OFF");
@@ -94,7 +110,7 @@ void check_structure(const std::filesystem::path& file, const std::string& bytes
     std::istringstream tokens(line.text);
     std::string token;
     for (int axis = 0; axis < 3; ++axis)
-      if (!(tokens >> token) || !is_number(token))
+      if (token.clear(); !(tokens >> token) || !is_number(token))
         fail(file, "OFF line " + std::to_string(line.number) + ": vertex " + std::to_string(v) +
                        " needs three finite coordinates" +
                        (token.empty() ? std::string() : " ('" + token + "' is not one)"));
@@ -105,8 +121,10 @@ void check_structure(const std::filesystem::path& file, const std::string& bytes
     std::string token;
     const std::string where =
         "OFF line " + std::to_string(line.number) + ": face " + std::to_string(f) + ": ";
-    if (!(tokens >> token) || !is_count(token) || std::stoull(token) < 3)
-      fail(file, where + "'" + token + "' is not a corner count (a whole number >= 3)");
+    if (!(tokens >> token) || !is_count(token) || std::stoull(token) < 3 ||
+        std::stoull(token) > kMostCorners)
+      fail(file, where + "'" + token + "' is not a corner count (a whole number from 3 to " +
+                     std::to_string(kMostCorners) + ", what assimp reads)");
     const std::uint64_t corners = std::stoull(token);
     for (std::uint64_t c = 0; c < corners; ++c) {
       token.clear();

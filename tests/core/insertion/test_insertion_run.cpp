@@ -299,6 +299,13 @@ TEST(InsertionRun, TheLadderClimbsFromRungZeroWhenItsStartFiresWithinTheRungBelo
   EXPECT_EQ(a.rungs_m, (std::vector<double>{400e-6, 100e-6}));
   EXPECT_EQ(a.needles[0].puncture->depth_m, b.needles[0].puncture->depth_m);
   EXPECT_TRUE(a.needles[0].puncture->at_first_contact);
+  // Asked 50 um deep, the start rung still runs to 200 um to decide, and decides the same.
+  const InsertionRun shallow =
+      run_insertion(pressure_scene("0.25 MPa", "[\"1500 um\", \"1500 um\", \"1500 um\"]", "50 um"),
+                    {bevel}, fast());
+  EXPECT_EQ(shallow.rungs_m, (std::vector<double>{400e-6, 100e-6}));
+  ASSERT_TRUE(shallow.needles[0].puncture.has_value());
+  EXPECT_EQ(shallow.needles[0].puncture->depth_m, a.needles[0].puncture->depth_m);
 }
 
 // A start above the rung covering the requested depth still runs (its run stops at the depth),

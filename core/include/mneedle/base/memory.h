@@ -29,8 +29,11 @@ std::size_t parse_memory_size(std::string_view text);
 /// MemAvailable of a /proc/meminfo text, in bytes; nullopt when absent or malformed.
 std::optional<std::size_t> meminfo_available_bytes(std::string_view meminfo);
 
-/// Room under a cgroup v2 limit: memory.max's text ("max" = no limit) less memory.current's;
-/// nullopt when there is no limit or either text is malformed. 0 when the group is at its limit.
-std::optional<std::size_t> cgroup_room_bytes(std::string_view max, std::string_view current);
+/// Room under a cgroup v2 limit: memory.max's text ("max" = no limit) less memory.current's,
+/// the page cache (memory.stat's active_file and inactive_file, which the kernel reclaims) not
+/// counted as held; nullopt when there is no limit or max or current is malformed. 0 when the
+/// group is at its limit.
+std::optional<std::size_t> cgroup_room_bytes(std::string_view max, std::string_view current,
+                                             std::string_view stat);
 
 }  // namespace mneedle

@@ -171,9 +171,9 @@ struct InsertionRun {
   double horizon_m = 0.0;
   double first_step_m = 0.0;  ///< the pre-puncture model's depth step on that rung
   /// Every rung's horizon that ran, in order (docs/model.md, "Pre-puncture horizon"): from rung 0
-  /// up; for the 3-D model from one rung below the closed form's crossing (and from rung 0 again
-  /// when that start fired within the rung below it); without a criterion, the rung covering the
-  /// requested depth alone.
+  /// up; for the 3-D model from the rung covering the closed form's crossing over its margin (and
+  /// from rung 0 again when that start fired within the rung below it); without a criterion, the
+  /// rung covering the requested depth alone.
   std::vector<double> rungs_m;
   // Mesh summary of the FE stage (zeros when none ran).
   int nodes = 0;
