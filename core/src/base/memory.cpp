@@ -67,14 +67,14 @@ std::size_t peak_memory_bytes() {
 std::size_t parse_memory_size(std::string_view text) {
   const std::string quoted = "'" + std::string(text) + "'";
   std::string_view rest = text;
-  while (!rest.empty() && rest.front() == ' ') rest.remove_prefix(1);
+  while (!rest.empty() && (rest.front() == ' ' || rest.front() == '\t')) rest.remove_prefix(1);
   double value = 0.0;
   const auto [end, error] = std::from_chars(rest.data(), rest.data() + rest.size(), value);
   if (error != std::errc{} || !std::isfinite(value) || value <= 0.0)
     throw InputError(quoted + ": expected a positive size with a unit, e.g. '4 GiB'");
   std::string_view unit(end, static_cast<std::size_t>(rest.data() + rest.size() - end));
-  while (!unit.empty() && unit.front() == ' ') unit.remove_prefix(1);
-  while (!unit.empty() && unit.back() == ' ') unit.remove_suffix(1);
+  while (!unit.empty() && (unit.front() == ' ' || unit.front() == '\t')) unit.remove_prefix(1);
+  while (!unit.empty() && (unit.back() == ' ' || unit.back() == '\t')) unit.remove_suffix(1);
   constexpr std::pair<std::string_view, double> kUnits[] = {
       {"B", 1.0},         {"kB", 1e3},           {"MB", 1e6},
       {"GB", 1e9},        {"TB", 1e12},          {"KiB", 1024.0},

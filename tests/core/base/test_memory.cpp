@@ -41,6 +41,7 @@ TEST(Memory, SizesNeedOneOfTheByteUnits) {
   EXPECT_EQ(parse_memory_size("1.5 GB"), 1500000000ull);
   EXPECT_EQ(parse_memory_size("512MiB"), 512ull * 1024 * 1024);
   EXPECT_EQ(parse_memory_size("  100 B "), 100ull);
+  EXPECT_EQ(parse_memory_size("\t2 KiB\t"), 2048ull);
   for (const char* bad :
        {"4", "4 gb", "4 GiBs", "GiB", "-1 GiB", "0 MB", "nan MB", "1e30 TB", "0.5 B"})
     EXPECT_THROW(parse_memory_size(bad), mneedle::InputError) << bad;
@@ -65,7 +66,7 @@ TEST(Memory, AProcessLimitCapsTheMemoryLeft) {
   EXPECT_GT(*available_memory_bytes(), 0u);
 }
 
-TEST(Memory, PeakMemoryIsTheProcesssResidentPeak) {
+TEST(Memory, PeakMemoryIsTheProcessResidentPeak) {
   EXPECT_GT(mneedle::peak_memory_bytes(), 1u << 20);  // a test binary holds more than 1 MiB
 }
 

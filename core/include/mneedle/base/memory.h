@@ -22,8 +22,8 @@ std::optional<std::size_t> available_memory_bytes();
 void set_memory_limit_bytes(std::optional<std::size_t> bytes);
 
 /// "<number> <unit>" in bytes, the unit one of B, kB, MB, GB, TB (powers of 1000) or KiB, MiB,
-/// GiB, TiB (powers of 1024). Throws InputError naming the text for anything else (a number
-/// without a unit among them).
+/// GiB, TiB (powers of 1024), at least one byte. Throws InputError naming the text for anything
+/// else (a number without a unit among them).
 std::size_t parse_memory_size(std::string_view text);
 
 /// MemAvailable of a /proc/meminfo text, in bytes; nullopt when absent or malformed.
