@@ -702,6 +702,28 @@ TEST(WorkLimits, AFactorAboveTheMemoryLimitEndsTheRunInOneLineBeforeItIsAllocate
             0);
 }
 
+// An address-space limit (`ulimit -v`, as batch systems set) counts as memory left: the run is
+// refused in one line with status 3. Before, CHOLMOD's solve crashed (status 139) and OpenBLAS
+// retried its work buffer's mmap for ever; 400 MB leaves no room for the fast skin run's
+// 69 MiB factor beside the process's mappings and OpenBLAS's buffers. AddressSanitizer's shadow
+// memory cannot be mapped under such a limit at all.
+TEST(WorkLimits, AnAddressSpaceLimitEndsTheRunInOneLineInsteadOfAHangOrACrash) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer cannot start under ulimit -v";
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  GTEST_SKIP() << "AddressSanitizer cannot start under ulimit -v";
+#endif
+#endif
+  const auto run = mneedle::test::run_command(
+      "ulimit -v 400000 && timeout 120 '" + mneedle::test::mneedle_binary() + "' simulate '" +
+      kRoot + "/designs/scenes/human_skin.toml' --fidelity fast --quiet");
+  EXPECT_EQ(run.exit_code, 3) << run.err;
+  EXPECT_EQ(run.err.rfind("mneedle: error: ", 0), 0u) << run.err;
+  EXPECT_NE(run.err.find("of memory left to this process"), std::string::npos) << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+}
+
 }  // namespace
 
 namespace {

@@ -8,9 +8,11 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "mneedle/base/error.h"
@@ -20,6 +22,8 @@ namespace mneedle {
 namespace {
 
 // The limit set by set_memory_limit_bytes; 0 = none (a zero budget is not a useful limit).
+// OpenBLAS's work buffer (BUFFER_SIZE of Debian's build, seen in its mmap calls).
+constexpr std::size_t kBlasBufferBytes = std::size_t{128} << 20;
 std::atomic<std::size_t> g_limit{0};
 
 std::optional<std::size_t> parse_count(std::string_view text) {
@@ -45,18 +49,23 @@ std::string own_cgroup() {
   return {};
 }
 
-// The resident set now (bytes): /proc/self/statm's second field, in pages.
-std::size_t resident_bytes() {
-  const std::string text = read_text("/proc/self/statm");
-  const auto space = text.find(' ');
-  if (space == std::string::npos) return 0;
-  const std::string rest = text.substr(space + 1);
-  const auto pages = parse_count(rest.substr(0, rest.find(' ')));
+// Field `index` of /proc/self/statm (0: the address space, 1: the resident set), in bytes; 0
+// where it cannot be read.
+std::size_t statm_bytes(int index) {
+  std::istringstream fields(read_text("/proc/self/statm"));
+  std::string field;
+  for (int i = 0; i <= index; ++i)
+    if (!(fields >> field)) return 0;
+  const auto pages = parse_count(field);
   const long page = sysconf(_SC_PAGESIZE);
   return pages && page > 0 ? *pages * static_cast<std::size_t>(page) : 0;
 }
 
 }  // namespace
+
+std::size_t resident_memory_bytes() {
+  return statm_bytes(1);
+}
 
 std::size_t peak_memory_bytes() {
   rusage usage{};
@@ -137,9 +146,18 @@ std::optional<std::size_t> available_memory_bytes() {
     take(cgroup_room_bytes(read_text((group + "/memory.max").c_str()),
                            read_text((group + "/memory.current").c_str()),
                            read_text((group + "/memory.stat").c_str())));
+  // An address-space limit (ulimit -v, as batch systems set): mappings count, resident or not.
+  // OpenBLAS maps a work buffer per calling thread on first use and, when the limit refuses
+  // it, retries for ever (Debian's 0.3.21), so room for those is kept back.
+  if (rlimit space{}; getrlimit(RLIMIT_AS, &space) == 0 && space.rlim_cur != RLIM_INFINITY) {
+    const auto limit = static_cast<std::size_t>(space.rlim_cur);
+    const std::size_t held =
+        statm_bytes(0) + kBlasBufferBytes * (std::thread::hardware_concurrency() + 1);
+    take(limit > held ? limit - held : 0);
+  }
   if (const std::size_t limit = g_limit.load(); limit > 0) {
     // The process's own budget counts what it holds now against it.
-    const std::size_t held = resident_bytes();
+    const std::size_t held = resident_memory_bytes();
     take(limit > held ? limit - held : 0);
   }
   return room;
@@ -147,6 +165,24 @@ std::optional<std::size_t> available_memory_bytes() {
 
 void set_memory_limit_bytes(std::optional<std::size_t> bytes) {
   g_limit.store(bytes.value_or(0));
+}
+
+std::string memory_size_text(double bytes) {
+  std::ostringstream out;
+  out << std::fixed;
+  if (bytes < 1024.0 * 1024.0 * 1024.0)
+    out << std::setprecision(0) << bytes / (1024.0 * 1024.0) << " MiB";
+  else
+    out << std::setprecision(2) << bytes / (1024.0 * 1024.0 * 1024.0) << " GiB";
+  return out.str();
+}
+
+void require_memory(double bytes, std::string_view what, std::string_view remedy) {
+  const std::optional<std::size_t> room = available_memory_bytes();
+  if (!room || bytes <= static_cast<double>(*room)) return;
+  throw OutOfMemoryError(std::string(what) + " needs " + memory_size_text(bytes) +
+                         ", more than the " + memory_size_text(static_cast<double>(*room)) +
+                         " of memory left to this process; " + std::string(remedy));
 }
 
 }  // namespace mneedle

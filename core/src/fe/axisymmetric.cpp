@@ -405,6 +405,8 @@ Equilibrium AxisymmetricModel::solve(const std::vector<std::uint32_t>& prescribe
             cached_energy = energy;
             break;
           }
+        } catch (const OutOfMemoryError&) {
+          throw;
         } catch (const SolverError&) {
           // An inverted element at the full step: try a shorter one.
         }

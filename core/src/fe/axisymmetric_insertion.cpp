@@ -473,6 +473,8 @@ class NonlinearStepper : public Stepper {
           trial_iterations += trial.newton_iterations;
           largest_solve = std::max(largest_solve, trial.newton_iterations);
         }
+      } catch (const OutOfMemoryError&) {
+        throw;  // a shorter step needs as much memory
       } catch (const SolverError& e) {
         failure = e.what();
       }

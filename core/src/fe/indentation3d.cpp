@@ -21,6 +21,7 @@
 #include "fe/vtu_writer.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/files.h"
+#include "mneedle/base/memory.h"
 #include "mneedle/fe/crack.h"
 #include "mneedle/fe/solid3d.h"
 #include "mneedle/fe/sparse_solver.h"
@@ -321,6 +322,16 @@ struct Indentation3d::Impl {
     linear_factorized = true;
   }
 
+  // The linear sticking path holds every captured node's compliance densely: over a flat end
+  // under a fine contact zone that is thousands of nodes and tens of GB. What would not fit is
+  // refused before it is allocated (docs/performance.md, "Memory").
+  static void require_contact_memory(double bytes, std::size_t nodes) {
+    require_memory(bytes,
+                   "3-D contact: the dense compliance of " + std::to_string(nodes) +
+                       " surface nodes held by the needle",
+                   "a coarser contact_zone or fidelity needs less");
+  }
+
   // The sticking path's surface rows (candidates, then the ring) eliminated last, so that their
   // compliance is read from the dense factor of the Schur complement onto them
   // (docs/performance.md, "The contact block"). Not with crack faces in contact (their gaps need
@@ -343,6 +354,28 @@ struct Indentation3d::Impl {
           std::find(missing.begin(), missing.end(), c.node) == missing.end())
         missing.push_back(c.node);
     if (missing.empty()) return;
+    {
+      // What the new columns keep, and what computing them holds meanwhile: the contact block's
+      // columns and (first nodes only) their fields, or one chunk's unit loads, its columns and
+      // CHOLMOD's copy of them.
+      const double columns = 3.0 * static_cast<double>(missing.size());
+      const double kept_rows =
+          static_cast<double>(surface_rows()) +
+          (watched_overflow ? 0.0 : 3.0 * static_cast<double>(watched.size())) +
+          (crack_contact() ? static_cast<double>(pairs.size()) : 0.0);
+      const double dofs = static_cast<double>(model.dof_count());
+      const double meanwhile =
+          solver.has_trailing_block()
+              ? static_cast<double>(surface_rows()) * columns +
+                    (watched.empty() || watched_overflow ||
+                             column_cache.size() + captured.size() + missing.size() >
+                                 kWatchedBlockNodes
+                         ? 0.0
+                         : dofs * columns)
+              : 3.0 * dofs * 3.0 * static_cast<double>(std::min(kColumnChunkNodes, missing.size()));
+      require_contact_memory(8.0 * (kept_rows * columns + meanwhile),
+                             column_cache.size() + missing.size());
+    }
     if (solver.has_trailing_block()) {
       std::vector<Eigen::Index> at;
       for (int node : missing)
@@ -411,6 +444,17 @@ struct Indentation3d::Impl {
     cache_compliance_columns(found);
     const Eigen::Index old_columns = compliance.cols();
     const auto added = 3 * static_cast<Eigen::Index>(found.size());
+    {
+      // The grown compliance (copied while the old one is still held), the watched rows, and
+      // the next condensed solve's dense matrix with its Cholesky factor.
+      const auto columns = static_cast<double>(old_columns + added);
+      const double coupling = columns + static_cast<double>(active_pairs.size());
+      const double watched_rows =
+          watched_overflow ? 0.0 : 3.0 * static_cast<double>(watched.size());
+      require_contact_memory(8.0 * ((static_cast<double>(surface_rows()) + watched_rows) * columns +
+                                    2.0 * coupling * coupling),
+                             captured.size() + found.size());
+    }
     compliance.conservativeResize(surface_rows(), old_columns + added);
     const double watched_bytes =
         8.0 * 3.0 * static_cast<double>(watched.size()) * static_cast<double>(old_columns + added);
@@ -800,6 +844,8 @@ struct Indentation3d::Impl {
           u = trial;
           return trial_norm;
         }
+      } catch (const OutOfMemoryError&) {
+        throw;
       } catch (const SolverError&) {
         if (halving == kMaxLineSearchHalvings) throw;
       }
@@ -850,6 +896,8 @@ struct Indentation3d::Impl {
         depth += h;
         if (used <= 4) step = 1.5 * h;
         cuts = 0;
+      } catch (const OutOfMemoryError&) {
+        throw;  // a shorter step needs as much memory
       } catch (const SolverError& error) {
         u = saved_u;
         if (frictionless()) contact->set_multipliers(saved_multipliers);
@@ -1402,7 +1450,10 @@ Step3d Indentation3d::advance_to(double depth) {
     } catch (const SolverError& error) {
       const std::string what = error.what();
       if (what.rfind("3-D solve", 0) == 0) throw;
-      throw SolverError("3-D solve: stopped at depth " + micrometres(impl_->depth) + ": " + what);
+      const std::string where = "3-D solve: stopped at depth " + micrometres(impl_->depth) + ": ";
+      if (dynamic_cast<const OutOfMemoryError*>(&error) != nullptr)
+        throw OutOfMemoryError(where + what);
+      throw SolverError(where + what);
     }
     impl_->depth = depth;
   } else {
@@ -1681,7 +1732,8 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
             (needles[n].y == 0.0 && mesh.mirror_y0 ? 2.0 : 1.0) * crack_areas[n];
       }
     }
-    if (!options.vtu_directory.empty()) {
+    if (!options.vtu_directory.empty() &&
+        (options.vtu_depth_m <= 0.0 || depth <= options.vtu_depth_m * (1.0 + 1e-12))) {
       const std::filesystem::path dir(options.vtu_directory);
       const std::string tissue = "step_" + std::to_string(k) + ".vtu",
                         needles_file = "needles_" + std::to_string(k) + ".vtu";

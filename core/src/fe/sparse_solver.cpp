@@ -4,10 +4,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
-#include <iomanip>
 #include <mutex>
-#include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -315,21 +312,10 @@ Eigen::SparseMatrix<double> permuted(
 // needs and what there is (docs/performance.md, "Memory"): otherwise the allocation fails deep
 // in CHOLMOD (read as "not positive definite") or the machine swaps for minutes.
 [[maybe_unused]] void check_factor_fits(double factor_bytes, Eigen::Index unknowns) {
-  const std::optional<std::size_t> room = available_memory_bytes();
-  if (!room || factor_bytes <= static_cast<double>(*room)) return;
-  auto size = [](double bytes) {
-    std::ostringstream out;
-    if (bytes < 1024.0 * 1024.0 * 1024.0)
-      out << std::fixed << std::setprecision(0) << bytes / (1024.0 * 1024.0) << " MiB";
-    else
-      out << std::fixed << std::setprecision(2) << bytes / (1024.0 * 1024.0 * 1024.0) << " GiB";
-    return out.str();
-  };
-  throw SolverError("sparse solver: the factor of " + std::to_string(unknowns) +
-                    " unknowns needs " + size(factor_bytes) + ", more than the " +
-                    size(static_cast<double>(*room)) +
-                    " of memory left to this process; a coarser fidelity, a smaller contact "
-                    "zone or fewer mesh refinement levels needs less");
+  require_memory(factor_bytes,
+                 "sparse solver: the factor of " + std::to_string(unknowns) + " unknowns",
+                 "a coarser fidelity, a smaller contact zone or fewer mesh refinement levels "
+                 "needs less");
 }
 
 }  // namespace

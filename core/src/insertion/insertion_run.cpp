@@ -190,6 +190,7 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
   o.steps = plan.steps;
   o.vtu_directory = plan.vtu_directory;
   o.vtu_comment = plan.vtu_comment;
+  o.vtu_depth_m = plan.shown_depth_m;
   o.inp_path = plan.inp_path;
   o.inp_depth_m = plan.inp_depth_m;
   o.inp_comment = plan.inp_comment;
@@ -211,7 +212,9 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
       more = watch.keep_going(i, sample_of(step.depth_m, step.needles[i], areas[i])) && more;
       force += step.needles[i].force_N;
     }
-    if (options.on_progress)
+    const bool shown =
+        plan.shown_depth_m <= 0.0 || step.depth_m <= plan.shown_depth_m * (1.0 + 1e-12);
+    if (options.on_progress && shown)
       options.on_progress("fe_3d", ++step_index, o.overrides.steps.value_or(o.steps), step.depth_m,
                           force);
     return more;
@@ -520,6 +523,8 @@ bool measure_domain_cut(RunPlan& plan, const std::vector<PreparedNeedle>& needle
     try {
       f_full = reference_on(plan.full_block_x_m, plan.full_block_y_m);
       f_reduced = reference_on(plan.block_x_m, plan.block_y_m);
+    } catch (const OutOfMemoryError&) {
+      throw;  // the whole block would need more still
     } catch (const SolverError& e) {
       unmeasured = e.what();
     }
@@ -1065,11 +1070,15 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
         const double below = deciding ? detail::pre_puncture_horizon(from - 1) : 0.0;
         // The decision sees the start rung as deep as the rung below reaches, whatever depth was
         // asked; the answer is then cut at that depth as always.
-        if (deciding) plan.depth_m = std::max(plan.depth_m, below);
+        if (deciding) {
+          plan.shown_depth_m = plan.depth_m;  // what goes deeper only decides: not shown
+          plan.depth_m = std::max(plan.depth_m, below);
+        }
         pre = run_pre(plan, scene, needles, areas, options, run);
         run.rungs_m.push_back(plan.horizon_m);
         if (deciding) {
           plan.depth_m = scene.insertion.depth;
+          plan.shown_depth_m = 0.0;
           const double crossed = deepest_first_crossing(plan, pre);
           if (crossed > 0.0 && crossed <= below * (1.0 + 1e-12)) return true;
         }

@@ -9,7 +9,9 @@ namespace {
 using mneedle::available_memory_bytes;
 using mneedle::cgroup_room_bytes;
 using mneedle::meminfo_available_bytes;
+using mneedle::memory_size_text;
 using mneedle::parse_memory_size;
+using mneedle::require_memory;
 using mneedle::set_memory_limit_bytes;
 
 TEST(Memory, MeminfoAvailableIsReadInKibibytes) {
@@ -68,6 +70,32 @@ TEST(Memory, AProcessLimitCapsTheMemoryLeft) {
 
 TEST(Memory, PeakMemoryIsTheProcessResidentPeak) {
   EXPECT_GT(mneedle::peak_memory_bytes(), 1u << 20);  // a test binary holds more than 1 MiB
+  // Now, not the peak: the kernel updates the two counts at different times, so neither bounds
+  // the other to the page.
+  EXPECT_GT(mneedle::resident_memory_bytes(), 1u << 20);
+}
+
+TEST(Memory, SizesPrintInWholeMebibytesBelowAGibibyteAndInGibibytesAbove) {
+  EXPECT_EQ(memory_size_text(0.0), "0 MiB");
+  EXPECT_EQ(memory_size_text(69.4 * 1024 * 1024), "69 MiB");
+  EXPECT_EQ(memory_size_text(31.384 * 1024 * 1024 * 1024), "31.38 GiB");
+}
+
+// What does not fit in the memory left is refused with what it needs, what there is and what
+// to do; what fits, or anything where the room is unknown, passes.
+TEST(Memory, RequireMemoryRefusesWhatExceedsTheMemoryLeftInOneLine) {
+  EXPECT_NO_THROW(require_memory(1024.0, "a test block", "nothing to do"));
+  set_memory_limit_bytes(1);
+  try {
+    require_memory(2.0 * 1024 * 1024, "a test block", "ask for less");
+    set_memory_limit_bytes(std::nullopt);
+    FAIL() << "expected an OutOfMemoryError";
+  } catch (const mneedle::OutOfMemoryError& e) {
+    set_memory_limit_bytes(std::nullopt);
+    EXPECT_STREQ(e.what(),
+                 "a test block needs 2 MiB, more than the 0 MiB of memory left to this process; "
+                 "ask for less");
+  }
 }
 
 }  // namespace

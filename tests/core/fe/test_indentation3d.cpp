@@ -6,8 +6,11 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <optional>
+#include <string>
 
 #include "mneedle/base/error.h"
+#include "mneedle/base/memory.h"
 #include "mneedle/fe/crack.h"
 #include "mneedle/fe/solid3d.h"
 #include "needle_meshes.h"
@@ -284,6 +287,52 @@ TEST(Indentation3d, TheContactBlockGivesWhatSparseSolvesGive) {
     EXPECT_TRUE(blocked.uses_contact_block());
     EXPECT_FALSE(plain.uses_contact_block());
   }
+}
+
+// The linear sticking path keeps each captured node's compliance columns densely: what a new
+// capture would allocate beyond the memory left is refused first, in one line naming the nodes,
+// what they need and what is left (docs/performance.md, "Memory"); over a blunt bevel's flat
+// under a 3 um contact zone that was tens of GB and, under `ulimit -v`, a crash in CHOLMOD.
+// Here a cone holds 1 node at 20 um and 21 at 100 um; each node its tip takes on the way needs
+// unit loads, columns and CHOLMOD's copy, 3 x 3 x dofs doubles (1.4 MB on this mesh), above the
+// 1 MiB the limit leaves.
+TEST(Indentation3d, ContactColumnsThatCannotFitAreRefusedBeforeTheyAreAllocated) {
+  const TetMesh mesh =
+      punch_mesh(homogeneous_block(MaterialModel::Linear, 1e5, 0.4, 400e-6, 300e-6), 100e-6, 100e-6,
+                 2, Fidelity::Standard);
+  const Needle3d cone{"cone", mneedle::test::cone_needle(std::numbers::pi / 6, 100e-6, 1e-3, 48),
+                      0.0, 0.0};
+  Indentation3dOptions sparse;
+  sparse.contact_block = false;
+  Indentation3d run(mesh, {cone}, 100e-6, sparse);
+  const int held = run.advance_to(20e-6).needles[0].captured_nodes;
+  ASSERT_GT(held, 0);
+  struct Budget {  // the process's limit, removed whatever the test does
+    Budget() { mneedle::set_memory_limit_bytes(mneedle::resident_memory_bytes() + (1u << 20)); }
+    ~Budget() { mneedle::set_memory_limit_bytes(std::nullopt); }
+  };
+  {
+    const Budget budget;
+    try {
+      run.advance_to(100e-6);
+      FAIL() << "expected a SolverError";
+    } catch (const mneedle::OutOfMemoryError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind("3-D solve: stopped at depth 20 um: 3-D contact: the dense compliance "
+                           "of ",
+                           0),
+                0u)
+          << what;
+      EXPECT_NE(what.find(" surface nodes held by the needle needs "), std::string::npos) << what;
+      EXPECT_NE(what.find("of memory left to this process; a coarser contact_zone"),
+                std::string::npos)
+          << what;
+    }
+  }
+  // The same insertion with the memory there takes those nodes.
+  Indentation3d fits(mesh, {cone}, 100e-6, sparse);
+  fits.advance_to(20e-6);
+  EXPECT_GT(fits.advance_to(100e-6).needles[0].captured_nodes, held);
 }
 
 TEST(Indentation3d, SimulateThreeDimensionalReportsMeshAndCurve) {

@@ -4,10 +4,15 @@
 #include "mneedle/insertion/insertion_run.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <numbers>
+#include <regex>
 #include <string>
 
 #include "fe/needle_meshes.h"
@@ -320,11 +325,35 @@ TEST(InsertionRun, AStartAboveTheRequestedDepthStillRunsSoTheAnswerDoesNotDepend
         pressure_scene("0.3 MPa", "[\"1500 um\", \"1500 um\", \"1500 um\"]", depth), {bevel},
         fast());
   };
-  const InsertionRun shallow = at_depth("50 um");
   const InsertionRun a = at_depth("300 um");
   const InsertionRun b = at_depth("900 um");
+  // The 50 um run decides on the 400 um rung's run to 200 um (the rung below reaches that far);
+  // what it shows, progress lines and VTU steps, ends where it was asked to.
+  InsertionRunOptions shown = fast();
+  shown.vtu_directory =
+      (std::filesystem::temp_directory_path() / ("mneedle_shown_" + std::to_string(::getpid())))
+          .string();
+  double deepest_progress = 0.0;
+  shown.on_progress = [&](const std::string&, int, int, double depth_m, double) {
+    deepest_progress = std::max(deepest_progress, depth_m);
+  };
+  const InsertionRun shallow =
+      run_insertion(pressure_scene("0.3 MPa", "[\"1500 um\", \"1500 um\", \"1500 um\"]", "50 um"),
+                    {bevel}, shown);
   EXPECT_EQ(shallow.rungs_m, (std::vector<double>{400e-6}));
   EXPECT_FALSE(shallow.needles[0].puncture.has_value());
+  EXPECT_GT(deepest_progress, 0.0);
+  EXPECT_LE(deepest_progress, 50e-6 * (1 + 1e-12));
+  std::ifstream pvd(shown.vtu_directory + "/steps.pvd");
+  const std::string collection{std::istreambuf_iterator<char>(pvd),
+                               std::istreambuf_iterator<char>()};
+  const std::regex timestep("timestep=\"([^\"]+)\"");
+  int steps = 0;
+  for (auto it = std::sregex_iterator(collection.begin(), collection.end(), timestep);
+       it != std::sregex_iterator(); ++it, ++steps)
+    EXPECT_LE(std::stod((*it)[1].str()), 50e-6 * (1 + 1e-12)) << (*it)[0].str();
+  EXPECT_GT(steps, 0);
+  std::filesystem::remove_all(shown.vtu_directory);
   ASSERT_TRUE(a.needles[0].puncture && b.needles[0].puncture);
   EXPECT_EQ(a.needles[0].puncture->depth_m, b.needles[0].puncture->depth_m);
   EXPECT_NEAR(a.needles[0].puncture->depth_m, 238e-6, 1e-6);  // measured 238.07 um

@@ -17,4 +17,11 @@ class SolverError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A computation refused before it allocated what would not fit in the memory left
+/// (require_memory): a shorter step or another try needs as much, so retry loops pass it on.
+class OutOfMemoryError : public SolverError {
+ public:
+  using SolverError::SolverError;
+};
+
 }  // namespace mneedle

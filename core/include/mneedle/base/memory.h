@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace mneedle {
@@ -12,14 +13,27 @@ namespace mneedle {
 /// process, so a report of one run is exact only when the process did nothing bigger before.
 std::size_t peak_memory_bytes();
 
-/// Memory this process may still take (bytes): the smaller of the kernel's MemAvailable
-/// (/proc/meminfo), the room left under its cgroup's memory.max (cgroup v2) and the limit set
-/// with set_memory_limit_bytes, of those that are known; nullopt when none is.
+/// The resident set now (bytes): /proc/self/statm; 0 where it cannot be read.
+std::size_t resident_memory_bytes();
+
+/// Memory this process may still take (bytes): the smallest of the kernel's MemAvailable
+/// (/proc/meminfo), the room left under its cgroup's memory.max (cgroup v2), the room left in
+/// its address-space limit (RLIMIT_AS, `ulimit -v`; less OpenBLAS's work buffers, 128 MiB per
+/// hardware thread and one more) and the limit set with
+/// set_memory_limit_bytes, of those that are known; nullopt when none is.
 std::optional<std::size_t> available_memory_bytes();
 
 /// A limit of this process's own below what the machine has (tests; a user's budget); nullopt
 /// removes it. Process-wide.
 void set_memory_limit_bytes(std::optional<std::size_t> bytes);
+
+/// A size as refusals print it: whole MiB below a GiB, GiB to two decimals from there.
+std::string memory_size_text(double bytes);
+
+/// Refuses, before it is allocated, what cannot fit: throws OutOfMemoryError "<what> needs <size>,
+/// more than the <size> of memory left to this process; <remedy>" when `bytes` exceed
+/// available_memory_bytes(). Nothing when the room is unknown.
+void require_memory(double bytes, std::string_view what, std::string_view remedy);
 
 /// "<number> <unit>" in bytes, the unit one of B, kB, MB, GB, TB (powers of 1000) or KiB, MiB,
 /// GiB, TiB (powers of 1024), at least one byte. Throws InputError naming the text for anything
