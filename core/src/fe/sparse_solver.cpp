@@ -410,6 +410,18 @@ void SparseSolver::factorize(const Eigen::SparseMatrix<double>& input) {
   // Not positive definite (e.g. a hyperelastic tangent past a limit point): LDLT still
   // factorises symmetric indefinite matrices with a nonsingular leading-minor sequence. It gets
   // P K Pᵀ, the Cholesky's fill-reducing order.
+#ifdef MNEEDLE_HAVE_CHOLMOD
+  // The fallback's simplicial factor has about the supernodal one's entries, each with its row
+  // index (12 bytes), and the permuted copy of K comes on top: refused as the factor is when it
+  // cannot fit (CHOLMOD itself fails this way when it ran out of memory).
+  if (!impl_->indefinite_analyzed)
+    require_memory(
+        1.5 * impl_->cholesky.factor_bytes() +
+            (impl_->permuted ? 12.0 * static_cast<double>(input.nonZeros()) : 0.0),
+        "sparse solver: the LDLT fallback for " + std::to_string(input.rows()) + " unknowns",
+        "a coarser fidelity, a smaller contact zone or fewer mesh refinement levels "
+        "needs less");
+#endif
   Eigen::SparseMatrix<double> reordered;
   if (impl_->permuted) reordered = permuted(input, impl_->permutation);
   const Eigen::SparseMatrix<double>& matrix = impl_->permuted ? reordered : input;

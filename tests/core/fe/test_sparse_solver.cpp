@@ -90,6 +90,35 @@ TEST(SparseSolver, FallsBackToLdltForIndefiniteMatrix) {
   EXPECT_LT((matrix * solver.solve(rhs) - rhs).norm(), 1e-8);
 }
 
+// The LDLT fallback needs about as much again as the factor that failed: when that does not fit
+// it is refused before Eigen allocates it (docs/performance.md, "Memory").
+TEST(SparseSolver, AnLdltFallbackThatCannotFitIsRefusedBeforeItIsAllocated) {
+  mneedle::fe::SparseSolver spd;
+  spd.factorize(shifted_laplacian(40, 0.5));
+  if (spd.backend() != "cholmod-supernodal-llt") GTEST_SKIP() << "the check is CHOLMOD's";
+  const SpMat matrix = shifted_laplacian(40, -0.5);
+  mneedle::fe::SparseSolver solver;
+  solver.analyze(matrix);
+  struct Budget {  // the process's limit, removed whatever the test does
+    Budget() { mneedle::set_memory_limit_bytes(1); }
+    ~Budget() { mneedle::set_memory_limit_bytes(std::nullopt); }
+  };
+  {
+    const Budget budget;
+    try {
+      solver.factorize(matrix);
+      FAIL() << "expected an OutOfMemoryError";
+    } catch (const mneedle::OutOfMemoryError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind("sparse solver: the LDLT fallback for 40 unknowns needs ", 0), 0u)
+          << what;
+    }
+  }
+  solver.factorize(matrix);  // with the memory there
+  EXPECT_TRUE(solver.ok());
+  EXPECT_EQ(solver.backend(), "eigen-simplicial-ldlt");
+}
+
 TEST(SparseSolver, SolvesSeveralRightHandSidesAtOnce) {
   const SpMat matrix = shifted_laplacian(30, 0.2);
   mneedle::fe::SparseSolver solver;
