@@ -7,12 +7,15 @@
 #include <atomic>
 #include <charconv>
 #include <cmath>
+#include <condition_variable>
 #include <fstream>
 #include <iomanip>
 #include <iterator>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <thread>
+#include <unordered_map>
 #include <utility>
 
 #include "mneedle/base/error.h"
@@ -177,12 +180,74 @@ std::string memory_size_text(double bytes) {
   return out.str();
 }
 
+namespace {
+
+// Bytes reserved by reserve_memory and not yet released, in the whole process and by thread.
+std::mutex g_reserved_mutex;
+std::condition_variable g_reserved_released;
+double g_reserved = 0.0;
+std::unordered_map<std::thread::id, double> g_reserved_by_thread;
+
+}  // namespace
+
+MemoryReservation::MemoryReservation(double bytes, std::thread::id owner)
+    : bytes_(bytes), owner_(owner) {}
+
+MemoryReservation::~MemoryReservation() {
+  release();
+}
+
+MemoryReservation::MemoryReservation(MemoryReservation&& other) noexcept
+    : bytes_(std::exchange(other.bytes_, 0.0)), owner_(other.owner_) {}
+
+MemoryReservation& MemoryReservation::operator=(MemoryReservation&& other) noexcept {
+  if (this != &other) {
+    release();
+    bytes_ = std::exchange(other.bytes_, 0.0);
+    owner_ = other.owner_;
+  }
+  return *this;
+}
+
+void MemoryReservation::release() {
+  if (bytes_ <= 0.0) return;
+  {
+    const std::lock_guard<std::mutex> lock(g_reserved_mutex);
+    g_reserved -= bytes_;
+    const auto mine = g_reserved_by_thread.find(owner_);
+    if (mine != g_reserved_by_thread.end() && (mine->second -= bytes_) <= 0.0)
+      g_reserved_by_thread.erase(mine);
+  }
+  bytes_ = 0.0;
+  g_reserved_released.notify_all();
+}
+
+MemoryReservation reserve_memory(double bytes, std::string_view what, std::string_view remedy) {
+  std::unique_lock<std::mutex> lock(g_reserved_mutex);
+  for (;;) {
+    const std::optional<std::size_t> room = available_memory_bytes();
+    const double left = room ? static_cast<double>(*room) : 0.0;
+    if (!room || bytes <= left - g_reserved) {
+      // Unknown room: nothing is checked, and nothing is held that others would wait for.
+      if (!room) return {};
+      g_reserved += bytes;
+      g_reserved_by_thread[std::this_thread::get_id()] += bytes;
+      return MemoryReservation(bytes, std::this_thread::get_id());
+    }
+    // Other threads' reservations turn into allocations the room then counts: wait for them
+    // when the block fits beside what is allocated now, never for this thread's own.
+    const auto mine = g_reserved_by_thread.find(std::this_thread::get_id());
+    const double own = mine == g_reserved_by_thread.end() ? 0.0 : mine->second;
+    if (bytes > left || g_reserved - own <= 0.0)
+      throw OutOfMemoryError(std::string(what) + " needs " + memory_size_text(bytes) +
+                             ", more than the " + memory_size_text(std::max(left, 0.0)) +
+                             " of memory left to this process; " + std::string(remedy));
+    g_reserved_released.wait(lock);
+  }
+}
+
 void require_memory(double bytes, std::string_view what, std::string_view remedy) {
-  const std::optional<std::size_t> room = available_memory_bytes();
-  if (!room || bytes <= static_cast<double>(*room)) return;
-  throw OutOfMemoryError(std::string(what) + " needs " + memory_size_text(bytes) +
-                         ", more than the " + memory_size_text(static_cast<double>(*room)) +
-                         " of memory left to this process; " + std::string(remedy));
+  reserve_memory(bytes, what, remedy).release();
 }
 
 }  // namespace mneedle

@@ -214,6 +214,7 @@ struct SparseSolver::Impl {
   bool trailing_ordered = false;
   std::size_t trailing_dofs = 0;  // of the last analysis (a later set_trailing_nodes waits)
   Eigen::MatrixXd trailing_factor;
+  MemoryReservation factor_reservation;  // from the analysis until the factor is allocated
 };
 
 SparseSolver::SparseSolver(int dofs_per_node) : impl_(std::make_unique<Impl>()) {
@@ -311,11 +312,13 @@ Eigen::SparseMatrix<double> permuted(
 // A factor that cannot fit in the memory left is refused before it is allocated, with what it
 // needs and what there is (docs/performance.md, "Memory"): otherwise the allocation fails deep
 // in CHOLMOD (read as "not positive definite") or the machine swaps for minutes.
-[[maybe_unused]] void check_factor_fits(double factor_bytes, Eigen::Index unknowns) {
-  require_memory(factor_bytes,
-                 "sparse solver: the factor of " + std::to_string(unknowns) + " unknowns",
-                 "a coarser fidelity, a smaller contact zone or fewer mesh refinement levels "
-                 "needs less");
+// The room stays reserved until the factor is allocated (SparseSolver::factorize), so that
+// `screen --jobs N`'s threads do not each count the same memory.
+[[maybe_unused]] MemoryReservation reserve_factor(double factor_bytes, Eigen::Index unknowns) {
+  return reserve_memory(factor_bytes,
+                        "sparse solver: the factor of " + std::to_string(unknowns) + " unknowns",
+                        "a coarser fidelity, a smaller contact zone or fewer mesh refinement "
+                        "levels needs less");
 }
 
 }  // namespace
@@ -386,7 +389,8 @@ void SparseSolver::analyze(const Eigen::SparseMatrix<double>& matrix) {
     return;
   }
 #ifdef MNEEDLE_HAVE_CHOLMOD
-  check_factor_fits(impl_->cholesky.factor_bytes(), matrix.rows());
+  impl_->factor_reservation.release();  // the previous analysis's, if never factorised
+  impl_->factor_reservation = reserve_factor(impl_->cholesky.factor_bytes(), matrix.rows());
 #endif
 }
 
@@ -394,6 +398,7 @@ void SparseSolver::factorize(const Eigen::SparseMatrix<double>& input) {
   if (input.rows() != impl_->rows || input.nonZeros() != impl_->nonzeros) analyze(input);
 #ifdef MNEEDLE_HAVE_CHOLMOD
   const bool factorized = impl_->cholesky.factorize(input);
+  impl_->factor_reservation.release();  // allocated now (or failed): the kernel counts it
 #else
   impl_->cholesky.factorize(input);
   const bool factorized = impl_->cholesky.info() == Eigen::Success;

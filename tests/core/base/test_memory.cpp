@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
+#include <thread>
+
 #include "mneedle/base/error.h"
 
 namespace {
@@ -96,6 +100,33 @@ TEST(Memory, RequireMemoryRefusesWhatExceedsTheMemoryLeftInOneLine) {
                  "a test block needs 2 MiB, more than the 0 MiB of memory left to this process; "
                  "ask for less");
   }
+}
+
+// Threads checking at once (`screen --jobs N`) see each other's reservations: a block that
+// fits beside what is allocated but not beside another thread's reservation waits for its
+// release; the same block beside this thread's own reservation, or one larger than the room, is
+// refused at once instead (waiting on oneself would never end).
+TEST(Memory, AnotherThreadsReservationIsWaitedForAndOnesOwnIsNot) {
+  constexpr double kMiB = 1024.0 * 1024.0;
+  set_memory_limit_bytes(mneedle::resident_memory_bytes() + (256u << 20));
+  {
+    mneedle::MemoryReservation first = mneedle::reserve_memory(160 * kMiB, "first", "-");
+    EXPECT_THROW(mneedle::reserve_memory(160 * kMiB, "again", "-"), mneedle::OutOfMemoryError);
+    EXPECT_THROW(mneedle::reserve_memory(300 * kMiB, "larger", "-"), mneedle::OutOfMemoryError);
+    std::atomic<bool> released{false}, taken{false};
+    std::thread other([&] {
+      const mneedle::MemoryReservation second = mneedle::reserve_memory(160 * kMiB, "second", "-");
+      EXPECT_TRUE(released.load());
+      taken = true;
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    EXPECT_FALSE(taken.load());
+    released = true;
+    first.release();
+    other.join();
+    EXPECT_TRUE(taken.load());
+  }
+  set_memory_limit_bytes(std::nullopt);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <thread>
 
 namespace mneedle {
 
@@ -30,9 +31,38 @@ void set_memory_limit_bytes(std::optional<std::size_t> bytes);
 /// A size as refusals print it: whole MiB below a GiB, GiB to two decimals from there.
 std::string memory_size_text(double bytes);
 
+/// Memory promised to a block about to be allocated (reserve_memory), counted as taken until
+/// released or destroyed: threads of one process that check at once (`screen --jobs N`) do not
+/// all count the same room. Move-only.
+class MemoryReservation {
+ public:
+  MemoryReservation() = default;
+  ~MemoryReservation();
+  MemoryReservation(MemoryReservation&& other) noexcept;
+  MemoryReservation& operator=(MemoryReservation&& other) noexcept;
+  MemoryReservation(const MemoryReservation&) = delete;
+  MemoryReservation& operator=(const MemoryReservation&) = delete;
+  /// Once the block is allocated: the kernel's counts hold it from then on.
+  void release();
+
+ private:
+  friend MemoryReservation reserve_memory(double, std::string_view, std::string_view);
+  MemoryReservation(double bytes, std::thread::id owner);
+  double bytes_ = 0.0;
+  std::thread::id owner_;
+};
+
+/// require_memory that keeps the room it found: the block counts against the memory left for
+/// every other check until the reservation is released. A block that fits beside what is
+/// allocated but not beside other threads' reservations waits for them (their blocks are then
+/// allocated and counted); one that does not fit even so, or that only this thread's own
+/// reservations stand in the way of, is refused. Nothing is held where the room is unknown.
+MemoryReservation reserve_memory(double bytes, std::string_view what, std::string_view remedy);
+
 /// Refuses, before it is allocated, what cannot fit: throws OutOfMemoryError "<what> needs <size>,
 /// more than the <size> of memory left to this process; <remedy>" when `bytes` exceed
-/// available_memory_bytes(). Nothing when the room is unknown.
+/// available_memory_bytes() less other threads' reservations (waiting for those as
+/// reserve_memory does). Nothing when the room is unknown.
 void require_memory(double bytes, std::string_view what, std::string_view remedy);
 
 /// "<number> <unit>" in bytes, the unit one of B, kB, MB, GB, TB (powers of 1000) or KiB, MiB,
