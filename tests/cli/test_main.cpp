@@ -705,8 +705,8 @@ TEST(WorkLimits, AFactorAboveTheMemoryLimitEndsTheRunInOneLineBeforeItIsAllocate
 // An address-space limit (`ulimit -v`, as batch systems set) counts as memory left: the run is
 // refused in one line with status 3. Before, CHOLMOD's solve crashed (status 139) and OpenBLAS
 // retried its work buffer's mmap for ever; 400 MB leaves no room for the fast skin run's
-// 69 MiB factor beside the process's mappings and OpenBLAS's buffers. AddressSanitizer's shadow
-// memory cannot be mapped under such a limit at all.
+// 69 MiB factor beside the process's mappings and OpenBLAS's buffers, 1.5 GB does.
+// AddressSanitizer's shadow memory cannot be mapped under such a limit at all.
 TEST(WorkLimits, AnAddressSpaceLimitEndsTheRunInOneLineInsteadOfAHangOrACrash) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "AddressSanitizer cannot start under ulimit -v";
@@ -715,13 +715,23 @@ TEST(WorkLimits, AnAddressSpaceLimitEndsTheRunInOneLineInsteadOfAHangOrACrash) {
   GTEST_SKIP() << "AddressSanitizer cannot start under ulimit -v";
 #endif
 #endif
-  const auto run = mneedle::test::run_command(
-      "ulimit -v 400000 && timeout 120 '" + mneedle::test::mneedle_binary() + "' simulate '" +
-      kRoot + "/designs/scenes/human_skin.toml' --fidelity fast --quiet");
+  // One OpenBLAS thread: a many-core machine's threads would not start under 400 MB at all.
+  const auto under = [](const std::string& kilobytes) {
+    return mneedle::test::run_command("ulimit -v " + kilobytes +
+                                      " && OPENBLAS_NUM_THREADS=1 timeout 120 '" +
+                                      mneedle::test::mneedle_binary() + "' simulate '" + kRoot +
+                                      "/designs/scenes/human_skin.toml' --fidelity fast --quiet");
+  };
+  const auto run = under("400000");
   EXPECT_EQ(run.exit_code, 3) << run.err;
   EXPECT_EQ(run.err.rfind("mneedle: error: ", 0), 0u) << run.err;
+  EXPECT_NE(run.err.find("the factor of"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("of memory left to this process"), std::string::npos) << run.err;
   EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  // 1.5 GB holds the run (about 0.3 GB mapped at the factorisation, a 69 MiB factor and the
+  // kept-back 256 MiB of OpenBLAS buffers).
+  const auto fits = under("1500000");
+  EXPECT_EQ(fits.exit_code, 0) << fits.err;
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "mneedle/base/memory.h"
 
+#include <sched.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -8,6 +9,7 @@
 #include <charconv>
 #include <cmath>
 #include <condition_variable>
+#include <cstdlib>
 #include <fstream>
 #include <iomanip>
 #include <iterator>
@@ -17,6 +19,7 @@
 #include <thread>
 #include <unordered_map>
 #include <utility>
+#include <vector>
 
 #include "mneedle/base/error.h"
 
@@ -24,9 +27,9 @@ namespace mneedle {
 
 namespace {
 
-// The limit set by set_memory_limit_bytes; 0 = none (a zero budget is not a useful limit).
 // OpenBLAS's work buffer (BUFFER_SIZE of Debian's build, seen in its mmap calls).
 constexpr std::size_t kBlasBufferBytes = std::size_t{128} << 20;
+// The limit set by set_memory_limit_bytes; 0 = none (a zero budget is not a useful limit).
 std::atomic<std::size_t> g_limit{0};
 
 std::optional<std::size_t> parse_count(std::string_view text) {
@@ -38,18 +41,63 @@ std::optional<std::size_t> parse_count(std::string_view text) {
   return value;
 }
 
+// The threads OpenBLAS runs, as it counts them: OPENBLAS_NUM_THREADS, GOTO_NUM_THREADS or
+// OMP_NUM_THREADS when set, else the CPUs this process may use.
+std::size_t blas_threads() {
+  for (const char* name : {"OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS"})
+    if (const char* value = std::getenv(name); value != nullptr)
+      if (const auto count = parse_count(value); count && *count > 0) return *count;
+  cpu_set_t cpus;
+  CPU_ZERO(&cpus);
+  if (sched_getaffinity(0, sizeof(cpus), &cpus) == 0 && CPU_COUNT(&cpus) > 0)
+    return static_cast<std::size_t>(CPU_COUNT(&cpus));
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
 std::string read_text(const char* path) {
   std::ifstream in(path);
   if (!in) return {};
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-// This process's cgroup v2 folder ("0::/path" in /proc/self/cgroup), empty when not on v2.
-std::string own_cgroup() {
+// This process's cgroup folders for the memory controller, from its own group up to the
+// hierarchy's root: cgroup v2 ("0::/path" in /proc/self/cgroup, under /sys/fs/cgroup) or v1
+// ("N:...memory...:/path", under /sys/fs/cgroup/memory). A limit on any of them caps the process.
+std::vector<std::string> own_cgroups(bool v2) {
   std::istringstream lines(read_text("/proc/self/cgroup"));
-  for (std::string line; std::getline(lines, line);)
-    if (line.rfind("0::", 0) == 0) return "/sys/fs/cgroup" + line.substr(3);
-  return {};
+  std::string path;
+  for (std::string line; std::getline(lines, line);) {
+    const auto first = line.find(':'), second = line.find(':', first + 1);
+    if (first == std::string::npos || second == std::string::npos) continue;
+    const std::string controllers = line.substr(first + 1, second - first - 1);
+    bool memory = false;
+    for (std::size_t at = 0; at <= controllers.size();) {
+      const auto end = std::min(controllers.find(',', at), controllers.size());
+      memory = memory || controllers.substr(at, end - at) == "memory";
+      at = end + 1;
+    }
+    if (v2 ? line.rfind("0::", 0) == 0 : memory) path = line.substr(second + 1);
+  }
+  if (path.empty() || path.front() != '/') return {};
+  const std::string mount = v2 ? "/sys/fs/cgroup" : "/sys/fs/cgroup/memory";
+  std::vector<std::string> chain;
+  for (;;) {
+    chain.push_back(mount + (path == "/" ? "" : path));
+    if (path == "/") break;
+    path = path.substr(0, std::max<std::size_t>(path.rfind('/'), 1));
+  }
+  return chain;
+}
+
+// The value of `key` at a line's start in a memory.stat text, nullopt when absent.
+std::optional<std::size_t> stat_value(std::string_view stat, std::string_view key) {
+  for (std::size_t at = stat.find(key); at != std::string_view::npos; at = stat.find(key, at + 1)) {
+    if (at != 0 && stat[at - 1] != '\n') continue;
+    std::string_view value = stat.substr(at + key.size());
+    if (value.empty() || value.front() != ' ') continue;  // a longer key
+    return parse_count(value.substr(1, value.find('\n') - 1));
+  }
+  return std::nullopt;
 }
 
 // Field `index` of /proc/self/statm (0: the address space, 1: the resident set), in bytes; 0
@@ -124,17 +172,26 @@ std::optional<std::size_t> cgroup_room_bytes(std::string_view max, std::string_v
   if (!limit || !used) return std::nullopt;
   // memory.current counts the group's page cache, which the kernel drops on demand: a container
   // that has just compiled the project sits near its limit with little of it held.
-  std::size_t cache = 0;
-  for (const std::string_view key : {"active_file ", "inactive_file "}) {
-    for (std::size_t at = stat.find(key); at != std::string_view::npos;
-         at = stat.find(key, at + 1)) {
-      if (at != 0 && stat[at - 1] != '\n') continue;  // a key at a line's start only
-      std::string_view value = stat.substr(at + key.size());
-      value = value.substr(0, value.find('\n'));
-      if (const auto bytes = parse_count(value)) cache += *bytes;
-      break;
-    }
-  }
+  const std::size_t cache =
+      stat_value(stat, "active_file").value_or(0) + stat_value(stat, "inactive_file").value_or(0);
+  const std::size_t held = *used > cache ? *used - cache : 0;
+  return *limit > held ? *limit - held : 0;
+}
+
+std::optional<std::size_t> cgroup_v1_room_bytes(std::string_view limit_in_bytes,
+                                                std::string_view usage_in_bytes,
+                                                std::string_view stat) {
+  const auto limit = parse_count(limit_in_bytes);
+  const auto used = parse_count(usage_in_bytes);
+  // No limit reads as the page counter's maximum (9223372036854771712 on 4 KiB pages).
+  if (!limit || !used || *limit >= (std::size_t{1} << 62)) return std::nullopt;
+  // The hierarchy's page cache (total_*) where the kernel gives it, else the group's own.
+  const auto total_active = stat_value(stat, "total_active_file");
+  const auto total_inactive = stat_value(stat, "total_inactive_file");
+  const std::size_t cache = total_active || total_inactive
+                                ? total_active.value_or(0) + total_inactive.value_or(0)
+                                : stat_value(stat, "active_file").value_or(0) +
+                                      stat_value(stat, "inactive_file").value_or(0);
   const std::size_t held = *used > cache ? *used - cache : 0;
   return *limit > held ? *limit - held : 0;
 }
@@ -144,18 +201,21 @@ std::optional<std::size_t> available_memory_bytes() {
   auto take = [&room](std::optional<std::size_t> other) {
     if (other) room = room ? std::min(*room, *other) : *other;
   };
-  const std::string group = own_cgroup();
-  if (!group.empty())
+  for (const std::string& group : own_cgroups(true))
     take(cgroup_room_bytes(read_text((group + "/memory.max").c_str()),
                            read_text((group + "/memory.current").c_str()),
                            read_text((group + "/memory.stat").c_str())));
+  for (const std::string& group : own_cgroups(false))
+    take(cgroup_v1_room_bytes(read_text((group + "/memory.limit_in_bytes").c_str()),
+                              read_text((group + "/memory.usage_in_bytes").c_str()),
+                              read_text((group + "/memory.stat").c_str())));
   // An address-space limit (ulimit -v, as batch systems set): mappings count, resident or not.
-  // OpenBLAS maps a work buffer per calling thread on first use and, when the limit refuses
-  // it, retries for ever (Debian's 0.3.21), so room for those is kept back.
+  // OpenBLAS maps a work buffer per thread on first use and, when the limit refuses it, retries
+  // for ever (Debian's 0.3.21), so room for one per thread and one more is kept back; buffers
+  // already mapped are then counted twice, which errs on refusing.
   if (rlimit space{}; getrlimit(RLIMIT_AS, &space) == 0 && space.rlim_cur != RLIM_INFINITY) {
     const auto limit = static_cast<std::size_t>(space.rlim_cur);
-    const std::size_t held =
-        statm_bytes(0) + kBlasBufferBytes * (std::thread::hardware_concurrency() + 1);
+    const std::size_t held = statm_bytes(0) + kBlasBufferBytes * (blas_threads() + 1);
     take(limit > held ? limit - held : 0);
   }
   if (const std::size_t limit = g_limit.load(); limit > 0) {
@@ -187,6 +247,7 @@ std::mutex g_reserved_mutex;
 std::condition_variable g_reserved_released;
 double g_reserved = 0.0;
 std::unordered_map<std::thread::id, double> g_reserved_by_thread;
+int g_reserve_waiters = 0;
 
 }  // namespace
 
@@ -222,7 +283,13 @@ void MemoryReservation::release() {
   g_reserved_released.notify_all();
 }
 
+int reserve_memory_waiters() {
+  const std::lock_guard<std::mutex> lock(g_reserved_mutex);
+  return g_reserve_waiters;
+}
+
 MemoryReservation reserve_memory(double bytes, std::string_view what, std::string_view remedy) {
+  if (!(bytes > 0.0)) return {};
   std::unique_lock<std::mutex> lock(g_reserved_mutex);
   for (;;) {
     const std::optional<std::size_t> room = available_memory_bytes();
@@ -235,14 +302,17 @@ MemoryReservation reserve_memory(double bytes, std::string_view what, std::strin
       return MemoryReservation(bytes, std::this_thread::get_id());
     }
     // Other threads' reservations turn into allocations the room then counts: wait for them
-    // when the block fits beside what is allocated now, never for this thread's own.
+    // when the block fits beside what is allocated now, and never while this thread holds one
+    // (two threads holding and waiting would wait for ever).
     const auto mine = g_reserved_by_thread.find(std::this_thread::get_id());
-    const double own = mine == g_reserved_by_thread.end() ? 0.0 : mine->second;
-    if (bytes > left || g_reserved - own <= 0.0)
+    const bool own = mine != g_reserved_by_thread.end();
+    if (bytes > left || own || g_reserved <= 0.0)
       throw OutOfMemoryError(std::string(what) + " needs " + memory_size_text(bytes) +
                              ", more than the " + memory_size_text(std::max(left, 0.0)) +
                              " of memory left to this process; " + std::string(remedy));
+    ++g_reserve_waiters;
     g_reserved_released.wait(lock);
+    --g_reserve_waiters;
   }
 }
 

@@ -884,6 +884,8 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
       InsertionStep twin;
       try {
         twin = cracked->advance_to(depth);
+      } catch (const OutOfMemoryError&) {
+        throw;  // the twin's memory, not its crack faces
       } catch (const SolverError& e) {
         // Name the twin: its failure ends the run, and on nonlinear layers the held crack faces
         // are the likely cause (docs/model.md, "Crack faces in contact").

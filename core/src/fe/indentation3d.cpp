@@ -325,11 +325,12 @@ struct Indentation3d::Impl {
   // The linear sticking path holds every captured node's compliance densely: over a flat end
   // under a fine contact zone that is thousands of nodes and tens of GB. What would not fit is
   // refused before it is allocated (docs/performance.md, "Memory").
-  static void require_contact_memory(double bytes, std::size_t nodes) {
-    require_memory(bytes,
-                   "3-D contact: the dense compliance of " + std::to_string(nodes) +
-                       " surface nodes held by the needle",
-                   "a coarser contact_zone or fidelity needs less");
+  // Held until the block is allocated, so that other threads (screen --jobs N) count it.
+  [[nodiscard]] static MemoryReservation reserve_contact_memory(double bytes, std::size_t nodes) {
+    return reserve_memory(bytes,
+                          "3-D contact: the dense compliance of " + std::to_string(nodes) +
+                              " surface nodes held by the needle",
+                          "a coarser contact_zone or fidelity needs less");
   }
 
   // The sticking path's surface rows (candidates, then the ring) eliminated last, so that their
@@ -354,6 +355,7 @@ struct Indentation3d::Impl {
           std::find(missing.begin(), missing.end(), c.node) == missing.end())
         missing.push_back(c.node);
     if (missing.empty()) return;
+    MemoryReservation reserved;
     {
       // What the new columns keep, and what computing them holds meanwhile: the contact block's
       // columns and (first nodes only) their fields, or one chunk's unit loads, its columns and
@@ -373,8 +375,8 @@ struct Indentation3d::Impl {
                          ? 0.0
                          : dofs * columns)
               : 3.0 * dofs * 3.0 * static_cast<double>(std::min(kColumnChunkNodes, missing.size()));
-      require_contact_memory(8.0 * (kept_rows * columns + meanwhile),
-                             column_cache.size() + missing.size());
+      reserved = reserve_contact_memory(8.0 * (kept_rows * columns + meanwhile),
+                                        column_cache.size() + missing.size());
     }
     if (solver.has_trailing_block()) {
       std::vector<Eigen::Index> at;
@@ -444,6 +446,7 @@ struct Indentation3d::Impl {
     cache_compliance_columns(found);
     const Eigen::Index old_columns = compliance.cols();
     const auto added = 3 * static_cast<Eigen::Index>(found.size());
+    MemoryReservation reserved;
     {
       // The grown compliance (copied while the old one is still held), the watched rows, and
       // the next condensed solve's dense matrix with its Cholesky factor.
@@ -451,9 +454,10 @@ struct Indentation3d::Impl {
       const double coupling = columns + static_cast<double>(active_pairs.size());
       const double watched_rows =
           watched_overflow ? 0.0 : 3.0 * static_cast<double>(watched.size());
-      require_contact_memory(8.0 * ((static_cast<double>(surface_rows()) + watched_rows) * columns +
-                                    2.0 * coupling * coupling),
-                             captured.size() + found.size());
+      reserved = reserve_contact_memory(
+          8.0 * ((static_cast<double>(surface_rows()) + watched_rows) * columns +
+                 2.0 * coupling * coupling),
+          captured.size() + found.size());
     }
     compliance.conservativeResize(surface_rows(), old_columns + added);
     const double watched_bytes =
@@ -1707,6 +1711,7 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
     // no step solves for the whole field (docs/performance.md, "The stress criterion's cost").
     run.watch_nodes(stress_probe->nodes());
   }
+  bool vtu_past = false;  // a step at or beyond vtu_depth_m was written
   for (int k = 1; k <= steps; ++k) {
     const double depth = options.depth * k / steps;
     Step3d step = run.advance_to(depth);
@@ -1732,8 +1737,9 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
             (needles[n].y == 0.0 && mesh.mirror_y0 ? 2.0 : 1.0) * crack_areas[n];
       }
     }
-    if (!options.vtu_directory.empty() &&
-        (options.vtu_depth_m <= 0.0 || depth <= options.vtu_depth_m * (1.0 + 1e-12))) {
+    const bool written = !options.vtu_directory.empty() && !vtu_past;
+    if (options.vtu_depth_m > 0.0 && depth >= options.vtu_depth_m * (1.0 - 1e-12)) vtu_past = true;
+    if (written) {
       const std::filesystem::path dir(options.vtu_directory);
       const std::string tissue = "step_" + std::to_string(k) + ".vtu",
                         needles_file = "needles_" + std::to_string(k) + ".vtu";

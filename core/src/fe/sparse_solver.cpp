@@ -419,8 +419,9 @@ void SparseSolver::factorize(const Eigen::SparseMatrix<double>& input) {
   // The fallback's simplicial factor has about the supernodal one's entries, each with its row
   // index (12 bytes), and the permuted copy of K comes on top: refused as the factor is when it
   // cannot fit (CHOLMOD itself fails this way when it ran out of memory).
+  MemoryReservation fallback;  // held while Eigen allocates the factor
   if (!impl_->indefinite_analyzed)
-    require_memory(
+    fallback = reserve_memory(
         1.5 * impl_->cholesky.factor_bytes() +
             (impl_->permuted ? 12.0 * static_cast<double>(input.nonZeros()) : 0.0),
         "sparse solver: the LDLT fallback for " + std::to_string(input.rows()) + " unknowns",

@@ -29,8 +29,9 @@ struct RunPlan {
   double full_block_y_m = 0.0;
   double axisymmetric_radius_m = 0.0;
   double depth_m = 0.0;  ///< the requested insertion depth: where the curve ends
-  /// Where progress lines and VTU steps end when the run goes deeper than depth_m to decide
-  /// where the ladder starts (docs/model.md, "Pre-puncture horizon"); 0: they end with the run.
+  /// Progress lines and VTU steps end with the first step at or beyond this depth when the run
+  /// goes deeper than depth_m to decide where the ladder starts (docs/model.md, "Pre-puncture
+  /// horizon"), as a run asked for that depth ends; 0: they end with the run.
   double shown_depth_m = 0.0;
   double horizon_m = 0.0;  ///< the pre-puncture model's depth (a rung of pre_puncture_horizon)
   int steps = 0;           ///< pre-puncture depth steps over the horizon

@@ -205,6 +205,7 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
   o.crack_face_contact = options.crack_face_contact;
   CrossingWatch watch(needles.size(), plan);
   int step_index = 0;
+  bool past_shown = false;
   o.on_step = [&](const fe::Step3d& step) {
     bool more = true;
     double force = 0.0;
@@ -212,8 +213,10 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
       more = watch.keep_going(i, sample_of(step.depth_m, step.needles[i], areas[i])) && more;
       force += step.needles[i].force_N;
     }
-    const bool shown =
-        plan.shown_depth_m <= 0.0 || step.depth_m <= plan.shown_depth_m * (1.0 + 1e-12);
+    // Through the first step at or beyond the shown depth, where a run asked for that depth
+    // stops.
+    const bool shown = plan.shown_depth_m <= 0.0 || !past_shown;
+    if (step.depth_m >= plan.shown_depth_m * (1.0 - 1e-12)) past_shown = true;
     if (options.on_progress && shown)
       options.on_progress("fe_3d", ++step_index, o.overrides.steps.value_or(o.steps), step.depth_m,
                           force);

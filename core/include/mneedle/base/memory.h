@@ -18,9 +18,10 @@ std::size_t peak_memory_bytes();
 std::size_t resident_memory_bytes();
 
 /// Memory this process may still take (bytes): the smallest of the kernel's MemAvailable
-/// (/proc/meminfo), the room left under its cgroup's memory.max (cgroup v2), the room left in
+/// (/proc/meminfo), the room left under the memory limits of its cgroup and every ancestor
+/// (cgroup v2 memory.max, v1 memory.limit_in_bytes), the room left in
 /// its address-space limit (RLIMIT_AS, `ulimit -v`; less OpenBLAS's work buffers, 128 MiB per
-/// hardware thread and one more) and the limit set with
+/// OpenBLAS thread and one more) and the limit set with
 /// set_memory_limit_bytes, of those that are known; nullopt when none is.
 std::optional<std::size_t> available_memory_bytes();
 
@@ -55,9 +56,12 @@ class MemoryReservation {
 /// require_memory that keeps the room it found: the block counts against the memory left for
 /// every other check until the reservation is released. A block that fits beside what is
 /// allocated but not beside other threads' reservations waits for them (their blocks are then
-/// allocated and counted); one that does not fit even so, or that only this thread's own
-/// reservations stand in the way of, is refused. Nothing is held where the room is unknown.
+/// allocated and counted); one that does not fit even so, or asked for by a thread that holds a
+/// reservation itself, is refused. Nothing is held where the room is unknown.
 MemoryReservation reserve_memory(double bytes, std::string_view what, std::string_view remedy);
+
+/// Threads waiting in reserve_memory now (tests).
+int reserve_memory_waiters();
 
 /// Refuses, before it is allocated, what cannot fit: throws OutOfMemoryError "<what> needs <size>,
 /// more than the <size> of memory left to this process; <remedy>" when `bytes` exceed
@@ -79,5 +83,13 @@ std::optional<std::size_t> meminfo_available_bytes(std::string_view meminfo);
 /// group is at its limit.
 std::optional<std::size_t> cgroup_room_bytes(std::string_view max, std::string_view current,
                                              std::string_view stat);
+
+/// The same under a cgroup v1 memory controller: memory.limit_in_bytes less
+/// memory.usage_in_bytes, the page cache (memory.stat's total_active_file and
+/// total_inactive_file, else active_file and inactive_file) not counted; nullopt when unlimited
+/// (2^62 bytes and more) or malformed.
+std::optional<std::size_t> cgroup_v1_room_bytes(std::string_view limit_in_bytes,
+                                                std::string_view usage_in_bytes,
+                                                std::string_view stat);
 
 }  // namespace mneedle

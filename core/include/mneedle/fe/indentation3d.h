@@ -174,8 +174,8 @@ struct Simulation3dOptions {
   /// steps.pvd (the collection, depth as time); files of an earlier run are removed first.
   std::string vtu_directory;
   std::string vtu_comment;  ///< written into every VTU and the .pvd (the run's provenance)
-  /// Steps deeper than this (m) write no VTU files (0: every step does): a run that goes on past
-  /// what its caller shows.
+  /// Steps after the first at or beyond this depth (m) write no VTU files (0: every step does):
+  /// a run that goes on past what its caller shows.
   double vtu_depth_m = 0.0;
   ContactMode contact = ContactMode::Sticking;
   /// Honoured: order, tip_size_m, growth, domain_scale (block size x and y), tolerance, steps,
