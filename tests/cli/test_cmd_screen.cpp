@@ -46,7 +46,8 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
   // each at the depth the README quotes (fast; standard and fine within 6 %). Pinned to 1 %: the
   // run is deterministic, so any move is a change of the model or the mesh to explain
   // (docs/validation.md, "The stress criterion in skin"; the cone moved 62.3 -> 62.8 um with the
-  // pointed-tip mesh rule of the axisymmetric model, docs/model.md "Mesh").
+  // pointed-tip mesh rule of the axisymmetric model, docs/model.md "Mesh"; the blunt bevel
+  // 100.0 -> 85.8 um with its flat meshed in cells of 2 L, docs/model.md "Tissue block and mesh").
   std::map<std::string, nlohmann::json> by_name;
   for (const auto& d : j["designs"]) {
     EXPECT_TRUE(d["ok"].get<bool>()) << d.dump();
@@ -57,7 +58,7 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
   }
   const std::vector<std::pair<std::string, double>> readme = {{"cone", 62.8e-6},
                                                               {"sharp_bevel", 65.4e-6},
-                                                              {"blunt_bevel", 100.0e-6},
+                                                              {"blunt_bevel", 85.81e-6},
                                                               {"cylinder", 148.0e-6}};
   for (std::size_t i = 0; i < readme.size(); ++i) {
     const auto& [name, depth] = readme[i];
@@ -86,25 +87,27 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
 
 // The README's claim on the same table at the finer levels: "`standard` and `fine` read each
 // within 6 % of these". Measured 2026-12-05 (standard / fine, um): cone 65.44 / 65.79, sharp
-// bevel 65.76 / 62.75, blunt bevel 101.79 / 104.51, cylinder 141.43 / 140.52; the largest gap to
-// fast is the cylinder's -5.1 % at fine (the sharp bevel's -4.1 %). Fine resolves the sharp bevel's
-// tip since 2026-12-06 (it read 68.97 um, +5.5 %, before; docs/model.md, "Tissue block and mesh").
+// bevel 65.76 / 62.75, blunt bevel 85.47 / 85.68 (2026-12-06, its flat meshed in cells of 2 L
+// at every level: 101.79 / 104.51 before, against fast's 100.0), cylinder 141.43 / 140.52; the
+// largest gap to fast is the cylinder's -5.1 % at fine (the sharp bevel's -4.1 %). Fine resolves
+// the sharp bevel's tip since 2026-12-06 (it read 68.97 um, +5.5 %, before; docs/model.md,
+// "Tissue block and mesh").
 // Each level is also pinned to 1 % of its own reading, so that a move inside the 6 % is seen and
 // explained.
 TEST(ScreenCommand, ReadmeMainJobReadsWithinSixPercentOfFastAtStandardAndFine) {
   const std::map<std::string, double> fast = {{"cone", 62.8e-6},
                                               {"sharp_bevel", 65.4e-6},
-                                              {"blunt_bevel", 100.0e-6},
+                                              {"blunt_bevel", 85.81e-6},
                                               {"cylinder", 148.0e-6}};
   const std::map<std::string, std::map<std::string, double>> level = {{"standard",
                                                                        {{"cone", 65.44e-6},
                                                                         {"sharp_bevel", 65.76e-6},
-                                                                        {"blunt_bevel", 101.79e-6},
+                                                                        {"blunt_bevel", 85.47e-6},
                                                                         {"cylinder", 141.43e-6}}},
                                                                       {"fine",
                                                                        {{"cone", 65.79e-6},
                                                                         {"sharp_bevel", 62.75e-6},
-                                                                        {"blunt_bevel", 104.51e-6},
+                                                                        {"blunt_bevel", 85.68e-6},
                                                                         {"cylinder", 140.52e-6}}}};
   for (const auto& [fidelity, depths] : level) {
     const auto run = run_mneedle("screen '" + kRoot + "/designs' --scene '" + kSkin +
@@ -127,6 +130,38 @@ TEST(ScreenCommand, ReadmeMainJobReadsWithinSixPercentOfFastAtStandardAndFine) {
     EXPECT_EQ(order.back(), "cylinder") << fidelity;
     EXPECT_EQ(order[2], "blunt_bevel") << fidelity;
   }
+}
+
+// The puncture depth is a continuous function of every design parameter (docs/model.md,
+// "Contact with the rigid needle (sticking)"): blunt bevels of 32 and 33 deg in skin read
+// 85.81 and 85.81 um at fast (2026-12-06), 45 deg 85.35 um. Until captures were grouped over a
+// fiftieth of the surface spacing instead of a quarter, the 33 deg bevel's first capture event
+// took a row of nodes 0.4 um beside its flat, whose face was 0.62 um above them against the
+// group's 0.625 um, pulled them onto the needle, and read 79.80 um: a 7 % step for one degree.
+// The three are pinned to 1 % (deterministic runs) and 32/33 deg asked to agree to 0.1 %.
+TEST(ScreenCommand, ABluntBevelsPunctureDepthDoesNotJumpWithItsBevelAngle) {
+  const fs::path dir = fs::temp_directory_path() / ("angles_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream list(dir / "designs.toml");
+  for (int angle : {32, 33, 45})
+    list << "[[designs]]\nname = \"blunt_" << angle
+         << "\"\nplugin = \"blunt_bevel\"\nbevel_angle = \"" << angle << " deg\"\n\n";
+  list.close();
+  const auto run = run_mneedle("screen '" + (dir / "designs.toml").string() + "' --scene '" +
+                               kSkin + "' --jobs 2 --json");
+  fs::remove_all(dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  std::map<std::string, double> depth;
+  for (const auto& d : j["designs"]) {
+    ASSERT_TRUE(d["punctured"].get<bool>()) << d.dump();
+    depth[d["design"].get<std::string>()] = d["puncture_depth_m"].get<double>();
+  }
+  ASSERT_EQ(depth.size(), 3u);
+  EXPECT_NEAR(depth["blunt_32"], 85.81e-6, 0.01 * 85.81e-6);
+  EXPECT_NEAR(depth["blunt_33"], 85.81e-6, 0.01 * 85.81e-6);
+  EXPECT_NEAR(depth["blunt_45"], 85.35e-6, 0.01 * 85.35e-6);
+  EXPECT_NEAR(depth["blunt_33"], depth["blunt_32"], 1e-3 * depth["blunt_32"]);
 }
 
 // The analytic model in skin: the stratum corneum spreads a flat punch's load as in the FE (the

@@ -53,11 +53,13 @@ std::string micrometres(double metres) {
 constexpr int kMaxCaptureRounds = 60;
 // Captures in depth order (advance_linear): a node's entry depth is bisected to
 // kCaptureBisection x the needle's radius; the nodes entering within kCaptureGroup x the radius
-// after the first are captured with it (1.15 um for paper A's needles; docs/model.md, "Contact
-// with the rigid needle (sticking)", has what the group length changed).
+// after the first are captured with it (1.15 um for paper A's needles), at most a fiftieth of the
+// surface's half spacing: a quarter took a node beside a flat that the flat's own hold keeps out,
+// and the depth jumped with the bevel angle (docs/model.md, "Contact with the rigid needle
+// (sticking)", has what the group length changed).
 constexpr double kCaptureBisection = 1e-5;
 constexpr double kCaptureGroup = 1e-2;
-constexpr double kCaptureGroupPerSpacing = 0.25;
+constexpr double kCaptureGroupPerSpacing = 0.02;
 constexpr int kMaxNewtonIterations = 40;
 constexpr int kMaxLineSearchHalvings = 6;
 constexpr int kMaxStepCuts = 12;

@@ -596,6 +596,46 @@ TEST(TissueMesh, TheFineLevelGradesItsMeshDownToAPointedTip) {
   EXPECT_GT(widest_at(generate_tissue_mesh(two), contact), 4.0 * at_tip);
 }
 
+// A flat first contact (a blunt bevel's flat, a cylinder's end) gets cells of 2 L over it and
+// 2 L beyond its outline at every level, where the stress criterion fires on the flat's rim:
+// the same mesh, node for node, as a scene's own zone of 2 L (docs/model.md, "Tissue block and
+// mesh"). Not where the level cannot resolve L (the silicone scenes' 0.15 um), not without a
+// criterion length, and not without refinement levels to bisect it out of (no error then: the
+// zone is the level's choice, not the user's).
+TEST(TissueMesh, AFlatFirstContactIsMeshedWithCellsOfTwiceTheCriterionLengthAtEveryLevel) {
+  const Eigen::Vector2d corner(60e-6, -40e-6);
+  const std::vector<Eigen::Vector2d> flat = {corner, corner + Eigen::Vector2d(50e-6, 0.0),
+                                             corner + Eigen::Vector2d(50e-6, 80e-6),
+                                             corner + Eigen::Vector2d(0.0, 80e-6)};
+  const Eigen::Vector2d middle = corner + Eigen::Vector2d(25e-6, 40e-6);
+  for (Fidelity fidelity : {Fidelity::Fast, Fidelity::Standard, Fidelity::Fine}) {
+    SCOPED_TRACE(static_cast<int>(fidelity));
+    TissueBlockSpec spec = paper_a_skin(fidelity, 2);
+    spec.sites.front().first_contact = flat;
+    spec.criterion_length = 10e-6;
+    const TetMesh shipped = generate_tissue_mesh(spec);
+    // Every top-layer cell over the flat: bisection's 40 um boxes halved to 20 um.
+    EXPECT_LE(boxes_near(shipped, middle, 25e-6).widest, 20e-6 * (1.0 + 1e-9));
+    auto asked = spec;
+    asked.overrides.contact_zone_size_m = 20e-6;
+    const TetMesh same = generate_tissue_mesh(asked);
+    ASSERT_EQ(shipped.nodes.size(), same.nodes.size());
+    for (std::size_t n = 0; n < shipped.nodes.size(); ++n)
+      ASSERT_EQ(shipped.nodes[n], same.nodes[n]);
+    auto no_length = spec;
+    no_length.criterion_length = 0.0;
+    no_length.overrides.refinement_levels = 2;
+    EXPECT_GT(boxes_near(generate_tissue_mesh(no_length), middle, 25e-6).widest, 20e-6);
+    auto tiny = spec;
+    tiny.criterion_length = 0.15e-6;
+    tiny.overrides.refinement_levels = 2;
+    EXPECT_GT(boxes_near(generate_tissue_mesh(tiny), middle, 25e-6).widest, 20e-6);
+    auto unrefined = spec;
+    unrefined.overrides.refinement_levels = 0;
+    EXPECT_GT(boxes_near(generate_tissue_mesh(unrefined), middle, 25e-6).widest, 20e-6);
+  }
+}
+
 // The contact zone's own grid lines and its grading toward the tip keep a symmetric needle's
 // mesh symmetric, so the half and quarter models stay exact with a zone (a cone's tip on the
 // axis).
