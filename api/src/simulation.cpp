@@ -114,6 +114,7 @@ nlohmann::json run_json(const InsertionRun& run, const Scene& scene) {
   if (run.min_dihedral_deg > 0.0) {
     mesh["min_dihedral_deg"] = run.min_dihedral_deg;
     mesh["max_aspect_ratio"] = run.max_aspect_ratio;
+    mesh["contact_zone_m"] = run.contact_zone_m;
   }
   nlohmann::json reductions = nlohmann::json::array();
   for (const Reduction& r : run.reductions) {
@@ -252,6 +253,17 @@ std::vector<std::string> stress_warnings(const InsertionRun& run, const Scene& s
                     format_quantity(top.strength ? top.strength->length : 0.0, Dimension::Length) +
                     ") is far below the mesh's elements, so the stress criterion cannot fire "
                     "(docs/model.md, \"Criteria\", stress)");
+  }
+  if (run.unresolved_flats > 0) {
+    const double widest =
+        fe::kMostFlatRadiusPerLength * (top.strength ? top.strength->length : 0.0);
+    out.push_back(scene.source_name + ": tissue.layers[0] '" + top.name +
+                  "': " + std::to_string(run.unresolved_flats) +
+                  " flat needle end(s) got no contact zone (wider than " +
+                  format_quantity(widest, Dimension::Length) +
+                  " in radius, or a mesh without refinement), so the stress at the flat's rim is "
+                  "read on coarse cells and the depth may be a fifth too deep; set "
+                  "model.contact_zone (docs/model.md, \"Tissue block and mesh\")");
   }
   return out;
 }

@@ -56,10 +56,12 @@ constexpr int kMaxCaptureRounds = 60;
 // after the first are captured with it (1.15 um for paper A's needles), at most a fiftieth of the
 // surface's half spacing: a quarter took a node beside a flat that the flat's own hold keeps out,
 // and the depth jumped with the bevel angle (docs/model.md, "Contact with the rigid needle
-// (sticking)", has what the group length changed).
+// (sticking)", has what the group length changed); never below kCaptureGroupBisections
+// bisection tolerances, which the bisection cannot tell apart.
 constexpr double kCaptureBisection = 1e-5;
 constexpr double kCaptureGroup = 1e-2;
 constexpr double kCaptureGroupPerSpacing = 0.02;
+constexpr double kCaptureGroupBisections = 4.0;
 constexpr int kMaxNewtonIterations = 40;
 constexpr int kMaxLineSearchHalvings = 6;
 constexpr int kMaxStepCuts = 12;
@@ -256,7 +258,10 @@ struct Indentation3d::Impl {
   // it: kCaptureGroup of the needle's radius, but no more than kCaptureGroupPerSpacing of the
   // surface's finest spacing, so that a group never spans the nodes of a resolved contact patch.
   double group_length() const {
-    return std::min(kCaptureGroup * capture_radius, kCaptureGroupPerSpacing * surface_spacing);
+    // Never below a few bisection tolerances: entries closer than that are not told apart.
+    return std::max(
+        std::min(kCaptureGroup * capture_radius, kCaptureGroupPerSpacing * surface_spacing),
+        kCaptureGroupBisections * kCaptureBisection * capture_radius);
   }
 
   // Rows of the sticking path's compliance: the candidates, then the ring.
@@ -1661,6 +1666,8 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   result.elements = static_cast<int>(mesh.elements.size());
   result.order = mesh.order;
   result.quality = mesh_quality(mesh);
+  result.contact_zone_m = mesh.contact_zone_m;
+  result.unresolved_flats = mesh.unresolved_flats;
   Indentation3dOptions solver_options;
   solver_options.contact = options.contact;
   if (options.overrides.tolerance) solver_options.tolerance = *options.overrides.tolerance;

@@ -101,9 +101,11 @@ struct AxisWindow {
 // FidelityOverrides::contact_zone_size_m.
 struct ContactZone {
   double size = 0.0;
-  double tip_size = 0.0;  ///< m, at a pointed first contact (0: no grading toward it)
-  double radius = 0.0;    ///< m, lateral reach beyond the outline (or beyond the needle's radius)
-  double depth = 0.0;     ///< m, below the surface
+  std::vector<char> around;  ///< per site: the zone refines there (every level's zone over a
+                             ///< flat covers only the flats that get one)
+  double tip_size = 0.0;     ///< m, at a pointed first contact (0: no grading toward it)
+  double radius = 0.0;  ///< m, lateral reach beyond the outline (or beyond the needle's radius)
+  double depth = 0.0;   ///< m, below the surface
 };
 
 // The fine level's own contact zone under one pointed tip with a criterion length L: cells of
@@ -139,14 +141,27 @@ bool fine_resolves_the_tip(const TissueBlockSpec& spec) {
 // stress criterion fires, lies in cells of about a needle radius, and paper A's blunt bevel in
 // skin read 100 / 102 / 104.5 um at fast / standard / fine; with it 85.8 / 85.5 / 85.7 um, and
 // a 3-D cylinder at fine 139.9 um against the axisymmetric model's 140.6 um (docs/validation.md,
-// "How fine the flat must be"). Cells of L read within 2 % of 2 L at 2-3 times the cost.
+// "How fine the flat must be"). Cells of L read 2 % shallower at fine (84.0 um), 4-6 % at fast
+// and standard, whose far field is too stiff to gain from them, at 2-3 times the cost.
 constexpr double kFlatZonePerLength = 2.0;
 
+// A site the flat zone is for: a flat first contact (two or more lowest points) under a
+// criterion length, TET10, no wider than kMostFlatRadiusPerLength L (the zone's cells grow as
+// (R / L)^2: a wider flat would cost more than the rest of the mesh; the silicone scenes' 0.15 um
+// against a 115 um needle is far beyond). Each site on its own, so that in an array a flat needle
+// gets its zone whatever its neighbours' tips.
+bool flat_wants_zone(const TissueBlockSpec& spec, const NeedleSite& site) {
+  return site.first_contact.size() >= 2 && spec.criterion_length > 0.0 && spec.order == 2;
+}
+bool flat_gets_zone(const TissueBlockSpec& spec, const NeedleSite& site, int levels) {
+  return levels > 0 && flat_wants_zone(spec, site) &&
+         site.radius <= kMostFlatRadiusPerLength * spec.criterion_length;
+}
+
 bool flat_zone_applies(const TissueBlockSpec& spec, int levels) {
-  if (levels <= 0 || spec.sites.empty()) return false;
   for (const NeedleSite& site : spec.sites)
-    if (site.first_contact.size() < 2 || !length_resolvable(spec, site.radius)) return false;
-  return true;
+    if (flat_gets_zone(spec, site, levels)) return true;
+  return false;
 }
 
 ContactZone contact_zone(const TissueBlockSpec& spec, int levels) {
@@ -163,9 +178,12 @@ ContactZone contact_zone(const TissueBlockSpec& spec, int levels) {
     zone.tip_size = kFineTipPerLength * spec.criterion_length;
   } else if (flat_zone_applies(spec, levels)) {
     zone.size = kFlatZonePerLength * spec.criterion_length;
+    for (const NeedleSite& site : spec.sites)
+      zone.around.push_back(flat_gets_zone(spec, site, levels) ? 1 : 0);
   } else {
     return zone;
   }
+  if (zone.around.empty()) zone.around.assign(spec.sites.size(), 1);
   zone.radius = spec.overrides.contact_zone_reach.value_or(kContactZoneReach) *
                 std::max(zone.size, spec.criterion_length);
   zone.depth = std::min(spec.layers.front().thickness, 2.0 * zone.radius);
@@ -195,7 +213,9 @@ double refinement_target(const Eigen::Vector3d& p, const std::vector<NeedleSite>
     MeshSizing graded = sizing;
     graded.fine_size = zone.size;
     const double under = -p.z() - zone.depth;
-    for (const NeedleSite& site : sites) {
+    for (std::size_t i = 0; i < sites.size(); ++i) {
+      const NeedleSite& site = sites[i];
+      if (!zone.around[i]) continue;
       const double lateral =
           (site.first_contact.empty() ? std::hypot(p.x() - site.x, p.y() - site.y) - site.radius
                                       : distance_to_outline(p.head<2>(), site.first_contact)) -
@@ -232,7 +252,9 @@ std::array<std::vector<AxisWindow>, 2> zone_windows(const TissueBlockSpec& spec,
   const double top_cell = z[z.size() - 1] - z[z.size() - 2];
   const double fine = kZoneBoxAspect * top_cell;
   if (fine >= lateral.fine_size) return windows;
-  for (const NeedleSite& site : spec.sites) {
+  for (std::size_t i = 0; i < spec.sites.size(); ++i) {
+    const NeedleSite& site = spec.sites[i];
+    if (!zone.around[i]) continue;
     Eigen::Vector2d lo(site.x - site.radius, site.y - site.radius),
         hi(site.x + site.radius, site.y + site.radius);
     if (!site.first_contact.empty()) {
@@ -766,6 +788,11 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   TetMesh mesh;
   mesh.order = spec.order;
   mesh.layers = spec.layers;
+  mesh.contact_zone_m = zone.size;
+  for (const NeedleSite& site : spec.sites)
+    if (flat_wants_zone(spec, site) && !flat_gets_zone(spec, site, levels) &&
+        !spec.overrides.contact_zone_size_m)
+      ++mesh.unresolved_flats;
   for (int a = 0; a < 3; ++a)
     mesh.grid_cells[static_cast<std::size_t>(a)] =
         static_cast<int>(axes[static_cast<std::size_t>(a)].size()) - 1;

@@ -115,6 +115,8 @@ struct PreResult {
   bool axisymmetric = false;
   double min_dihedral_deg = 0.0;
   double max_aspect_ratio = 0.0;
+  double contact_zone_m = 0.0;
+  int unresolved_flats = 0;
   std::string model;
   std::optional<fe::InpExport> exported;
 };
@@ -260,6 +262,8 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
   out.order = r.order;
   out.min_dihedral_deg = r.quality.min_dihedral_deg;
   out.max_aspect_ratio = r.quality.max_aspect_ratio;
+  out.contact_zone_m = r.contact_zone_m;
+  out.unresolved_flats = r.unresolved_flats;
   out.model = "fe_3d";
   out.exported = r.exported;
   return out;
@@ -1100,6 +1104,8 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     run.axisymmetric = pre.axisymmetric;
     run.min_dihedral_deg = pre.min_dihedral_deg;
     run.max_aspect_ratio = pre.max_aspect_ratio;
+    run.contact_zone_m = pre.contact_zone_m;
+    run.unresolved_flats = pre.unresolved_flats;
     bool any_post = false;
     for (std::size_t i = 0; i < needles.size(); ++i) {
       run.needles.push_back(assemble_needle(needles[i].name, pre.needles[i], plan, areas[i],

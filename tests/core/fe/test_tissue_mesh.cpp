@@ -577,7 +577,8 @@ TEST(TissueMesh, TheFineLevelGradesItsMeshDownToAPointedTip) {
   auto tiny = spec;
   tiny.criterion_length = 0.15e-6;
   EXPECT_GT(widest_at(generate_tissue_mesh(tiny), contact), 4.0 * at_tip);
-  // Standard, no criterion length, a flat first contact, two needles: fine's plain mesh.
+  // Standard, no criterion length, two needles: fine's plain mesh; a flat first contact: not
+  // fine's tip zone (the 2 L zone over a flat, far coarser than the tip's 0.12 L).
   auto standard = spec;
   standard.fidelity = Fidelity::Standard;
   EXPECT_GT(widest_at(generate_tissue_mesh(standard), contact), 4.0 * at_tip);
@@ -632,8 +633,47 @@ TEST(TissueMesh, AFlatFirstContactIsMeshedWithCellsOfTwiceTheCriterionLengthAtEv
     EXPECT_GT(boxes_near(generate_tissue_mesh(tiny), middle, 25e-6).widest, 20e-6);
     auto unrefined = spec;
     unrefined.overrides.refinement_levels = 0;
-    EXPECT_GT(boxes_near(generate_tissue_mesh(unrefined), middle, 25e-6).widest, 20e-6);
+    const TetMesh plain = generate_tissue_mesh(unrefined);
+    EXPECT_GT(boxes_near(plain, middle, 25e-6).widest, 20e-6);
+    // What the mesh says of its zone: the size, and a flat that asked for one and got none.
+    EXPECT_DOUBLE_EQ(shipped.contact_zone_m, 20e-6);
+    EXPECT_EQ(shipped.unresolved_flats, 0);
+    EXPECT_DOUBLE_EQ(plain.contact_zone_m, 0.0);
+    EXPECT_EQ(plain.unresolved_flats, 1);
   }
+}
+
+// Each flat on its own: beside a pointed tip a flat still gets its 2 L zone and the tip none; a
+// two-point first contact (a chisel's edge) is a flat too; a flat wider than
+// kMostFlatRadiusPerLength L gets none, and the mesh counts it.
+TEST(TissueMesh, EachFlatFirstContactGetsItsZoneWhateverItsNeighbours) {
+  TissueBlockSpec spec = paper_a_skin(Fidelity::Standard, 2);
+  spec.criterion_length = 10e-6;
+  const Eigen::Vector2d flat_at(-600e-6, 0.0), tip_at(600e-6, 0.0);
+  NeedleSite flat{flat_at.x(), 0.0, 115e-6}, pointed{tip_at.x(), 0.0, 115e-6};
+  flat.first_contact = {
+      flat_at + Eigen::Vector2d(-20e-6, -40e-6), flat_at + Eigen::Vector2d(20e-6, -40e-6),
+      flat_at + Eigen::Vector2d(20e-6, 40e-6), flat_at + Eigen::Vector2d(-20e-6, 40e-6)};
+  pointed.first_contact = {tip_at};
+  spec.sites = {flat, pointed};
+  const TetMesh mixed = generate_tissue_mesh(spec);
+  EXPECT_DOUBLE_EQ(mixed.contact_zone_m, 20e-6);
+  EXPECT_LE(boxes_near(mixed, flat_at, 25e-6).widest, 20e-6 * (1.0 + 1e-9));
+  EXPECT_GT(boxes_near(mixed, tip_at, 25e-6).widest, 20e-6);
+  // A chisel's edge: two lowest points.
+  auto chisel = spec;
+  chisel.sites = {flat};
+  chisel.sites.front().first_contact = {flat_at + Eigen::Vector2d(0.0, -40e-6),
+                                        flat_at + Eigen::Vector2d(0.0, 40e-6)};
+  EXPECT_LE(boxes_near(generate_tissue_mesh(chisel), flat_at, 25e-6).widest, 20e-6 * (1.0 + 1e-9));
+  // A flat 25 L + a hair in radius: no zone, counted.
+  auto wide = spec;
+  wide.sites = {flat};
+  wide.sites.front().radius = kMostFlatRadiusPerLength * 10e-6 * (1.0 + 1e-9);
+  const TetMesh unzoned = generate_tissue_mesh(wide);
+  EXPECT_DOUBLE_EQ(unzoned.contact_zone_m, 0.0);
+  EXPECT_EQ(unzoned.unresolved_flats, 1);
+  EXPECT_GT(boxes_near(unzoned, flat_at, 100e-6).widest, 20e-6);
 }
 
 // The contact zone's own grid lines and its grading toward the tip keep a symmetric needle's

@@ -26,7 +26,8 @@ struct FidelityOverrides {
   /// lowest points) is bisected down to this element size, within contact_zone_reach times the
   /// larger of it and the criterion length of that contact (docs/model.md, "Tissue block and
   /// mesh"; unset at every fidelity, but fine takes its own under one pointed tip with a
-  /// criterion length; without refinement levels, none).
+  /// criterion length, and every level one of 2 L over each flat first contact no wider than
+  /// kMostFlatRadiusPerLength L; without refinement levels, none).
   std::optional<double> contact_zone_size_m;
   /// The contact zone's lateral reach beyond the first contact, in multiples of the larger of
   /// its size and the criterion length (unset: kContactZoneReach).

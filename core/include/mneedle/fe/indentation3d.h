@@ -209,6 +209,8 @@ struct Simulation3dResult {
   int elements = 0;
   int order = 2;
   MeshQuality quality;
+  double contact_zone_m = 0.0;  ///< TetMesh::contact_zone_m of the mesh solved
+  int unresolved_flats = 0;     ///< TetMesh::unresolved_flats
   Timing3d timing;
   std::string solver_backend;
   std::optional<InpExport> exported;  ///< set when options.inp_path was written

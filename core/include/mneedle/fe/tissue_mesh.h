@@ -80,6 +80,10 @@ struct MeshSizing {
 /// (m, > 0) asks for at least two with 10-node elements.
 int default_refinement_levels(Fidelity fidelity, int order, double criterion_length = 0.0);
 
+/// Widest needle radius, in criterion lengths L, whose flat first contact every level meshes
+/// with cells of 2 L (docs/model.md, "Tissue block and mesh"): 250 um in skin's L = 10 um.
+inline constexpr double kMostFlatRadiusPerLength = 25.0;
+
 /// Widest tip element (TET10; half for TET4) per criterion length: docs/model.md, "Tissue block
 /// and mesh", "The stress criterion's length".
 inline constexpr double kTipElementsPerCriterionLength = 5.5;
@@ -107,6 +111,11 @@ struct TetMesh {
   bool mirror_y0 = false;
   /// Likewise x >= 0 and the plane x = 0 (u_x = 0 there).
   bool mirror_x0 = false;
+  /// m; the contact zone's cell size (a scene's, fine's own or every level's over a flat; 0:
+  /// none) and the flat first contacts that a criterion length asked a zone for and did not get
+  /// (wider than kMostFlatRadiusPerLength L): docs/model.md, "Tissue block and mesh".
+  double contact_zone_m = 0.0;
+  int unresolved_flats = 0;
 
   int nodes_per_element() const { return order == 1 ? 4 : 10; }
   const MaterialParameters& material_of(int element) const {

@@ -182,6 +182,10 @@ struct InsertionRun {
   bool axisymmetric = false;
   double min_dihedral_deg = 0.0;  ///< 3-D mesh quality (0 for the axisymmetric model)
   double max_aspect_ratio = 0.0;
+  /// m; the 3-D mesh's contact zone (0: none), and the flat first contacts whose stress
+  /// criterion asked for one and did not get it (docs/model.md, "Tissue block and mesh").
+  double contact_zone_m = 0.0;
+  int unresolved_flats = 0;
   double seconds = 0.0;
   /// Stored energy against the needle's work over the pre-puncture curve (empty for analytic
   /// runs); docs/model.md, "Energy check".
