@@ -360,6 +360,18 @@ TEST(CmdSimulate, ABluntBevelsFlatIsMeshedWithCellsOfTwiceTheCriterionLength) {
   EXPECT_GT(d / finer, 1.0);
 }
 
+// A scene's `contact_zone = "none"` trades the flat's zone for speed: the blunt bevel then reads
+// what the levels read before they took it, 100.03 um at fast (17 % deep; pinned to 1 %), with no
+// zone in the mesh and no warning (the scene asked for it).
+TEST(CmdSimulate, ASceneCanTurnTheFlatsZoneOffAndReadsTheUnresolvedDepth) {
+  const nlohmann::json j = simulate_with_zone("paper_a_skin_blunt_bevel.toml",
+                                              "contact_zone = \"none\"", "--fidelity fast");
+  ASSERT_TRUE(j.is_object());
+  EXPECT_DOUBLE_EQ(j["mesh"]["contact_zone_m"].get<double>(), 0.0);
+  EXPECT_TRUE(j["warnings"].empty()) << j["warnings"].dump();
+  EXPECT_NEAR(j["needles"][0]["puncture"]["depth_m"].get<double>(), 100.03e-6, 0.01 * 100.03e-6);
+}
+
 // A flat end wider than 25 L (250 um in radius in skin) gets no zone of its own: the run says so
 // in one warning naming the scene and the layer, and the mesh reports no zone. A 600 um cylinder
 // on the 3-D model at fast.

@@ -42,9 +42,9 @@ void validate(const TissueBlockSpec& spec) {
       (*spec.overrides.refinement_levels < 0 ||
        *spec.overrides.refinement_levels > kMaxRefinementLevels))
     bad_spec("overrides.refinement_levels", "must be 0 to " + std::to_string(kMaxRefinementLevels));
-  if (spec.overrides.contact_zone_size_m && (!(*spec.overrides.contact_zone_size_m > 0.0) ||
+  if (spec.overrides.contact_zone_size_m && (!(*spec.overrides.contact_zone_size_m >= 0.0) ||
                                              !std::isfinite(*spec.overrides.contact_zone_size_m)))
-    bad_spec("overrides.contact_zone_size_m", "must be positive and finite");
+    bad_spec("overrides.contact_zone_size_m", "must be positive (or 0: no zone) and finite");
   if (spec.overrides.contact_zone_reach && (!(*spec.overrides.contact_zone_reach > 0.0) ||
                                             !(*spec.overrides.contact_zone_reach <= 100.0)))
     bad_spec("overrides.contact_zone_reach", "must be in (0, 100]");
@@ -168,6 +168,8 @@ ContactZone contact_zone(const TissueBlockSpec& spec, int levels) {
   ContactZone zone;
   if (spec.layers.empty()) return zone;
   if (spec.overrides.contact_zone_size_m) {
+    // 0: no zone at all, not even the level's own (a scene's "none").
+    if (*spec.overrides.contact_zone_size_m == 0.0) return zone;
     zone.size = *spec.overrides.contact_zone_size_m;
     // At fine a zone given without a tip size keeps fine's own grading toward a pointed tip.
     const double fine_tip =
@@ -750,7 +752,8 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   const int levels = spec.overrides.refinement_levels.value_or(
       default_refinement_levels(spec.fidelity, spec.order, spec.criterion_length));
   // The zone is bisected out of a refined grid: without levels it would be silently nothing.
-  if (spec.overrides.contact_zone_size_m && levels == 0)
+  if (spec.overrides.contact_zone_size_m && *spec.overrides.contact_zone_size_m > 0.0 &&
+      levels == 0)
     bad_spec("overrides.contact_zone_size_m",
              "needs refinement levels (mesh_refinement >= 1; fast without the stress criterion "
              "and TET4 elements have none by default)");

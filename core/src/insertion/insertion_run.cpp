@@ -1005,7 +1005,8 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     options.overrides.contact_zone_tip_size_m = scene.model.contact_zone_tip;
   // A scene's zone is bisected out of a refined grid: say so in the scene's words, before any
   // mesh is built (the mesh generator refuses it too, in its own).
-  if (scene.model.contact_zone && requested.overrides.contact_zone_size_m == std::nullopt) {
+  if (scene.model.contact_zone && *scene.model.contact_zone > 0.0 &&
+      requested.overrides.contact_zone_size_m == std::nullopt) {
     const auto& top = scene.tissue.layers;
     const double length =
         scene.model.criterion == PunctureCriterion::Stress && !top.empty() && top.front().strength

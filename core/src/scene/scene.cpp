@@ -766,13 +766,19 @@ ModelOptions read_model(std::optional<Table> t, const Tissue& tissue) {
                                                                  {"free", CrackFaces::Free}})
                       .value_or(m.crack_faces);
   m.mesh_refinement = t->optional_count("mesh_refinement", 0, kMaxMeshRefinement);
-  m.contact_zone = t->optional_positive("contact_zone", Dimension::Length);
+  // "none" turns off every zone the levels would take (0 inside): speed for accuracy.
+  const toml::node* zone = t->get("contact_zone");
+  if (zone && zone->as_string() && zone->as_string()->get() == "none")
+    m.contact_zone = 0.0;
+  else
+    m.contact_zone = t->optional_positive("contact_zone", Dimension::Length);
   m.contact_zone_tip = t->optional_positive("contact_zone_tip", Dimension::Length);
-  if (m.contact_zone_tip && !m.contact_zone)
-    t->fail_key("contact_zone_tip", "grades the contact zone: give contact_zone too");
+  if (m.contact_zone_tip && !(m.contact_zone && *m.contact_zone > 0.0))
+    t->fail_key("contact_zone_tip",
+                "grades the contact zone: give contact_zone too (a size, not \"none\")");
   if (m.contact_zone_tip && m.contact_zone && *m.contact_zone_tip > *m.contact_zone)
     t->fail_key("contact_zone_tip", "must not exceed contact_zone");
-  if (m.contact_zone && m.mesh_refinement == 0)
+  if (m.contact_zone && *m.contact_zone > 0.0 && m.mesh_refinement == 0)
     t->fail_key("contact_zone", "is bisected out of a refined grid: needs mesh_refinement >= 1");
   t->finish();
   return m;

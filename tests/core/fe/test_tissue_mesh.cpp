@@ -640,6 +640,13 @@ TEST(TissueMesh, AFlatFirstContactIsMeshedWithCellsOfTwiceTheCriterionLengthAtEv
     EXPECT_EQ(shipped.unresolved_flats, 0);
     EXPECT_DOUBLE_EQ(plain.contact_zone_m, 0.0);
     EXPECT_EQ(plain.unresolved_flats, 1);
+    // A scene's "none" (0): no zone, and no flat counted as unresolved (the user's choice).
+    auto none = spec;
+    none.overrides.contact_zone_size_m = 0.0;
+    const TetMesh unzoned = generate_tissue_mesh(none);
+    EXPECT_DOUBLE_EQ(unzoned.contact_zone_m, 0.0);
+    EXPECT_EQ(unzoned.unresolved_flats, 0);
+    EXPECT_GT(boxes_near(unzoned, middle, 25e-6).widest, 20e-6);
   }
 }
 

@@ -154,6 +154,12 @@ TEST(Scene, AContactZoneAndItsTipSizeAreLengths) {
   EXPECT_DOUBLE_EQ(*s.model.contact_zone_tip, 0.3e-6);
   const Scene plain = parse(with("fidelity = \"standard\"", "fidelity = \"standard\""));
   EXPECT_FALSE(plain.model.contact_zone || plain.model.contact_zone_tip);
+  // "none": no zone at all, not even the level's own (0 inside), with or without refinement.
+  const Scene none = parse(with("fidelity = \"standard\"",
+                                "fidelity = \"standard\"\nmesh_refinement = 0\n"
+                                "contact_zone = \"none\""));
+  ASSERT_TRUE(none.model.contact_zone.has_value());
+  EXPECT_DOUBLE_EQ(*none.model.contact_zone, 0.0);
 }
 
 TEST(Scene, PlainNumbersAreSi) {
@@ -375,6 +381,10 @@ TEST(SceneErrors, AContactZoneTipNeedsItsZoneAndFitsInIt) {
                {"model.contact_zone_tip", "must not exceed contact_zone"});
   expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\ncontact_zone = \"0 um\""),
                {"test.toml:31:", "model.contact_zone", "must be positive"});
+  expect_error(with("fidelity = \"standard\"",
+                    "fidelity = \"standard\"\ncontact_zone = \"none\"\n"
+                    "contact_zone_tip = \"0.3 um\""),
+               {"model.contact_zone_tip", "give contact_zone too"});
   expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\ncontact_zone = \"6 s\""),
                {"test.toml:31:", "model.contact_zone"});
   expect_error(with("fidelity = \"standard\"",

@@ -132,7 +132,8 @@ struct ModelOptions {
   /// 3-D TET10 tissue mesh: element size (m) in the top layer around each needle's first
   /// contact, and the size it grades down to toward a pointed one (docs/model.md, "Tissue block
   /// and mesh", contact zone; docs/validation.md, "The 3-D model under a point load, resolved");
-  /// empty: no zone (every fidelity's default).
+  /// empty: the level's own (fine's under a pointed tip, every level's over a flat); 0 (the
+  /// scene's "none"): no zone at all.
   std::optional<double> contact_zone;
   std::optional<double> contact_zone_tip;
 
