@@ -281,17 +281,8 @@ TEST(CmdSimulate, ReadmeSiliconeFigurePuncturesWhereItsCaptionSays) {
   EXPECT_NEAR(p["depth_m"].get<double>(), 0.62e-3, 0.01 * 0.62e-3);
 }
 
-// The README's resolved 3-D depth in skin (docs/validation.md, "The 3-D model under a point load,
-// resolved"): paper A's sharp bevel with the scene's contact zone graded down to its tip punctures
-// at 61.47 um at standard (2026-12-05; the study's converged 63.4-63.8 um at fine's growth,
-// standard's 1.8 reads 3-4 % low), where standard alone reads 65.8 um, 7 % deeper. It read 61.09 um
-// while a capture event took every node entering within 1.15 um of depth with it (110 nodes at the
-// first contact; with groups of at most a quarter of the surface's finest spacing 85 nodes were
-// captured over 74 events, and a fiftieth, since 2026-12-06, reads the same). Pinned to 1 % (a
-// mesh-converged FE number: a move is a change to explain); the gap to the plain level is asked to
-// stay at least 5 % (7 % measured). 8 s, release only. `simulate --json` of a shipped skin scene
-// with `zone_keys` added to its [model] table (after its fidelity); the whole output (null when the
-// run failed).
+// `simulate --json` of a shipped skin scene with `zone_keys` added to its [model] table (after
+// its fidelity); the whole output (null when the run failed).
 nlohmann::json simulate_with_zone(const std::string& scene, const std::string& zone_keys,
                                   const std::string& arguments) {
   const std::string source = std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/" + scene;
@@ -323,6 +314,15 @@ std::pair<nlohmann::json, nlohmann::json> punctures_with_zone(const std::string&
           nlohmann::json::parse(plain.out)["needles"][0]["puncture"]};
 }
 
+// The README's resolved 3-D depth in skin (docs/validation.md, "The 3-D model under a point load,
+// resolved"): paper A's sharp bevel with the scene's contact zone graded down to its tip punctures
+// at 61.47 um at standard (2026-12-05; the study's converged 63.4-63.8 um at fine's growth,
+// standard's 1.8 reads 3-4 % low), where standard alone reads 65.8 um, 7 % deeper. It read 61.09 um
+// while a capture event took every node entering within 1.15 um of depth with it (110 nodes at the
+// first contact; with groups of at most a quarter of the surface's finest spacing 85 nodes were
+// captured over 74 events; with a fiftieth, since 2026-12-06, it reads 61.470 um). Pinned to 1 % (a
+// mesh-converged FE number: a move is a change to explain); the gap to the plain level is asked to
+// stay at least 5 % (7 % measured). 8 s, release only.
 TEST(CmdSimulate, ASharpBevelWithItsTipResolvedPuncturesSkinShallowerThanTheShippedLevelReadsIt) {
   const auto [r, q] =
       punctures_with_zone("paper_a_skin_sharp_bevel.toml",

@@ -768,8 +768,12 @@ ModelOptions read_model(std::optional<Table> t, const Tissue& tissue) {
   m.mesh_refinement = t->optional_count("mesh_refinement", 0, kMaxMeshRefinement);
   // "none" turns off every zone the levels would take (0 inside): speed for accuracy.
   const toml::node* zone = t->get("contact_zone");
-  if (zone && zone->as_string() && zone->as_string()->get() == "none")
+  const auto* word = zone ? zone->as_string() : nullptr;
+  if (word && word->get() == "none")
     m.contact_zone = 0.0;
+  else if (word && word->get().find_first_of("0123456789") == std::string::npos)
+    t->fail_key("contact_zone",
+                "expected a length such as \"6 um\", or \"none\"; got \"" + word->get() + "\"");
   else
     m.contact_zone = t->optional_positive("contact_zone", Dimension::Length);
   m.contact_zone_tip = t->optional_positive("contact_zone_tip", Dimension::Length);

@@ -385,6 +385,9 @@ TEST(SceneErrors, AContactZoneTipNeedsItsZoneAndFitsInIt) {
                     "fidelity = \"standard\"\ncontact_zone = \"none\"\n"
                     "contact_zone_tip = \"0.3 um\""),
                {"model.contact_zone_tip", "give contact_zone too"});
+  expect_error(
+      with("fidelity = \"standard\"", "fidelity = \"standard\"\ncontact_zone = \"nothing\""),
+      {"test.toml:31:", "model.contact_zone", "or \"none\"", "\"nothing\""});
   expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\ncontact_zone = \"6 s\""),
                {"test.toml:31:", "model.contact_zone"});
   expect_error(with("fidelity = \"standard\"",
