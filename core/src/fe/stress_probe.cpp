@@ -188,6 +188,24 @@ ElementField element_field(const TetMesh& mesh, const Eigen::VectorXd& u, std::s
   return field;
 }
 
+// An element's corners (local indices) in an order that its mirror images across x = 0 and
+// y = 0 share: by depth, then |x|, then |y| (then x, y for corners that tie, which lie on
+// opposite sides of a plane no element of a mirrored model straddles). The eight-way split's
+// inner diagonal, hence where a ball's edge cuts the pieces, follows the corner order, so in the
+// mesh's own order a half model's balls and the whole block's were cut differently and read
+// 0.05-0.3 % apart (docs/model.md, "Tip stress").
+std::array<int, 4> canonical_corners(const TetMesh& mesh, std::size_t e) {
+  std::array<int, 4> order = {0, 1, 2, 3};
+  const auto& element = mesh.elements[e];
+  const auto key = [&](int a) {
+    const Eigen::Vector3d& p =
+        mesh.nodes[static_cast<std::size_t>(element[static_cast<std::size_t>(a)])];
+    return std::array<double, 5>{p.z(), std::abs(p.x()), std::abs(p.y()), p.x(), p.y()};
+  };
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
+  return order;
+}
+
 // The 8^levels equal sub-tetrahedra of the reference element in barycentric corners (the
 // eight-way split halves every edge; its children have equal volume).
 std::vector<std::array<Barycentric, 4>> sub_tetrahedra(int levels) {
@@ -388,10 +406,11 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
     const int level = probe_level(reach, length_m);
     const std::size_t first = subdivision_offset(level), count = std::size_t{1} << (3 * level);
     const double volume = tet_volume(corners) / static_cast<double>(count);
+    const std::array<int, 4> order = canonical_corners(mesh, e);
     for (std::size_t k = first; k < first + count; ++k) {
       const Barycentric l = centroid_of(subs[k]);
-      const Eigen::Vector3d x =
-          l(0) * corners[0] + l(1) * corners[1] + l(2) * corners[2] + l(3) * corners[3];
+      Eigen::Vector3d x = Eigen::Vector3d::Zero();
+      for (int a = 0; a < 4; ++a) x += l(a) * corners[static_cast<std::size_t>(order[a])];
       points_.push_back({x, volume, static_cast<int>(e), static_cast<int>(k)});
     }
     // Every node a centre, midside nodes too: with corners only the STL cone's peak read lower
@@ -428,11 +447,14 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
   for (std::size_t i = 0; i < points_.size(); ++i) {
     const auto& element = mesh.elements[static_cast<std::size_t>(points_[i].element)];
     const std::array<Barycentric, 4>& sub = subs[static_cast<std::size_t>(points_[i].sub)];
+    const std::array<int, 4> order =
+        canonical_corners(mesh, static_cast<std::size_t>(points_[i].element));
     std::array<Eigen::Vector3d, 4> corners;
     for (std::size_t v = 0; v < 4; ++v) {
       Eigen::Vector3d x = Eigen::Vector3d::Zero();
       for (int a = 0; a < 4; ++a)
-        x += sub[v](a) * mesh.nodes[static_cast<std::size_t>(element[static_cast<std::size_t>(a)])];
+        x += sub[v](a) *
+             mesh.nodes[static_cast<std::size_t>(element[static_cast<std::size_t>(order[a])])];
       corners[v] = x;
       sub_reach[i] = std::max(sub_reach[i], (x - points_[i].x).norm());
     }
@@ -543,18 +565,25 @@ std::vector<double> PeakStressProbe::peak(const Eigen::VectorXd& u,
   for (int e : elements_) {
     const ElementField field =
         element_field(mesh, u, static_cast<std::size_t>(e), material, all_linear);
+    // The sub-points' barycentrics are over the canonical corners; the field's over the local.
+    const std::array<int, 4> order = canonical_corners(mesh, static_cast<std::size_t>(e));
+    const auto local = [&](const Barycentric& l) {
+      Barycentric out;
+      for (int a = 0; a < 4; ++a) out(order[static_cast<std::size_t>(a)]) = l(a);
+      return out;
+    };
     if (all_linear) {
       Eigen::Matrix3d at_corner[4];
       for (int c = 0; c < 4; ++c) at_corner[c] = field.cauchy(corner[c]);
       for (; i < points_.size() && points_[i].element == e; ++i) {
-        const Barycentric l = centroid_of(subs[static_cast<std::size_t>(points_[i].sub)]);
+        const Barycentric l = local(centroid_of(subs[static_cast<std::size_t>(points_[i].sub)]));
         stress[i] = largest(l(0) * at_corner[0] + l(1) * at_corner[1] + l(2) * at_corner[2] +
                             l(3) * at_corner[3]);
       }
     } else {
       for (; i < points_.size() && points_[i].element == e; ++i)
         stress[i] =
-            field.max_principal(centroid_of(subs[static_cast<std::size_t>(points_[i].sub)]));
+            field.max_principal(local(centroid_of(subs[static_cast<std::size_t>(points_[i].sub)])));
     }
   }
   assert(i == points_.size() && "the probe's sub-points are grouped by element");
