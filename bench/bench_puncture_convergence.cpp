@@ -18,8 +18,9 @@
 // (FidelityOverrides::contact_zone_size_m, docs/validation.md "The stress criterion in skin");
 // --zone-reach K: its lateral reach in multiples of max(UM, the criterion length)
 // (contact_zone_reach); --tip-size UM: inside the zone, elements graded down to UM toward a
-// pointed first contact (contact_zone_tip_size_m); --resolution N: the needle plugin's polygon
-// segments (default 64).
+// pointed first contact (contact_zone_tip_size_m); --through-top N: N elements through the top
+// layer's thickness (elements_through_top); --resolution N: the needle plugin's polygon segments
+// (default 64).
 // --level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS] (repeatable): run these levels instead of
 // the fidelities (errors are against the last one listed; --refine does not apply; SPACINGS are
 // TET10 node spacings per radius), each the given fidelity with its tip size, growth,
@@ -69,6 +70,7 @@ struct Options {
   std::optional<double>
       contact_zone_m;                // --contact-zone UM: FidelityOverrides::contact_zone_size_m
   std::optional<double> zone_reach;  // --zone-reach K: FidelityOverrides::contact_zone_reach
+  std::optional<int> through_top;    // --through-top N: FidelityOverrides::elements_through_top
   std::optional<double> tip_size_m;  // --tip-size UM: FidelityOverrides::contact_zone_tip_size_m
   std::optional<int> resolution;     // --resolution N: the plugin's segments
   std::vector<std::string> needles;
@@ -146,6 +148,8 @@ Options parse(int argc, char** argv) {
       o.full3d = true;
     } else if (a == "--contact-zone" && i + 1 < argc) {
       o.contact_zone_m = std::atof(argv[++i]) * 1e-6;
+    } else if (a == "--through-top" && i + 1 < argc) {
+      o.through_top = std::atoi(argv[++i]);
     } else if (a == "--tip-size" && i + 1 < argc) {
       o.tip_size_m = std::atof(argv[++i]) * 1e-6;
     } else if (a == "--zone-reach" && i + 1 < argc) {
@@ -173,7 +177,8 @@ Options parse(int argc, char** argv) {
     } else {
       std::cerr << "usage: bench_puncture_convergence [--criterion C] [--no-finer] [--finest] "
                    "[--refine N] [--tissue silicone|skin] [--frictionless] [--model3d] "
-                   "[--contact-zone UM] [--zone-reach K] [--tip-size UM] [--resolution N] "
+                   "[--contact-zone UM] [--zone-reach K] [--tip-size UM] [--through-top N] "
+                   "[--resolution N] "
                    "[--level LABEL=FIDELITY,SPACINGS,GROWTH,REFINE[,STEPS]]... [sharp_bevel] "
                    "[blunt_bevel] "
                    "[cylinder] [cone]\n";
@@ -202,6 +207,7 @@ std::vector<Level> levels(const Scene& scene, const PreparedNeedle& needle, cons
     r.overrides.contact_zone_size_m = o.contact_zone_m;
     r.overrides.contact_zone_reach = o.zone_reach;
     r.overrides.contact_zone_tip_size_m = o.tip_size_m;
+    r.overrides.elements_through_top = o.through_top;
     if (o.full3d) r.model = PreModel::Full3d;
     return r;
   };
