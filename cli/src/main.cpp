@@ -9,6 +9,8 @@
 #include "commands.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/memory.h"
+#include "mneedle/base/text.h"
+#include "mneedle/fe/sparse_solver.h"
 #include "run_provenance.h"
 
 int main(int argc, char** argv) {
@@ -64,6 +66,15 @@ int main(int argc, char** argv) {
       } catch (const mneedle::InputError& e) {
         if (!asks_help) throw mneedle::InputError(std::string("MNEEDLE_MEMORY_LIMIT: ") + e.what());
       }
+    }
+    // Huge pages for the factor, on unless turned off (docs/cli.md, "Environment").
+    if (const char* huge = std::getenv("MNEEDLE_HUGE_PAGES"); huge != nullptr && *huge) {
+      const std::string value(mneedle::trim(huge));
+      if (value == "on" || value == "off")
+        mneedle::fe::set_huge_pages(value == "on");
+      else if (!asks_help)
+        throw mneedle::InputError("MNEEDLE_HUGE_PAGES: must be \"on\" or \"off\", got '" + value +
+                                  "'");
     }
     app.parse(argc, argv);
   } catch (const mneedle::cli::QuietExit& e) {

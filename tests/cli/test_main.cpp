@@ -702,6 +702,32 @@ TEST(WorkLimits, AFactorAboveTheMemoryLimitEndsTheRunInOneLineBeforeItIsAllocate
             0);
 }
 
+// MNEEDLE_HUGE_PAGES (docs/cli.md, "Environment"): "off" takes the factor from ordinary pages and
+// changes no result (the skin scene at fast: the same puncture to the last bit); any other value
+// than "on" or "off" is bad input, one line naming the variable; help still answers.
+TEST(Environment, HugePagesOffChangesNoResultAndABadValueIsOneLine) {
+  const std::string run = "' simulate '" + kRoot + "/designs/scenes/human_skin.toml' --fidelity " +
+                          "fast --quiet --json";
+  const auto on = mneedle::test::run_command("'" + mneedle::test::mneedle_binary() + run);
+  const auto off = mneedle::test::run_command("MNEEDLE_HUGE_PAGES=off '" +
+                                              mneedle::test::mneedle_binary() + run);
+  ASSERT_EQ(on.exit_code, 0) << on.err;
+  ASSERT_EQ(off.exit_code, 0) << off.err;
+  const auto a = nlohmann::json::parse(on.out)["needles"][0]["puncture"];
+  const auto b = nlohmann::json::parse(off.out)["needles"][0]["puncture"];
+  EXPECT_EQ(a["depth_m"].get<double>(), b["depth_m"].get<double>());
+  EXPECT_EQ(a["force_N"].get<double>(), b["force_N"].get<double>());
+  const auto bad = mneedle::test::run_command("MNEEDLE_HUGE_PAGES=maybe '" +
+                                              mneedle::test::mneedle_binary() + run);
+  EXPECT_EQ(bad.exit_code, 1) << bad.err;
+  EXPECT_EQ(bad.err,
+            "mneedle: error: MNEEDLE_HUGE_PAGES: must be \"on\" or \"off\", got 'maybe'\n");
+  EXPECT_EQ(mneedle::test::run_command("MNEEDLE_HUGE_PAGES=maybe '" +
+                                       mneedle::test::mneedle_binary() + "' --help")
+                .exit_code,
+            0);
+}
+
 // An address-space limit (`ulimit -v`, as batch systems set) counts as memory left: the run is
 // refused in one line with status 3. Before, CHOLMOD's solve crashed (status 139) and OpenBLAS
 // retried its work buffer's mmap for ever; 400 MB leaves no room for the fast skin run's

@@ -2,6 +2,7 @@
 
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
@@ -20,6 +21,17 @@
 namespace mneedle::fe {
 
 namespace {
+std::atomic<bool> huge_pages_on{true};
+}  // namespace
+
+void set_huge_pages(bool on) {
+  huge_pages_on.store(on, std::memory_order_relaxed);
+}
+bool huge_pages() {
+  return huge_pages_on.load(std::memory_order_relaxed);
+}
+
+namespace {
 #ifdef MNEEDLE_HAVE_CHOLMOD
 constexpr const char* kCholeskyName = "cholmod-supernodal-llt";
 
@@ -27,13 +39,14 @@ constexpr const char* kCholeskyName = "cholmod-supernodal-llt";
 // pages where the kernel gives them on request (THP "madvise", Debian's default). The first touch
 // of each 4 KiB page is a page fault, and on the 2-core VMs we run on those faults were a quarter
 // of a skin run (docs/performance.md, "Where the time goes"). The advice is only advice: where
-// huge pages are off the memory is ordinary. Blocks come from posix_memalign, so CHOLMOD's
-// free() and realloc() stay valid for them.
+// huge pages are off the memory is ordinary, as it is after set_huge_pages(false) (a VM that
+// hands free memory back to its host: docs/performance.md, "Huge pages, measured again"). Blocks
+// come from posix_memalign, so CHOLMOD's free() and realloc() stay valid for them.
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
 constexpr std::size_t kHugeBlock = 4 * kHugePage;
 
 void* huge_page_malloc(std::size_t bytes) {
-  if (bytes < kHugeBlock) return std::malloc(bytes);
+  if (bytes < kHugeBlock || !huge_pages()) return std::malloc(bytes);
   void* block = nullptr;
   if (posix_memalign(&block, kHugePage, bytes) != 0) return nullptr;
   madvise(block, bytes / kHugePage * kHugePage, MADV_HUGEPAGE);

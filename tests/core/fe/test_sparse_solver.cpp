@@ -209,6 +209,27 @@ TEST(SparseSolver, AFactorLargeEnoughForHugePagesSolvesToRoundoff) {
   }
 }
 
+// set_huge_pages(false) (MNEEDLE_HUGE_PAGES=off, docs/cli.md "Environment") takes the same
+// large blocks from ordinary pages: the factor and every solve are bit for bit those of the
+// advised run, since only where the memory comes from changes.
+TEST(SparseSolver, HugePagesOffSolvesBitForBitAsOn) {
+  const SpMat matrix = nodal_system(14, 0.05);
+  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(matrix.rows(), -1.0, 1.0);
+  ASSERT_TRUE(mneedle::fe::huge_pages());  // the default
+  mneedle::fe::SparseSolver on(3);
+  on.factorize(matrix);
+  const Eigen::VectorXd x_on = on.solve(rhs);
+  mneedle::fe::set_huge_pages(false);
+  EXPECT_FALSE(mneedle::fe::huge_pages());
+  mneedle::fe::SparseSolver off(3);
+  off.factorize(matrix);
+  const Eigen::VectorXd x_off = off.solve(rhs);
+  mneedle::fe::set_huge_pages(true);
+  ASSERT_TRUE(off.ok());
+  EXPECT_EQ(off.factor_nonzeros(), on.factor_nonzeros());
+  EXPECT_EQ((x_off - x_on).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(SparseSolver, OrderingByNodeFindsTheFillOfOrderingByDof) {
   // The point of the nodal order is its cost, not a different factor: the fill must stay that of
   // CHOLMOD's own choice (AMD or METIS on the dofs).
