@@ -708,7 +708,8 @@ TEST(WorkLimits, AFactorAboveTheMemoryLimitEndsTheRunInOneLineBeforeItIsAllocate
 TEST(Environment, HugePagesOffChangesNoResultAndABadValueIsOneLine) {
   const std::string run = "' simulate '" + kRoot + "/designs/scenes/human_skin.toml' --fidelity " +
                           "fast --quiet --json";
-  const auto on = mneedle::test::run_command("'" + mneedle::test::mneedle_binary() + run);
+  const auto on =
+      mneedle::test::run_command("MNEEDLE_HUGE_PAGES=on '" + mneedle::test::mneedle_binary() + run);
   const auto off = mneedle::test::run_command("MNEEDLE_HUGE_PAGES=off '" +
                                               mneedle::test::mneedle_binary() + run);
   ASSERT_EQ(on.exit_code, 0) << on.err;

@@ -39,17 +39,18 @@ constexpr const char* kCholeskyName = "cholmod-supernodal-llt";
 // pages where the kernel gives them on request (THP "madvise", Debian's default). The first touch
 // of each 4 KiB page is a page fault, and on the 2-core VMs we run on those faults were a quarter
 // of a skin run (docs/performance.md, "Where the time goes"). The advice is only advice: where
-// huge pages are off the memory is ordinary, as it is after set_huge_pages(false) (a VM that
-// hands free memory back to its host: docs/performance.md, "Huge pages, measured again"). Blocks
-// come from posix_memalign, so CHOLMOD's free() and realloc() stay valid for them.
+// huge pages are off the memory is ordinary. After set_huge_pages(false) the same blocks are
+// advised away from huge pages (a VM that hands free memory back to its host:
+// docs/performance.md, "Huge pages, measured again"), which also holds where THP is "always".
+// Blocks come from posix_memalign, so CHOLMOD's free() and realloc() stay valid for them.
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
 constexpr std::size_t kHugeBlock = 4 * kHugePage;
 
 void* huge_page_malloc(std::size_t bytes) {
-  if (bytes < kHugeBlock || !huge_pages()) return std::malloc(bytes);
+  if (bytes < kHugeBlock) return std::malloc(bytes);
   void* block = nullptr;
   if (posix_memalign(&block, kHugePage, bytes) != 0) return nullptr;
-  madvise(block, bytes / kHugePage * kHugePage, MADV_HUGEPAGE);
+  madvise(block, bytes / kHugePage * kHugePage, huge_pages() ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
   return block;
 }
 

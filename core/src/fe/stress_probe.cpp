@@ -193,7 +193,7 @@ ElementField element_field(const TetMesh& mesh, const Eigen::VectorXd& u, std::s
 // opposite sides of a plane no element of a mirrored model straddles). The eight-way split's
 // inner diagonal, hence where a ball's edge cuts the pieces, follows the corner order, so in the
 // mesh's own order a half model's balls and the whole block's were cut differently and read
-// 0.05-0.3 % apart (docs/model.md, "Tip stress").
+// 0.05-0.3 % apart (docs/model.md, "Tip stress and cracked meshes").
 std::array<int, 4> canonical_corners(const TetMesh& mesh, std::size_t e) {
   std::array<int, 4> order = {0, 1, 2, 3};
   const auto& element = mesh.elements[e];
@@ -389,6 +389,7 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
     throw InputError("stress probe: search depth must be >= 0 and finite");
   const std::vector<std::array<Barycentric, 4>>& subs = probe_subdivision();
   std::vector<char> candidate_node(mesh.nodes.size(), 0);
+  std::vector<std::array<int, 4>> element_order;  // canonical_corners of each of elements_
   for (std::size_t e = 0; e < mesh.elements.size(); ++e) {
     if (mesh.element_layer[e] != layer) continue;
     const auto& element = mesh.elements[e];
@@ -407,6 +408,7 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
     const std::size_t first = subdivision_offset(level), count = std::size_t{1} << (3 * level);
     const double volume = tet_volume(corners) / static_cast<double>(count);
     const std::array<int, 4> order = canonical_corners(mesh, e);
+    element_order.push_back(order);
     for (std::size_t k = first; k < first + count; ++k) {
       const Barycentric l = centroid_of(subs[k]);
       Eigen::Vector3d x = Eigen::Vector3d::Zero();
@@ -444,11 +446,12 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
   // centroid.
   std::vector<std::array<Eigen::Vector3d, 8>> sub_children(points_.size());
   std::vector<double> sub_reach(points_.size(), 0.0);
+  std::size_t in_elements = 0;  // index into elements_ of points_[i]'s element
   for (std::size_t i = 0; i < points_.size(); ++i) {
+    if (i > 0 && points_[i].element != points_[i - 1].element) ++in_elements;
     const auto& element = mesh.elements[static_cast<std::size_t>(points_[i].element)];
     const std::array<Barycentric, 4>& sub = subs[static_cast<std::size_t>(points_[i].sub)];
-    const std::array<int, 4> order =
-        canonical_corners(mesh, static_cast<std::size_t>(points_[i].element));
+    const std::array<int, 4>& order = element_order[in_elements];
     std::array<Eigen::Vector3d, 4> corners;
     for (std::size_t v = 0; v < 4; ++v) {
       Eigen::Vector3d x = Eigen::Vector3d::Zero();

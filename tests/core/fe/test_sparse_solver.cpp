@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <fstream>
+#include <string>
 #include <vector>
 
 #include "mneedle/base/error.h"
@@ -209,25 +211,54 @@ TEST(SparseSolver, AFactorLargeEnoughForHugePagesSolvesToRoundoff) {
   }
 }
 
-// set_huge_pages(false) (MNEEDLE_HUGE_PAGES=off, docs/cli.md "Environment") takes the same
-// large blocks from ordinary pages: the factor and every solve are bit for bit those of the
-// advised run, since only where the memory comes from changes.
-TEST(SparseSolver, HugePagesOffSolvesBitForBitAsOn) {
+// The process's mappings whose kernel flags (/proc/self/smaps, VmFlags) include `flag`: "hg"
+// for memory advised onto huge pages, "nh" for memory advised away from them.
+int mappings_flagged(const std::string& flag) {
+  std::ifstream smaps("/proc/self/smaps");
+  int count = 0;
+  for (std::string line; std::getline(smaps, line);)
+    if (line.rfind("VmFlags:", 0) == 0 && (line + " ").find(" " + flag + " ") != std::string::npos)
+      ++count;
+  return count;
+}
+
+// Restores the process-wide default however the test ends.
+struct HugePagesRestored {
+  ~HugePagesRestored() { mneedle::fe::set_huge_pages(true); }
+};
+
+// set_huge_pages(false) (MNEEDLE_HUGE_PAGES=off, docs/cli.md "Environment") advises the same
+// large blocks away from huge pages, and the factor and every solve are bit for bit those of the
+// default run: only where the memory comes from changes. The advice is read back from the
+// kernel's flags while each factor is held (skipped where the kernel has no THP).
+TEST(SparseSolver, HugePagesOffAdvisesTheFactorAwayAndSolvesBitForBitAsOn) {
+  const HugePagesRestored restore;
   const SpMat matrix = nodal_system(14, 0.05);
   const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(matrix.rows(), -1.0, 1.0);
   ASSERT_TRUE(mneedle::fe::huge_pages());  // the default
-  mneedle::fe::SparseSolver on(3);
-  on.factorize(matrix);
-  const Eigen::VectorXd x_on = on.solve(rhs);
+  Eigen::VectorXd x_on, x_off;
+  double nonzeros_on = 0.0;
+  bool advised = false;
+  {
+    const int before = mappings_flagged("hg");
+    mneedle::fe::SparseSolver on(3);
+    on.factorize(matrix);
+    ASSERT_TRUE(on.ok());
+    advised = mappings_flagged("hg") > before;
+    x_on = on.solve(rhs);
+    nonzeros_on = on.factor_nonzeros();
+  }
   mneedle::fe::set_huge_pages(false);
   EXPECT_FALSE(mneedle::fe::huge_pages());
+  const int away_before = mappings_flagged("nh");
   mneedle::fe::SparseSolver off(3);
   off.factorize(matrix);
-  const Eigen::VectorXd x_off = off.solve(rhs);
-  mneedle::fe::set_huge_pages(true);
   ASSERT_TRUE(off.ok());
-  EXPECT_EQ(off.factor_nonzeros(), on.factor_nonzeros());
+  x_off = off.solve(rhs);
+  EXPECT_EQ(off.factor_nonzeros(), nonzeros_on);
   EXPECT_EQ((x_off - x_on).cwiseAbs().maxCoeff(), 0.0);
+  if (!with_cholmod() || !advised) GTEST_SKIP() << "no huge-page advice on this kernel or build";
+  EXPECT_GT(mappings_flagged("nh"), away_before);
 }
 
 TEST(SparseSolver, OrderingByNodeFindsTheFillOfOrderingByDof) {
