@@ -244,6 +244,54 @@ TEST(StressProbe, HalfModelBallsHoldWhatTheWholeBlocksHold) {
   EXPECT_LT(worst, 1e-12);
 }
 
+// The same mesh with each element's corners numbered in another order (the even permutation
+// 0 1 2 3 -> 0 2 3 1, which keeps the orientation) and its midside nodes renumbered to match.
+TetMesh corners_renumbered(TetMesh mesh) {
+  constexpr int kEdges[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};  // VTK order
+  constexpr int kFrom[4] = {0, 2, 3, 1};
+  const auto edge_of = [&](int a, int b) {
+    for (int k = 0; k < 6; ++k)
+      if ((kEdges[k][0] == a && kEdges[k][1] == b) || (kEdges[k][0] == b && kEdges[k][1] == a))
+        return k;
+    return -1;
+  };
+  for (auto& element : mesh.elements) {
+    const auto old = element;
+    for (int i = 0; i < 4; ++i) element[static_cast<std::size_t>(i)] = old[kFrom[i]];
+    if (mesh.order == 2)
+      for (int k = 0; k < 6; ++k)
+        element[static_cast<std::size_t>(4 + k)] =
+            old[static_cast<std::size_t>(4 + edge_of(kFrom[kEdges[k][0]], kFrom[kEdges[k][1]]))];
+  }
+  return mesh;
+}
+
+// The peak averaged stress is a property of the elements, not of how each numbers its corners:
+// the probe cuts every element in a corner order of its own geometry (docs/model.md, "Tip
+// stress and cracked meshes") and evaluates the field at the matching local coordinates, on the
+// linear path (stress interpolated from the corners) and on the finite-strain one. In the
+// mesh's own corner order the cut followed the numbering and the two readings differed.
+// 1e-12: the round-off of the same sums over other local coordinates.
+TEST(StressProbe, PeakDoesNotDependOnHowElementsNumberTheirCorners) {
+  for (const MaterialModel model : {MaterialModel::Linear, MaterialModel::NeoHookean}) {
+    const TetMesh mesh = two_layer_block(2, 0.3, model);
+    const TetMesh renumbered = corners_renumbered(mesh);
+    // A field whose stress varies within an element (not reproduced by its shape functions).
+    const auto field = [](const Eigen::Vector3d& x) {
+      return Eigen::Vector3d(1e-7 * std::sin(3e3 * x.x()) * std::cos(2e3 * x.y()),
+                             2e-7 * std::sin(2.5e3 * x.x() * x.y() * 1e3),
+                             1e-7 * std::cos(2.5e3 * x.z()) * (1.0 + 1e3 * x.x()));
+    };
+    const double length = 0.04e-3;
+    const PeakStressProbe a(mesh, {{0.0, 0.0}}, {0.3e-3}, 1e-3, length, 0);
+    const PeakStressProbe b(renumbered, {{0.0, 0.0}}, {0.3e-3}, 1e-3, length, 0);
+    const double pa = a.peak(interpolate(mesh, field), {0.3e-3})[0];
+    const double pb = b.peak(interpolate(renumbered, field), {0.3e-3})[0];
+    ASSERT_GT(std::abs(pa), 0.0);
+    EXPECT_NEAR(pb / pa, 1.0, 1e-12) << (model == MaterialModel::Linear ? "linear" : "neo-Hookean");
+  }
+}
+
 // A point load on a stiff layer over a soft substrate (a sharp cone on a 1 GPa, 20 um layer over
 // 0.1 MPa) bends the layer: the peak is a tension, and it grows in proportion to the load.
 TEST(StressProbe, PeakUnderAPointLoadOnAStiffLayerIsATensionProportionalToTheLoad) {
