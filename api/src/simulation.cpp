@@ -12,6 +12,7 @@
 #include "mneedle/api/loads_json.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
+#include "mneedle/fe/blas_kernels.h"
 #include "mneedle/fe/tissue_mesh.h"
 #include "mneedle/insertion/energy_check.h"
 #include "mneedle/insertion/penetration_force.h"
@@ -79,6 +80,14 @@ nlohmann::json seconds_by_stage_json(const RunSeconds& t) {
           {"fe_runs", t.fe_runs}};
 }
 
+// The BLAS kernels the factorisations ran on (fe/blas_kernels.h): a fact about the machine, as
+// the time and the memory are; null where the BLAS is not OpenBLAS.
+nlohmann::json blas_kernels_json() {
+  const fe::BlasKernels kernels = fe::select_blas_kernels();
+  if (kernels.detected.empty()) return nullptr;
+  return {{"detected", kernels.detected}, {"used", kernels.used}};
+}
+
 nlohmann::json energy_check_json(const std::optional<EnergyCheck>& check) {
   if (!check) return nullptr;
   return {{"depth_m", check->depth_m},
@@ -140,6 +149,7 @@ nlohmann::json run_json(const InsertionRun& run, const Scene& scene) {
           {"pre_puncture_rungs_m", run.rungs_m},
           {"energy_check", energy_check_json(run.energy_check)},
           {"peak_memory_bytes", run.peak_memory_bytes},
+          {"blas_kernels", blas_kernels_json()},
           {"seconds_by_stage", seconds_by_stage_json(run.seconds_by_stage)},
           {"seconds", run.seconds}};
 }

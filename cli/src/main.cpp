@@ -10,6 +10,7 @@
 #include "mneedle/base/error.h"
 #include "mneedle/base/memory.h"
 #include "mneedle/base/text.h"
+#include "mneedle/fe/blas_kernels.h"
 #include "mneedle/fe/sparse_solver.h"
 #include "run_provenance.h"
 
@@ -75,6 +76,12 @@ int main(int argc, char** argv) {
       else if (!asks_help)
         throw mneedle::InputError("MNEEDLE_HUGE_PAGES: must be \"on\" or \"off\", got '" + value +
                                   "'");
+    }
+    // The factorisations' BLAS kernels, before any thread starts (docs/cli.md, "Environment").
+    try {
+      mneedle::fe::select_blas_kernels(mneedle::fe::blas_kernel_choice_from_environment());
+    } catch (const mneedle::InputError&) {
+      if (!asks_help) throw;
     }
     app.parse(argc, argv);
   } catch (const mneedle::cli::QuietExit& e) {

@@ -4,6 +4,8 @@
 
 #include <mutex>
 
+#include "mneedle/fe/blas_kernels.h"
+
 namespace mneedle {
 namespace {
 
@@ -35,6 +37,8 @@ int blas_threads() {
 }
 
 BlasThreadLimit::BlasThreadLimit(int threads) {
+  // The threads about to share OpenBLAS must find its kernels chosen (fe/blas_kernels.h).
+  fe::select_blas_kernels();
   std::lock_guard<std::mutex> lock(limit_mutex);
   if (active_limits++ > 0) return;
   saved_threads = blas_threads();

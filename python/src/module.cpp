@@ -23,6 +23,7 @@
 #include "mneedle/base/provenance.h"
 #include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
+#include "mneedle/fe/blas_kernels.h"
 #include "mneedle/insertion/insertion_run.h"
 #include "mneedle/needle/needle_frame.h"
 #include "mneedle/plugin_host.h"
@@ -120,6 +121,9 @@ PYBIND11_MODULE(_core, m) {
   py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
   py::register_exception<SolverError>(m, "SolverError", PyExc_RuntimeError);
   m.attr("__version__") = tool_version();
+  // The factorisations' BLAS kernels, as the CLI chooses them (docs/python.md): at import, before
+  // any thread of this module shares OpenBLAS.
+  fe::select_blas_kernels(fe::blas_kernel_choice_from_environment());
 
   m.def("_set_plugin_folder", &set_plugin_folder, py::arg("folder"));
   m.def("read_scene", &read_scene_values, py::arg("file"),

@@ -729,6 +729,43 @@ TEST(Environment, HugePagesOffChangesNoResultAndABadValueIsOneLine) {
             0);
 }
 
+// MNEEDLE_BLAS_KERNELS (docs/cli.md, "Environment"): "off" keeps OpenBLAS's own kernels, "auto"
+// (the default) replaces its SSE3 fallback on a CPU it does not know. The kernels sum in other
+// orders, so the puncture moves by round-off only: 9e-12 of the depth and 4e-11 of the force on
+// this scene, at most 4e-10 of the depth over the 40 designs of bench/screen_designs.sh
+// (docs/performance.md, "BLAS kernels"); 1e-9 is that with room, far below any physical change.
+// The JSON says which kernels ran. Any other value is bad input, one line; help still answers.
+TEST(Environment, BlasKernelsOffMovesNoResultBeyondRoundOffAndABadValueIsOneLine) {
+  const std::string run = "' simulate '" + kRoot + "/designs/scenes/human_skin.toml' --fidelity " +
+                          "fast --quiet --json";
+  const auto chosen = mneedle::test::run_command("MNEEDLE_BLAS_KERNELS=auto '" +
+                                                 mneedle::test::mneedle_binary() + run);
+  const auto off = mneedle::test::run_command("MNEEDLE_BLAS_KERNELS=off '" +
+                                              mneedle::test::mneedle_binary() + run);
+  ASSERT_EQ(chosen.exit_code, 0) << chosen.err;
+  ASSERT_EQ(off.exit_code, 0) << off.err;
+  const auto a = nlohmann::json::parse(chosen.out);
+  const auto b = nlohmann::json::parse(off.out);
+  const double depth = b["needles"][0]["puncture"]["depth_m"].get<double>();
+  const double force = b["needles"][0]["puncture"]["force_N"].get<double>();
+  EXPECT_NEAR(a["needles"][0]["puncture"]["depth_m"].get<double>(), depth, 1e-9 * depth);
+  EXPECT_NEAR(a["needles"][0]["puncture"]["force_N"].get<double>(), force, 1e-9 * force);
+  if (!b["blas_kernels"].is_null()) {
+    // off: OpenBLAS's own choice, detected and used alike; auto: the same detection.
+    EXPECT_EQ(b["blas_kernels"]["used"], b["blas_kernels"]["detected"]);
+    EXPECT_EQ(a["blas_kernels"]["detected"], b["blas_kernels"]["detected"]);
+  }
+  const auto bad = mneedle::test::run_command("MNEEDLE_BLAS_KERNELS=fastest '" +
+                                              mneedle::test::mneedle_binary() + run);
+  EXPECT_EQ(bad.exit_code, 1) << bad.err;
+  EXPECT_EQ(bad.err,
+            "mneedle: error: MNEEDLE_BLAS_KERNELS: must be \"auto\" or \"off\", got 'fastest'\n");
+  EXPECT_EQ(mneedle::test::run_command("MNEEDLE_BLAS_KERNELS=fastest '" +
+                                       mneedle::test::mneedle_binary() + "' --help")
+                .exit_code,
+            0);
+}
+
 // An address-space limit (`ulimit -v`, as batch systems set) counts as memory left: the run is
 // refused in one line with status 3. Before, CHOLMOD's solve crashed (status 139) and OpenBLAS
 // retried its work buffer's mmap for ever; 400 MB leaves no room for the fast skin run's

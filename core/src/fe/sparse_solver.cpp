@@ -11,6 +11,7 @@
 
 #include "mneedle/base/error.h"
 #include "mneedle/base/memory.h"
+#include "mneedle/fe/blas_kernels.h"
 
 #ifdef MNEEDLE_HAVE_CHOLMOD
 #include <sys/mman.h>
@@ -409,6 +410,9 @@ void SparseSolver::analyze(const Eigen::SparseMatrix<double>& matrix) {
 }
 
 void SparseSolver::factorize(const Eigen::SparseMatrix<double>& input) {
+  // The BLAS kernels are chosen before the first factorisation (a no-op once chosen; the CLI
+  // chooses them first thing, docs/performance.md "BLAS kernels").
+  select_blas_kernels();
   if (input.rows() != impl_->rows || input.nonZeros() != impl_->nonzeros) analyze(input);
 #ifdef MNEEDLE_HAVE_CHOLMOD
   const bool factorized = impl_->cholesky.factorize(input);
