@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
         if (!asks_help) throw mneedle::InputError(std::string("MNEEDLE_MEMORY_LIMIT: ") + e.what());
       }
     }
-    // Huge pages for the factor, on unless turned off (docs/cli.md, "Environment").
+    // Huge pages for the factor, off unless turned on (docs/cli.md, "Environment").
     if (const char* huge = std::getenv("MNEEDLE_HUGE_PAGES"); huge != nullptr && *huge) {
       const std::string value(mneedle::trim(huge));
       if (value == "on" || value == "off")

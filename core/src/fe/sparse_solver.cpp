@@ -22,7 +22,9 @@
 namespace mneedle::fe {
 
 namespace {
-std::atomic<bool> huge_pages_on{true};
+// Off by default: on the 2-core VMs measured (fresh and long-running) ordinary pages were as fast
+// or faster (docs/performance.md, "BLAS kernels and huge pages, a fresh VM").
+std::atomic<bool> huge_pages_on{false};
 }  // namespace
 
 void set_huge_pages(bool on) {
@@ -36,14 +38,14 @@ namespace {
 #ifdef MNEEDLE_HAVE_CHOLMOD
 constexpr const char* kCholeskyName = "cholmod-supernodal-llt";
 
-// Large CHOLMOD blocks (above all the factor: 100 MB for the skin half model) on transparent huge
-// pages where the kernel gives them on request (THP "madvise", Debian's default). The first touch
-// of each 4 KiB page is a page fault, and on the 2-core VMs we run on those faults were a quarter
-// of a skin run (docs/performance.md, "Where the time goes"). The advice is only advice: where
-// huge pages are off the memory is ordinary. After set_huge_pages(false) the same blocks are
-// advised away from huge pages (a VM that hands free memory back to its host:
-// docs/performance.md, "Huge pages, measured again"), which also holds where THP is "always".
-// Blocks come from posix_memalign, so CHOLMOD's free() and realloc() stay valid for them.
+// Large CHOLMOD blocks (above all the factor: 100 MB for the skin half model) 2 MiB-aligned and
+// advised away from transparent huge pages by default, which also holds where THP is "always":
+// on the VMs we measure on, which hand free memory back to their host, a huge page is memory the
+// host must fault in again (docs/performance.md, "BLAS kernels and huge pages, a fresh VM").
+// After set_huge_pages(true) the same blocks are advised onto huge pages, where the kernel gives
+// them on request (THP "madvise", Debian's default): on one VM the first touch of each 4 KiB page
+// was a quarter of a skin run (docs/performance.md, "Where the time goes"). The advice is only
+// advice. Blocks come from posix_memalign, so CHOLMOD's free() and realloc() stay valid for them.
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
 constexpr std::size_t kHugeBlock = 4 * kHugePage;
 

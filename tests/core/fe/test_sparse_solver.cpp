@@ -224,41 +224,42 @@ int mappings_flagged(const std::string& flag) {
 
 // Restores the process-wide default however the test ends.
 struct HugePagesRestored {
-  ~HugePagesRestored() { mneedle::fe::set_huge_pages(true); }
+  ~HugePagesRestored() { mneedle::fe::set_huge_pages(false); }
 };
 
-// set_huge_pages(false) (MNEEDLE_HUGE_PAGES=off, docs/cli.md "Environment") advises the same
-// large blocks away from huge pages, and the factor and every solve are bit for bit those of the
-// default run: only where the memory comes from changes. The advice is read back from the
-// kernel's flags while each factor is held (skipped where the kernel has no THP).
-TEST(SparseSolver, HugePagesOffAdvisesTheFactorAwayAndSolvesBitForBitAsOn) {
+// The default (MNEEDLE_HUGE_PAGES unset or off, docs/cli.md "Environment") advises the large
+// blocks away from huge pages; set_huge_pages(true) advises the same blocks onto them, and the
+// factor and every solve are bit for bit those of the default run: only where the memory comes
+// from changes. The advice is read back from the kernel's flags while each factor is held
+// (skipped where the kernel has no THP).
+TEST(SparseSolver, HugePagesOnAdvisesTheFactorOntoThemAndSolvesBitForBitAsTheDefault) {
   const HugePagesRestored restore;
   const SpMat matrix = nodal_system(14, 0.05);
   const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(matrix.rows(), -1.0, 1.0);
-  ASSERT_TRUE(mneedle::fe::huge_pages());  // the default
+  ASSERT_FALSE(mneedle::fe::huge_pages());  // the default
   Eigen::VectorXd x_on, x_off;
-  double nonzeros_on = 0.0;
+  double nonzeros_off = 0.0;
   bool advised = false;
   {
-    const int before = mappings_flagged("hg");
-    mneedle::fe::SparseSolver on(3);
-    on.factorize(matrix);
-    ASSERT_TRUE(on.ok());
-    advised = mappings_flagged("hg") > before;
-    x_on = on.solve(rhs);
-    nonzeros_on = on.factor_nonzeros();
+    const int before = mappings_flagged("nh");
+    mneedle::fe::SparseSolver off(3);
+    off.factorize(matrix);
+    ASSERT_TRUE(off.ok());
+    advised = mappings_flagged("nh") > before;
+    x_off = off.solve(rhs);
+    nonzeros_off = off.factor_nonzeros();
   }
-  mneedle::fe::set_huge_pages(false);
-  EXPECT_FALSE(mneedle::fe::huge_pages());
-  const int away_before = mappings_flagged("nh");
-  mneedle::fe::SparseSolver off(3);
-  off.factorize(matrix);
-  ASSERT_TRUE(off.ok());
-  x_off = off.solve(rhs);
-  EXPECT_EQ(off.factor_nonzeros(), nonzeros_on);
-  EXPECT_EQ((x_off - x_on).cwiseAbs().maxCoeff(), 0.0);
+  mneedle::fe::set_huge_pages(true);
+  EXPECT_TRUE(mneedle::fe::huge_pages());
+  const int onto_before = mappings_flagged("hg");
+  mneedle::fe::SparseSolver on(3);
+  on.factorize(matrix);
+  ASSERT_TRUE(on.ok());
+  x_on = on.solve(rhs);
+  EXPECT_EQ(on.factor_nonzeros(), nonzeros_off);
+  EXPECT_EQ((x_on - x_off).cwiseAbs().maxCoeff(), 0.0);
   if (!with_cholmod() || !advised) GTEST_SKIP() << "no huge-page advice on this kernel or build";
-  EXPECT_GT(mappings_flagged("nh"), away_before);
+  EXPECT_GT(mappings_flagged("hg"), onto_before);
 }
 
 TEST(SparseSolver, OrderingByNodeFindsTheFillOfOrderingByDof) {

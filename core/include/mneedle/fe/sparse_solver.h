@@ -71,10 +71,11 @@ class SparseSolver {
 };
 
 /// Whether CHOLMOD's large blocks (the factor above all) are advised onto transparent huge pages
-/// (default: on) or away from them (off). On a VM whose free memory is handed back to the host
-/// (free page reporting), a huge page is memory the host must fault in again: a long-running
-/// such VM ran 1.1-2x slower (wall time) with them (docs/performance.md, "Huge pages, measured
-/// again"). Results do not depend on it. Process-wide; set it before the first factorisation.
+/// (on) or away from them (off, the default). On a VM whose free memory is handed back to the
+/// host (free page reporting), a huge page is memory the host must fault in again: such VMs ran
+/// 1.1-2x slower (wall time) with them, fresh or long-running (docs/performance.md, "Huge pages,
+/// measured again" and "BLAS kernels and huge pages, a fresh VM"). Results do not depend on it.
+/// Process-wide; set it before the first factorisation.
 void set_huge_pages(bool on);
 bool huge_pages();
 
