@@ -6,6 +6,7 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -80,6 +81,8 @@ constexpr std::size_t kColumnChunkNodes = 64;
 // past them the probe reads the field once per output depth (docs/performance.md, "The contact
 // block").
 constexpr std::size_t kWatchedBlockNodes = 16;
+// Depths whose watched rows one back substitution reads (Indentation3d::watched_displacements).
+constexpr Eigen::Index kBackSolveColumns = 8;
 // Largest dense factor of the contact block (Impl::contact_block_fits): 256 MiB, 3 × 1900
 // surface nodes.
 constexpr double kContactBlockBudget = 256.0 * 1024 * 1024;
@@ -1507,6 +1510,46 @@ Eigen::VectorXd Indentation3d::watched_displacement() const {
   return out;
 }
 
+bool Indentation3d::watched_by_back_solve() const {
+  const Impl& m = *impl_;
+  const bool rows_kept =
+      !m.watched_overflow &&
+      m.watched_compliance.rows() == 3 * static_cast<Eigen::Index>(m.watched.size()) &&
+      m.watched_compliance.cols() == 3 * static_cast<Eigen::Index>(m.captured.size()) &&
+      m.multipliers.size() == m.watched_compliance.cols();
+  return m.model.is_linear() && !m.frictionless() && m.active_pairs.empty() && !rows_kept &&
+         !m.captured.empty() && m.solver.has_trailing_block();
+}
+
+Eigen::VectorXd Indentation3d::watched_trailing_loads() const {
+  if (!watched_by_back_solve())
+    throw InputError("3-D indentation: the watched rows of this depth need no back substitution");
+  const Impl& m = *impl_;
+  Eigen::VectorXd trailing = Eigen::VectorXd::Zero(m.surface_rows());
+  for (std::size_t i = 0; i < m.captured.size(); ++i)
+    trailing.segment<3>(3 * m.candidate_index[static_cast<std::size_t>(m.captured[i].node)]) =
+        m.multipliers.segment<3>(3 * static_cast<Eigen::Index>(i));
+  return trailing;
+}
+
+Eigen::MatrixXd Indentation3d::watched_displacements(const Eigen::MatrixXd& loads) const {
+  const Impl& m = *impl_;
+  if (!m.solver.has_trailing_block() || loads.rows() != m.surface_rows())
+    throw InputError("3-D indentation: trailing loads of the wrong size, or no trailing block");
+  Eigen::MatrixXd out(3 * static_cast<Eigen::Index>(m.watched.size()), loads.cols());
+  // kBackSolveColumns at a time: each back substitution holds two dense copies of the field per
+  // column (0.5 GB for eight columns of a 4-million-dof problem), and the factor streamed once
+  // for eight already costs about what it costs for one.
+  for (Eigen::Index first = 0; first < loads.cols(); first += kBackSolveColumns) {
+    const Eigen::Index count = std::min<Eigen::Index>(kBackSolveColumns, loads.cols() - first);
+    const Eigen::MatrixXd u = m.solver.solve_trailing_loads(loads.middleCols(first, count));
+    for (std::size_t w = 0; w < m.watched.size(); ++w)
+      out.block(3 * static_cast<Eigen::Index>(w), first, 3, count) =
+          u.middleRows<3>(3 * m.watched[w]);
+  }
+  return out;
+}
+
 const Timing3d& Indentation3d::timing() const {
   return impl_->timing;
 }
@@ -1720,21 +1763,69 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
     // no step solves for the whole field (docs/performance.md, "The stress criterion's cost").
     run.watch_nodes(stress_probe->nodes());
   }
+  // The probe's tip stress of one depth from the watched nodes' displacement.
+  const auto probe_step = [&](Step3d& step, double depth, const Eigen::VectorXd& watched) {
+    const auto probe_start = Clock::now();
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(mesh.nodes.size()));
+    const std::vector<int>& probed = stress_probe->nodes();
+    for (std::size_t w = 0; w < probed.size(); ++w)
+      u.segment<3>(3 * probed[w]) = watched.segment<3>(3 * static_cast<Eigen::Index>(w));
+    const std::vector<double> peak = stress_probe->peak(u, search_radii(depth));
+    for (std::size_t n = 0; n < needles.size(); ++n) step.needles[n].tip_stress_Pa = peak[n];
+    stress_seconds += seconds_since(probe_start);
+  };
+  // Once the watched rows cost a back substitution per depth (a flat face's many captures), the
+  // rest of the depths are advanced first and read in one back substitution of several columns:
+  // the factor is streamed once instead of once per depth (docs/performance.md, "The stress
+  // criterion's cost"). Advancing past the crossing costs contact-block solves only. Not where a
+  // depth writes files or a cracked twin advances in lock-step.
+  const bool look_ahead =
+      stress_probe && !cracked_run && options.vtu_directory.empty() && options.inp_path.empty();
   bool vtu_past = false;  // a step at or beyond vtu_depth_m was written
   for (int k = 1; k <= steps; ++k) {
     const double depth = options.depth * k / steps;
     Step3d step = run.advance_to(depth);
-    if (stress_probe) {
-      const auto probe_start = Clock::now();
-      const Eigen::VectorXd watched = run.watched_displacement();
-      Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(mesh.nodes.size()));
-      const std::vector<int>& probed = stress_probe->nodes();
-      for (std::size_t w = 0; w < probed.size(); ++w)
-        u.segment<3>(3 * probed[w]) = watched.segment<3>(3 * static_cast<Eigen::Index>(w));
-      const std::vector<double> peak = stress_probe->peak(u, search_radii(depth));
-      for (std::size_t n = 0; n < needles.size(); ++n) step.needles[n].tip_stress_Pa = peak[n];
-      stress_seconds += seconds_since(probe_start);
+    if (look_ahead && run.watched_by_back_solve()) {
+      std::vector<Step3d> ahead{std::move(step)};
+      std::vector<double> depths{depth};
+      Eigen::MatrixXd loads(run.watched_trailing_loads().size(), steps - k + 1);
+      loads.col(0) = run.watched_trailing_loads();
+      // A depth past the caller's stop must not end the run: its failure is kept and raised
+      // only if the caller asks for that depth.
+      std::exception_ptr failed;
+      bool last_read = false;  // the last depth's rows were read directly
+      for (int j = k + 1; j <= steps; ++j) {
+        const double next = options.depth * j / steps;
+        try {
+          ahead.push_back(run.advance_to(next));
+        } catch (const std::exception&) {
+          failed = std::current_exception();
+          break;
+        }
+        depths.push_back(next);
+        // The captures only grow, so the rows stay unkept; were they kept, read them now.
+        if (!run.watched_by_back_solve()) {
+          probe_step(ahead.back(), next, run.watched_displacement());
+          last_read = true;
+          break;
+        }
+        loads.col(static_cast<Eigen::Index>(ahead.size()) - 1) = run.watched_trailing_loads();
+      }
+      const auto solve_start = Clock::now();
+      const auto solved = static_cast<Eigen::Index>(ahead.size() - (last_read ? 1 : 0));
+      const Eigen::MatrixXd watched = run.watched_displacements(loads.leftCols(solved));
+      stress_seconds += seconds_since(solve_start);
+      bool stopped = false;
+      for (std::size_t i = 0; i < ahead.size() && !stopped; ++i) {
+        if (static_cast<Eigen::Index>(i) < solved)
+          probe_step(ahead[i], depths[i], watched.col(static_cast<Eigen::Index>(i)));
+        result.steps.push_back(whole_scene_step(ahead[i], selection, all_needles));
+        stopped = options.on_step && !options.on_step(result.steps.back());
+      }
+      if (failed && !stopped) std::rethrow_exception(failed);
+      break;
     }
+    if (stress_probe) probe_step(step, depth, run.watched_displacement());
     if (cracked_run) {
       const Step3d opened = cracked_run->advance_to(depth);
       const double release = (step.strain_energy_J - opened.strain_energy_J) / total_crack_area;

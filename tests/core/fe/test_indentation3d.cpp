@@ -289,6 +289,44 @@ TEST(Indentation3d, TheContactBlockGivesWhatSparseSolvesGive) {
   }
 }
 
+// Past the kept rows (a punch's whole face captured), each depth's watched rows cost a back
+// substitution; the states' trailing loads read together in one (more columns than one chunk of
+// eight) give each depth's watched_displacement() to round-off (1e-12 of the largest: the same
+// factor, summed per column or per block of columns). Before the punch touches, and on the kept
+// rows, no back substitution is needed and none is offered.
+TEST(Indentation3d, SeveralDepthsWatchedRowsReadInOneBackSubstitutionAreEachDepths) {
+  const TetMesh mesh = soft_punch_block();
+  const std::vector<int> nodes = every_seventh_node(mesh);
+  Indentation3d run(mesh, {{"punch", cylinder_needle(100e-6, 1e-3), 0.0, 0.0}}, 20e-6);
+  run.watch_nodes(nodes);
+  EXPECT_FALSE(run.watched_by_back_solve());
+  EXPECT_THROW(run.watched_trailing_loads(), mneedle::InputError);
+  std::vector<Eigen::VectorXd> one_by_one;
+  Eigen::MatrixXd loads;
+  for (int k = 1; k <= 10; ++k) {
+    run.advance_to(2e-6 * k);
+    ASSERT_TRUE(run.watched_by_back_solve()) << "depth " << 2e-6 * k;
+    const Eigen::VectorXd trailing = run.watched_trailing_loads();
+    loads.conservativeResize(trailing.size(), k);
+    loads.col(k - 1) = trailing;
+    one_by_one.push_back(run.watched_displacement());
+  }
+  const Eigen::MatrixXd together = run.watched_displacements(loads);
+  ASSERT_EQ(together.cols(), 10);
+  for (int k = 0; k < 10; ++k) {
+    const Eigen::VectorXd& alone = one_by_one[static_cast<std::size_t>(k)];
+    ASSERT_GT(alone.norm(), 0.0);
+    EXPECT_LE((together.col(k) - alone).norm(), 1e-12 * alone.norm()) << "depth " << k;
+  }
+  EXPECT_THROW(run.watched_displacements(loads.topRows(loads.rows() - 1)), mneedle::InputError);
+  // A cone's few captures keep their rows: no back substitution.
+  Indentation3d cone(
+      mesh, {{"cone", cone_needle(std::numbers::pi / 6, 100e-6, 1e-3, 48), 0.0, 0.0}}, 20e-6);
+  cone.watch_nodes(nodes);
+  cone.advance_to(5e-6);
+  EXPECT_FALSE(cone.watched_by_back_solve());
+}
+
 // The linear sticking path keeps each captured node's compliance columns densely: what a new
 // capture would allocate beyond the memory left is refused first, in one line naming the nodes,
 // what they need and what is left (docs/performance.md, "Memory"); over a blunt bevel's flat
@@ -700,6 +738,38 @@ TEST(Indentation3d, TipStressAndEnergyReleaseRateAreReportedWhenRequested) {
   EXPECT_THROW(
       simulate_3d(small_skin(), {{"cone", cone_needle(0.5, 60e-6, 1e-3), 0.0, 0.0}}, options),
       mneedle::InputError);
+}
+
+// A punch's tip stress read with the look-ahead (its whole face captured: the remaining depths
+// advanced first and read in one back substitution) equals the step-by-step reading, which a VTU
+// directory keeps (each depth writes its field), to round-off (1e-9 of the stress: the same
+// factor, summed per column or per block of columns); a caller's stop after the second depth
+// ends the steps there, the look-ahead's depths past it unreported.
+TEST(Indentation3d, TheLookAheadOfThePunchsTipStressChangesNoStepAndHonoursTheStop) {
+  Simulation3dOptions options = small_options();
+  options.steps = 6;
+  options.stress_average_length_m = 20e-6;
+  const std::vector<Needle3d> punch{{"punch", cylinder_needle(60e-6, 1e-3), 0.0, 0.0}};
+  const Simulation3dResult ahead = simulate_3d(small_skin(), punch, options);
+  options.vtu_directory = (std::filesystem::temp_directory_path() / "mneedle_look_ahead").string();
+  const Simulation3dResult stepwise = simulate_3d(small_skin(), punch, options);
+  std::filesystem::remove_all(options.vtu_directory);
+  ASSERT_EQ(ahead.steps.size(), 6u);
+  ASSERT_EQ(stepwise.steps.size(), 6u);
+  for (std::size_t k = 0; k < 6; ++k) {
+    const double expected = stepwise.steps[k].needles[0].tip_stress_Pa;
+    ASSERT_GT(expected, 0.0) << "step " << k;
+    EXPECT_NEAR(ahead.steps[k].needles[0].tip_stress_Pa, expected, 1e-9 * expected) << k;
+    EXPECT_NEAR(ahead.steps[k].needles[0].force_N, stepwise.steps[k].needles[0].force_N,
+                1e-9 * stepwise.steps[k].needles[0].force_N);
+  }
+  options.vtu_directory.clear();
+  int seen = 0;
+  options.on_step = [&seen](const Step3d&) { return ++seen < 2; };
+  const Simulation3dResult stopped = simulate_3d(small_skin(), punch, options);
+  ASSERT_EQ(stopped.steps.size(), 2u);
+  EXPECT_EQ(seen, 2);
+  EXPECT_EQ(stopped.steps[1].needles[0].tip_stress_Pa, ahead.steps[1].needles[0].tip_stress_Pa);
 }
 
 // Crack faces in contact (docs/model.md, "Crack faces in contact"). A bevel pushes the tissue

@@ -145,6 +145,19 @@ class Indentation3d {
   /// displacement()'s rows to round-off, and taken from it where no rows are kept (frictionless
   /// contact, nonlinear tissue, crack faces in contact).
   Eigen::VectorXd watched_displacement() const;
+  /// True when watched_displacement() at the last depth costs a back substitution through the
+  /// whole factor: the linear sticking path with more captured nodes than it keeps rows for,
+  /// through the contact block (its loads lie on the factor's trailing block). The state of such
+  /// a depth is then watched_trailing_loads(), and watched_displacements() reads several depths'
+  /// watched rows in one back substitution (docs/performance.md, "The stress criterion's cost").
+  bool watched_by_back_solve() const;
+  /// The last depth's contact loads on the trailing block (N, candidates' numbering); InputError
+  /// unless watched_by_back_solve().
+  Eigen::VectorXd watched_trailing_loads() const;
+  /// The watched rows (as watched_displacement(), m) of the states whose trailing loads are the
+  /// columns of `loads`, one column each; equal to watched_displacement() at each state to
+  /// round-off. InputError for a column of the wrong size or without a trailing block.
+  Eigen::MatrixXd watched_displacements(const Eigen::MatrixXd& loads) const;
   const Timing3d& timing() const;
   std::string solver_backend() const;
   /// True when the linear sticking path reads its compliance from the contact block
