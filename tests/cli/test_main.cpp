@@ -733,8 +733,9 @@ TEST(Environment, HugePagesOffChangesNoResultAndABadValueIsOneLine) {
 // (the default) replaces its SSE3 fallback on a CPU it does not know. The kernels sum in other
 // orders, so the puncture moves by round-off only: 9e-12 of the depth and 4e-11 of the force on
 // this scene, at most 4e-10 of the depth over the 40 designs of bench/screen_designs.sh
-// (docs/performance.md, "BLAS kernels"); 1e-9 is that with room, far below any physical change.
-// The JSON says which kernels ran. Any other value is bad input, one line; help still answers.
+// (docs/performance.md, "BLAS kernels and huge pages, a fresh VM"); 1e-9 is that with room, far
+// below any physical change. The JSON says which kernels ran. Any other value is bad input, one
+// line; help still answers.
 TEST(Environment, BlasKernelsOffMovesNoResultBeyondRoundOffAndABadValueIsOneLine) {
   const std::string run = "' simulate '" + kRoot + "/designs/scenes/human_skin.toml' --fidelity " +
                           "fast --quiet --json";

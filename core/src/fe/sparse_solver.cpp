@@ -413,7 +413,7 @@ void SparseSolver::analyze(const Eigen::SparseMatrix<double>& matrix) {
 
 void SparseSolver::factorize(const Eigen::SparseMatrix<double>& input) {
   // The BLAS kernels are chosen before the first factorisation (a no-op once chosen; the CLI
-  // chooses them first thing, docs/performance.md "BLAS kernels").
+  // chooses them first thing, docs/performance.md "BLAS kernels and huge pages, a fresh VM").
   select_blas_kernels();
   if (input.rows() != impl_->rows || input.nonZeros() != impl_->nonzeros) analyze(input);
 #ifdef MNEEDLE_HAVE_CHOLMOD

@@ -2,8 +2,8 @@
 // The BLAS kernels CHOLMOD's factorisations run on. OpenBLAS (Debian's libblas.so.3) picks its
 // kernels from the CPU's model number when it loads; a release that does not know the model
 // falls back to its SSE3 ("Prescott") kernels, 3-5x slower than the AVX2 or AVX-512 ones the
-// CPU has (OpenBLAS 0.3.21 on Intel model 207, Emerald Rapids; docs/performance.md, "BLAS
-// kernels"). Results differ from one kernel to another only by round-off.
+// CPU has (OpenBLAS 0.3.21 on Intel model 207, Emerald Rapids; docs/performance.md, "BLAS kernels
+// and huge pages, a fresh VM"). Results differ from one kernel to another only by round-off.
 
 #include <string>
 
