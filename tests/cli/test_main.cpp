@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -12,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mneedle/fe/blas_kernels.h"
 #include "run_mneedle.h"
 
 namespace {
@@ -752,9 +754,15 @@ TEST(Environment, BlasKernelsOffMovesNoResultBeyondRoundOffAndABadValueIsOneLine
   EXPECT_NEAR(a["needles"][0]["puncture"]["depth_m"].get<double>(), depth, 1e-9 * depth);
   EXPECT_NEAR(a["needles"][0]["puncture"]["force_N"].get<double>(), force, 1e-9 * force);
   if (!b["blas_kernels"].is_null()) {
-    // off: OpenBLAS's own choice, detected and used alike; auto: the same detection.
+    // off: OpenBLAS's own choice, detected and used alike; auto: the same detection, and the
+    // table's core where it has one for this CPU (this test's environment names none).
     EXPECT_EQ(b["blas_kernels"]["used"], b["blas_kernels"]["detected"]);
     EXPECT_EQ(a["blas_kernels"]["detected"], b["blas_kernels"]["detected"]);
+    const std::string better = mneedle::fe::better_openblas_core(
+        b["blas_kernels"]["detected"].get<std::string>(), mneedle::fe::cpu_simd_level());
+    if (std::getenv("OPENBLAS_CORETYPE") == nullptr && !better.empty()) {
+      EXPECT_EQ(a["blas_kernels"]["used"], better);
+    }
   }
   const auto bad = mneedle::test::run_command("MNEEDLE_BLAS_KERNELS=fastest '" +
                                               mneedle::test::mneedle_binary() + run);

@@ -95,14 +95,14 @@ BlasKernels apply(BlasKernelChoice choice) {
   kernels.detected = kernels.used = core_name();
   // A core the user named is OpenBLAS's choice already; a build without DYNAMIC_ARCH has one.
   const char* named = std::getenv("OPENBLAS_CORETYPE");
-  if (choice == BlasKernelChoice::Off || (named != nullptr && *named != '\0') || quit == nullptr ||
-      init == nullptr)
+  if (choice == BlasKernelChoice::Off || named != nullptr || quit == nullptr || init == nullptr)
     return kernels;
   const std::string better = better_openblas_core(kernels.detected, cpu_simd_level());
   if (better.empty()) return kernels;
-  // OpenBLAS reads OPENBLAS_CORETYPE when it initialises its kernel table; it checks the CPU
-  // again for the named core (and steps down when the registers are missing). The variable is
-  // removed again so that the environment stays the user's.
+  // OpenBLAS reads OPENBLAS_CORETYPE when it initialises its kernel table and takes the named
+  // core as given: cpu_simd_level() above (CPUID and the operating system's register support) is
+  // what keeps an instruction the CPU lacks from running. The variable is removed again so that
+  // the environment stays the user's (it was unset: a user's value, even empty, is kept above).
   ::setenv("OPENBLAS_CORETYPE", better.c_str(), 1);
   quit();
   init();

@@ -81,8 +81,10 @@ constexpr std::size_t kColumnChunkNodes = 64;
 // past them the probe reads the field once per output depth (docs/performance.md, "The contact
 // block").
 constexpr std::size_t kWatchedBlockNodes = 16;
-// Depths whose watched rows one back substitution reads (Indentation3d::watched_displacements).
+// Depths whose watched rows one back substitution reads (Indentation3d::watched_displacements),
+// and the dense copies of the field it may hold for them: 256 MiB, as kWatchedRowsBudget.
 constexpr Eigen::Index kBackSolveColumns = 8;
+constexpr double kBackSolveBudget = 256.0 * 1024 * 1024;
 // Largest dense factor of the contact block (Impl::contact_block_fits): 256 MiB, 3 × 1900
 // surface nodes.
 constexpr double kContactBlockBudget = 256.0 * 1024 * 1024;
@@ -1537,11 +1539,15 @@ Eigen::MatrixXd Indentation3d::watched_displacements(const Eigen::MatrixXd& load
   if (!m.solver.has_trailing_block() || loads.rows() != m.surface_rows())
     throw InputError("3-D indentation: trailing loads of the wrong size, or no trailing block");
   Eigen::MatrixXd out(3 * static_cast<Eigen::Index>(m.watched.size()), loads.cols());
-  // kBackSolveColumns at a time: each back substitution holds two dense copies of the field per
-  // column (0.5 GB for eight columns of a 4-million-dof problem), and the factor streamed once
-  // for eight already costs about what it costs for one.
-  for (Eigen::Index first = 0; first < loads.cols(); first += kBackSolveColumns) {
-    const Eigen::Index count = std::min<Eigen::Index>(kBackSolveColumns, loads.cols() - first);
+  // At most kBackSolveColumns at a time, and fewer where the field is large: a back
+  // substitution holds about four dense copies of the field per column (the load, CHOLMOD's two
+  // results and ours), kept within kBackSolveBudget; streaming the factor once for eight columns
+  // already costs about what it costs for one.
+  const double per_column = 4.0 * 8.0 * static_cast<double>(m.model.dof_count());
+  const Eigen::Index batch = std::clamp<Eigen::Index>(
+      static_cast<Eigen::Index>(kBackSolveBudget / per_column), 1, kBackSolveColumns);
+  for (Eigen::Index first = 0; first < loads.cols(); first += batch) {
+    const Eigen::Index count = std::min<Eigen::Index>(batch, loads.cols() - first);
     const Eigen::MatrixXd u = m.solver.solve_trailing_loads(loads.middleCols(first, count));
     for (std::size_t w = 0; w < m.watched.size(); ++w)
       out.block(3 * static_cast<Eigen::Index>(w), first, 3, count) =
@@ -1774,6 +1780,13 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
     for (std::size_t n = 0; n < needles.size(); ++n) step.needles[n].tip_stress_Pa = peak[n];
     stress_seconds += seconds_since(probe_start);
   };
+  // The watched nodes' displacement at the last depth, its cost counted as the probe's.
+  const auto timed_watched = [&]() {
+    const auto read_start = Clock::now();
+    Eigen::VectorXd watched = run.watched_displacement();
+    stress_seconds += seconds_since(read_start);
+    return watched;
+  };
   // Once the watched rows cost a back substitution per depth (a flat face's many captures), the
   // rest of the depths are advanced first and read in one back substitution of several columns:
   // the factor is streamed once instead of once per depth (docs/performance.md, "The stress
@@ -1786,46 +1799,55 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
     const double depth = options.depth * k / steps;
     Step3d step = run.advance_to(depth);
     if (look_ahead && run.watched_by_back_solve()) {
-      std::vector<Step3d> ahead{std::move(step)};
-      std::vector<double> depths{depth};
+      // Each depth's watched rows: a column of `loads` for the back substitution, or (were the
+      // rows kept again) read at once.
+      std::vector<Step3d> ahead;
+      std::vector<double> depths;
+      std::vector<Eigen::Index> column;  // -1: read at once, into `direct`
+      std::vector<Eigen::VectorXd> direct;
       Eigen::MatrixXd loads(run.watched_trailing_loads().size(), steps - k + 1);
-      loads.col(0) = run.watched_trailing_loads();
+      Eigen::Index used = 0;
+      // Recorded only once its rows are in hand, so a failure leaves the lists aligned.
+      const auto collect = [&](Step3d advanced, double at) {
+        Eigen::Index at_column = -1;
+        Eigen::VectorXd read;
+        if (run.watched_by_back_solve()) {
+          loads.col(used) = run.watched_trailing_loads();
+          at_column = used++;
+        } else {
+          read = timed_watched();
+        }
+        ahead.push_back(std::move(advanced));
+        depths.push_back(at);
+        column.push_back(at_column);
+        direct.push_back(std::move(read));
+      };
+      collect(std::move(step), depth);
       // A depth past the caller's stop must not end the run: its failure is kept and raised
       // only if the caller asks for that depth.
       std::exception_ptr failed;
-      bool last_read = false;  // the last depth's rows were read directly
-      for (int j = k + 1; j <= steps; ++j) {
+      for (int j = k + 1; j <= steps && !failed; ++j) {
         const double next = options.depth * j / steps;
         try {
-          ahead.push_back(run.advance_to(next));
+          collect(run.advance_to(next), next);
         } catch (const std::exception&) {
           failed = std::current_exception();
-          break;
         }
-        depths.push_back(next);
-        // The captures only grow, so the rows stay unkept; were they kept, read them now.
-        if (!run.watched_by_back_solve()) {
-          probe_step(ahead.back(), next, run.watched_displacement());
-          last_read = true;
-          break;
-        }
-        loads.col(static_cast<Eigen::Index>(ahead.size()) - 1) = run.watched_trailing_loads();
       }
       const auto solve_start = Clock::now();
-      const auto solved = static_cast<Eigen::Index>(ahead.size() - (last_read ? 1 : 0));
-      const Eigen::MatrixXd watched = run.watched_displacements(loads.leftCols(solved));
+      const Eigen::MatrixXd watched = run.watched_displacements(loads.leftCols(used));
       stress_seconds += seconds_since(solve_start);
       bool stopped = false;
       for (std::size_t i = 0; i < ahead.size() && !stopped; ++i) {
-        if (static_cast<Eigen::Index>(i) < solved)
-          probe_step(ahead[i], depths[i], watched.col(static_cast<Eigen::Index>(i)));
+        probe_step(ahead[i], depths[i],
+                   column[i] >= 0 ? Eigen::VectorXd(watched.col(column[i])) : direct[i]);
         result.steps.push_back(whole_scene_step(ahead[i], selection, all_needles));
         stopped = options.on_step && !options.on_step(result.steps.back());
       }
       if (failed && !stopped) std::rethrow_exception(failed);
       break;
     }
-    if (stress_probe) probe_step(step, depth, run.watched_displacement());
+    if (stress_probe) probe_step(step, depth, timed_watched());
     if (cracked_run) {
       const Step3d opened = cracked_run->advance_to(depth);
       const double release = (step.strain_energy_J - opened.strain_energy_J) / total_crack_area;

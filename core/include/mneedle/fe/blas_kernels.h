@@ -28,7 +28,7 @@ SimdLevel openblas_core_level(const std::string& core);
 std::string better_openblas_core(const std::string& detected, SimdLevel cpu);
 
 /// `auto` (the default): replace OpenBLAS's kernels by better_openblas_core's choice; `off`:
-/// keep OpenBLAS's own. Either way a core the user names in OPENBLAS_CORETYPE is kept.
+/// keep OpenBLAS's own. Either way a user's OPENBLAS_CORETYPE (set, even empty) is kept.
 enum class BlasKernelChoice { Auto, Off };
 
 /// MNEEDLE_BLAS_KERNELS ("auto" or "off"; unset or empty: auto). Throws InputError
