@@ -125,7 +125,7 @@ void check(const PlaneStrainInsertionProblem& p) {
     // The cohesive zone must be resolved: Hillerborg's length E G_c / sigma_max^2 (the scale of
     // the process zone) at least kInsertionMinCellsPerCohesiveLength cells, or the puncture
     // depth follows the mesh (docs/model.md, "Cohesive interface").
-    const double peak = 2.0 * c.toughness_J_per_m2 / c.failure_opening_m;
+    const double peak = cohesive_peak_traction(c);
     const double length = p.youngs_modulus_Pa * c.toughness_J_per_m2 / (peak * peak);
     if (length < kInsertionMinCellsPerCohesiveLength * h)
       bad("element_size_m",
@@ -254,25 +254,6 @@ class Block {
 
 }  // namespace
 
-double cohesive_damage(const CohesiveLaw& law, double largest_opening_m) {
-  if (!(law.toughness_J_per_m2 > 0.0) || largest_opening_m <= law.peak_opening_m) return 0.0;
-  if (largest_opening_m >= law.failure_opening_m) return 1.0;
-  // On the softening branch t = t_peak (delta_0 - delta) / (delta_0 - delta_y).
-  const double peak = 2.0 * law.toughness_J_per_m2 / law.failure_opening_m;
-  const double delta = largest_opening_m;
-  const double t =
-      peak * (law.failure_opening_m - delta) / (law.failure_opening_m - law.peak_opening_m);
-  return 1.0 - t / (peak / law.peak_opening_m * delta);
-}
-
-double cohesive_traction(const CohesiveLaw& law, double opening_m, double largest_opening_m) {
-  if (!(law.toughness_J_per_m2 > 0.0) || !(opening_m > 0.0)) return 0.0;
-  const double peak = 2.0 * law.toughness_J_per_m2 / law.failure_opening_m;
-  const double stiffness0 = peak / law.peak_opening_m;
-  const double reached = std::max(opening_m, largest_opening_m);
-  return (1.0 - cohesive_damage(law, reached)) * stiffness0 * opening_m;
-}
-
 PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInsertionProblem& p) {
   check(p);
   const Block block(p);
@@ -307,8 +288,7 @@ PlaneStrainInsertionResult simulate_plane_strain_insertion(const PlaneStrainInse
   // f_x = -2 L_j s_j u_x (the opening delta = 2 u_x: both halves move apart).
   const CohesiveLaw& law = p.cohesion;
   const bool cohesive = law.toughness_J_per_m2 > 0.0;
-  const double peak_traction =
-      cohesive ? 2.0 * law.toughness_J_per_m2 / law.failure_opening_m : 0.0;
+  const double peak_traction = cohesive_peak_traction(law);
   std::vector<double> share(m, 0.0), opened(m, 0.0), secant(m, 0.0), damage(m, 0.0);
   const double stiffness0 = cohesive ? peak_traction / law.peak_opening_m : 0.0;
   // The law's damage at the largest opening reached: t = (1 - D) K delta on unloading.
