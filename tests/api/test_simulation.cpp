@@ -6,6 +6,7 @@
 
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "error_message.h"
 #include "mneedle/base/error.h"
@@ -157,6 +158,59 @@ TEST(Simulation, StressThatReadZeroUnderLoadIsOneWarningNamingTheLength) {
     EXPECT_NE(warnings[0].find(part), std::string::npos) << warnings[0];
   EXPECT_EQ(warnings[0].find('\n'), std::string::npos);
   run.needles[0].curve[0].tip_stress_Pa = 1.0;
+  EXPECT_TRUE(criterion_warnings(run, scene).empty());
+}
+
+
+// A linear top layer 7463 times stiffer than the layer beneath (paper A's stratum corneum over
+// its epidermis), pushed deeper than its 20 um thickness before the needle punctures it, is one
+// warning naming the scene, the layer, the needle and the ratio; a finite-strain layer, a
+// puncture within the thickness or a contrast below kStiffTopLayerContrast say nothing, and a
+// needle that never punctures is judged by its deepest pre-puncture depth.
+TEST(Simulation, ALinearStiffTopLayerPushedBeyondItsThicknessIsOneWarning) {
+  Scene scene;
+  scene.source_name = "skin.toml";
+  TissueLayer top, below;
+  top.name = "stratum_corneum";
+  top.thickness = 20e-6;
+  top.material.youngs_modulus = 1e9;
+  below.name = "epidermis";
+  below.thickness = 100e-6;
+  below.material.youngs_modulus = 0.134e6;
+  scene.tissue.layers = {top, below};
+  InsertionRun run;
+  run.criterion = PunctureCriterion::Stress;
+  NeedleRun needle;
+  needle.name = "cylinder";
+  RunPoint point;
+  point.stage = Stage::Pre;
+  point.depth_m = 140.9e-6;
+  needle.curve.push_back(point);
+  Puncture puncture;
+  puncture.depth_m = 140.9e-6;
+  needle.puncture = puncture;
+  run.needles.push_back(needle);
+  std::vector<std::string> warnings = criterion_warnings(run, scene);
+  ASSERT_EQ(warnings.size(), 1u);
+  for (const char* part : {"skin.toml", "'stratum_corneum'", "'cylinder'", "140.9 um",
+                           "before it punctures", "7.0 times", "7463 times softer", "svk"})
+    EXPECT_NE(warnings[0].find(part), std::string::npos) << part << ": " << warnings[0];
+  EXPECT_EQ(warnings[0].find('\n'), std::string::npos);
+  // No puncture: the deepest pre-puncture depth, 50 um.
+  run.needles[0].puncture.reset();
+  run.needles[0].curve[0].depth_m = 50e-6;
+  warnings = criterion_warnings(run, scene);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("2.5 times"), std::string::npos) << warnings[0];
+  EXPECT_EQ(warnings[0].find("before it punctures"), std::string::npos) << warnings[0];
+  // Within the thickness, a finite-strain layer, a weak contrast: nothing.
+  run.needles[0].curve[0].depth_m = 19e-6;
+  EXPECT_TRUE(criterion_warnings(run, scene).empty());
+  run.needles[0].curve[0].depth_m = 50e-6;
+  scene.tissue.layers[0].material.model = MaterialModel::StVenantKirchhoff;
+  EXPECT_TRUE(criterion_warnings(run, scene).empty());
+  scene.tissue.layers[0].material.model = MaterialModel::Linear;
+  scene.tissue.layers[0].material.youngs_modulus = 0.9 * kStiffTopLayerContrast * 0.134e6;
   EXPECT_TRUE(criterion_warnings(run, scene).empty());
 }
 

@@ -17,6 +17,7 @@
 #include <sstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace {
 
@@ -366,13 +367,15 @@ TEST(CmdSimulate, ABluntBevelsFlatIsMeshedWithCellsOfTwiceTheCriterionLength) {
 
 // A scene's `contact_zone = "none"` trades the flat's zone for speed: the blunt bevel then reads
 // what the levels read before they took it, 100.03 um at fast (17 % deep; pinned to 1 %), with no
-// zone in the mesh and no warning (the scene asked for it).
+// zone in the mesh and no warning about the zone (the scene asked for it; the linear stratum
+// corneum pushed past its thickness is warned about, as on every run of these scenes).
 TEST(CmdSimulate, ASceneCanTurnTheFlatsZoneOffAndReadsTheUnresolvedDepth) {
   const nlohmann::json j = simulate_with_zone("paper_a_skin_blunt_bevel.toml",
                                               "contact_zone = \"none\"", "--fidelity fast");
   ASSERT_TRUE(j.is_object());
   EXPECT_DOUBLE_EQ(j["mesh"]["contact_zone_m"].get<double>(), 0.0);
-  EXPECT_TRUE(j["warnings"].empty()) << j["warnings"].dump();
+  for (const auto& w : j["warnings"])
+    EXPECT_EQ(w.get<std::string>().find("contact zone"), std::string::npos) << w;
   EXPECT_NEAR(j["needles"][0]["puncture"]["depth_m"].get<double>(), 100.03e-6, 0.01 * 100.03e-6);
 }
 
@@ -395,8 +398,12 @@ TEST(CmdSimulate, AFlatEndTooWideForItsZoneIsReadOnCoarseCellsAndTheRunSaysSo) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
   EXPECT_DOUBLE_EQ(j["mesh"]["contact_zone_m"].get<double>(), 0.0);
-  ASSERT_EQ(j["warnings"].size(), 1u) << j["warnings"].dump();
-  const std::string warning = j["warnings"][0].get<std::string>();
+  // The zone's warning; the other one is the small-strain stratum corneum's.
+  std::vector<std::string> zone;
+  for (const auto& w : j["warnings"])
+    if (w.get<std::string>().find("contact zone") != std::string::npos) zone.push_back(w);
+  ASSERT_EQ(zone.size(), 1u) << j["warnings"].dump();
+  const std::string warning = zone[0];
   EXPECT_NE(warning.find("wide_flat_"), std::string::npos) << warning;
   EXPECT_NE(warning.find("stratum_corneum"), std::string::npos) << warning;
   EXPECT_NE(warning.find("no contact zone"), std::string::npos) << warning;

@@ -37,9 +37,17 @@ InsertionRunOptions simulate_run_options(const Scene& scene, const SimulateSetti
 /// (docs/model.md, "Penetration criterion"): a top layer thinner than the needle's diameter (no
 /// half-space), a layer so brittle against the needle that F_p is an upper bound. Energy
 /// ("Crack faces in contact"): crack faces that passed through each other (their contact is not
-/// modelled on that path). Empty for the other criteria. The CLI prints them on stderr, Python
-/// raises them as RuntimeWarnings.
+/// modelled on that path). Stress: a probe that read nothing, flat ends without a contact zone.
+/// Any criterion: a linear (small-strain) top layer at least kStiffTopLayerContrast times stiffer
+/// than the layer beneath, pushed deeper than its own thickness before puncture
+/// (docs/validation.md, "Finite strain in a stiff top layer"). The CLI prints them on stderr,
+/// Python raises them as RuntimeWarnings.
 std::vector<std::string> criterion_warnings(const InsertionRun& run, const Scene& scene);
+
+/// E of the top layer over E of the one beneath from which a small-strain top layer pushed
+/// beyond its thickness is warned about: a stiff film on a soft base, which bends and stretches
+/// like a plate (the stratum corneum over the epidermis: 7463).
+inline constexpr double kStiffTopLayerContrast = 10.0;
 
 /// The run as `simulate --json` prints it (without provenance): needles with curves and
 /// punctures, mesh, total curve, models, reductions, criterion, loads, energy check, memory and
