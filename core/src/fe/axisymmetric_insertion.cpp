@@ -61,11 +61,12 @@ double gap(const AxisymmetricNeedle& needle, double depth, const Eigen::Vector2d
 }
 
 // Captures every candidate node that entered the needle between (d0, u0) and (d1, u1), at the
-// linearly interpolated crossing. Returns how many were added.
+// linearly interpolated crossing, as long as that crossing lies within `latest` of the step.
+// Returns how many were added.
 int capture_new_nodes(const AxisymmetricNeedle& needle,
                       const std::vector<std::uint32_t>& candidates, const AxisymmetricMesh& mesh,
                       double d0, const Eigen::VectorXd& u0, double d1, const Eigen::VectorXd& u1,
-                      ContactState& state) {
+                      ContactState& state, double latest = 1.0) {
   int added = 0;
   for (std::uint32_t node : candidates) {
     if (state.captured.count(node)) continue;
@@ -76,11 +77,39 @@ int capture_new_nodes(const AxisymmetricNeedle& needle,
     if (!(g1 < 0.0)) continue;
     const double g0 = gap(needle, d0, p0);
     const double t = std::isfinite(g0) && g0 > 0.0 ? g0 / (g0 - g1) : 0.0;
+    if (t > latest) continue;
     state.captured[node] = Capture{p0 + t * (p1 - p0), d0 + t * (d1 - d0)};
     ++added;
   }
   return added;
 }
+
+// The earliest crossing, as a fraction t of the step (d0, d1], of the candidates not yet captured
+// that are inside the needle at d1 (as capture_new_nodes interpolates it); 2 when none is.
+double earliest_capture(const AxisymmetricNeedle& needle,
+                        const std::vector<std::uint32_t>& candidates, const AxisymmetricMesh& mesh,
+                        double d0, const Eigen::VectorXd& u0, double d1, const Eigen::VectorXd& u1,
+                        const ContactState& state) {
+  double earliest = 2.0;
+  for (std::uint32_t node : candidates) {
+    if (state.captured.count(node)) continue;
+    const Eigen::Vector2d X = mesh.nodes[node];
+    const double g1 = gap(needle, d1, X + Eigen::Vector2d(u1[2 * node], u1[2 * node + 1]));
+    if (!(g1 < 0.0)) continue;
+    const double g0 = gap(needle, d0, X + Eigen::Vector2d(u0[2 * node], u0[2 * node + 1]));
+    earliest = std::min(earliest, std::isfinite(g0) && g0 > 0.0 ? g0 / (g0 - g1) : 0.0);
+  }
+  return earliest;
+}
+
+// A capture inside a step ends the step there (docs/model.md, "Captures at their own depth"):
+// nodes are captured only when the earliest of them crosses within this fraction of the step's
+// end, or when the step left is shorter than kShortestCaptureStep of the sub-step. Capturing
+// every node inside the needle at the step's end instead pins nodes the tissue would have
+// carried away before the needle reached them (a stiff layer bends away from a rounded tip): the
+// depth then moved with the step (a 37 um rounded tip on skin fired at the first step).
+constexpr double kCaptureGroup = 1e-3;
+constexpr double kShortestCaptureStep = 1e-6;
 
 Eigen::Vector2d captured_displacement(const AxisymmetricMesh& mesh, std::uint32_t node,
                                       const Capture& c, double depth) {
@@ -440,6 +469,7 @@ class NonlinearStepper : public Stepper {
       trial_pairs.latched.assign(pairs_.size(), 0);
       int trial_iterations = 0;
       int largest_solve = 0;  // Newton iterations of the step's hardest single solve
+      double event = 0.0;     // > 0: a capture inside the step, which ends there
       std::string failure;
       Equilibrium trial;
       try {
@@ -451,9 +481,18 @@ class NonlinearStepper : public Stepper {
             50 + (close_pairs_ ? kMaxCrackRounds + 4 * static_cast<int>(pairs_.size()) : 0);
         largest_solve = trial.newton_iterations;
         for (int round = 0;; ++round) {
+          // The first capture inside the step ends the step there (kCaptureGroup).
+          const double t =
+              earliest_capture(needle_, candidates_, mesh, depth_, current_.displacement, next,
+                               trial.displacement, trial_state);
+          const double start = kShortestCaptureStep * interval_ / (next - depth_);
+          if (t > start && t < 1.0 - kCaptureGroup) {
+            event = depth_ + t * (next - depth_);
+            break;
+          }
           const bool captured =
               capture_new_nodes(needle_, candidates_, mesh, depth_, current_.displacement, next,
-                                trial.displacement, trial_state) > 0;
+                                trial.displacement, trial_state, t <= start ? start : 1.0) > 0;
           PairUpdate pairs = close_pairs_
                                  ? update_pairs(trial.displacement, next, round, trial_pairs)
                                  : PairUpdate::Settled;
@@ -477,6 +516,11 @@ class NonlinearStepper : public Stepper {
         throw;  // a shorter step needs as much memory
       } catch (const SolverError& e) {
         failure = e.what();
+      }
+      if (event > 0.0) {
+        step_ = event - depth_;
+        iterations += trial_iterations;
+        continue;
       }
       if (!failure.empty()) {
         step_ *= 0.5;
@@ -620,13 +664,26 @@ class LinearStepper : public Stepper {
     if (!surface_) return make_step(target, 0, 0, 0, 0, 0);
     int solves = 0;
     while (depth_ < target * (1.0 - 1e-12)) {
-      const double next = std::min(target, depth_ + sub_step_ * (1.0 + 1e-9));
+      double next = std::min(target, depth_ + sub_step_ * (1.0 + 1e-9));
       for (int round = 0; round < 1000; ++round) {
         solve_contact(next);
         ++solves;
-        if (capture_new_nodes(needle_, candidates_, mesh_, depth_, previous_, next,
-                              surface_->scatter(u_, n_), state_) == 0)
-          break;
+        const Eigen::VectorXd u = surface_->scatter(u_, n_);
+        const double t =
+            earliest_capture(needle_, candidates_, mesh_, depth_, previous_, next, u, state_);
+        if (t > 1.0) break;
+        // Nodes already touching at the step's start are captured there; otherwise the first
+        // capture inside the step ends the step there: solve again at it.
+        const double start = kShortestCaptureStep * sub_step_ / (next - depth_);
+        if (t <= start) {
+          capture_new_nodes(needle_, candidates_, mesh_, depth_, previous_, next, u, state_, start);
+          continue;
+        }
+        if (t < 1.0 - kCaptureGroup) {
+          next = depth_ + t * (next - depth_);
+          continue;
+        }
+        capture_new_nodes(needle_, candidates_, mesh_, depth_, previous_, next, u, state_);
       }
       depth_ = next;
       previous_ = surface_->scatter(u_, n_);

@@ -52,6 +52,16 @@ std::string micrometres(double metres) {
 }
 
 constexpr int kMaxCaptureRounds = 60;
+// Nonlinear sticking (solve_nonlinear_at): a node's entry inside a step is bisected to
+// 2^-kEntryBisections of the step; nodes inside at the step's start are those entering within
+// its first kCaptureStartFraction.
+constexpr int kEntryBisections = 30;
+constexpr double kCaptureStartFraction = 1e-6;
+
+// The first capture of a nonlinear step enters before the step's end: the step ends at `depth`.
+struct CaptureEvent {
+  double depth;
+};
 // Captures in depth order (advance_linear): a node's entry depth is bisected to
 // kCaptureBisection x the needle's radius; the nodes entering within kCaptureGroup x the radius
 // after the first are captured with it (1.15 um for paper A's needles), at most a fiftieth of the
@@ -876,13 +886,58 @@ struct Indentation3d::Impl {
     });
   }
 
-  int solve_nonlinear_at(double at_depth) {
+  // Where, as a fraction t of the step from (from_depth, from_u) to (at_depth, u), the node of
+  // capture c entered its needle, both moving linearly over the step: bisected on the needle's
+  // inside test to kEntryBisections halvings.
+  double entry_fraction(const CapturedNode& c, double from_depth, const Eigen::VectorXd& from_u,
+                        double at_depth) const {
+    const auto node = static_cast<std::size_t>(c.node);
+    const Eigen::Vector3d x0 = mesh.nodes[node] + from_u.segment<3>(3 * c.node);
+    const Eigen::Vector3d x1 = mesh.nodes[node] + u.segment<3>(3 * c.node);
+    const auto inside = [&](double t) {
+      const Eigen::Vector3d local =
+          x0 + t * (x1 - x0) - tip(c.needle, from_depth + t * (at_depth - from_depth));
+      return shapes[static_cast<std::size_t>(c.needle)].touches(local);
+    };
+    if (inside(0.0)) return 0.0;
+    double lo = 0.0, hi = 1.0;
+    for (int i = 0; i < kEntryBisections; ++i)
+      (inside(0.5 * (lo + hi)) ? hi : lo) = 0.5 * (lo + hi);
+    return hi;
+  }
+
+  // Nonlinear sticking: the nodes that enter a needle within the step are captured in depth order
+  // (docs/model.md, "Contact with the rigid needle (sticking)"): those inside at the step's start
+  // at once; when the first of the others enters more than the group length (group_length(), as
+  // on the linear path) before the step's end, the step ends that far after it (CaptureEvent);
+  // otherwise every node found is captured at the step's end. A twin copying a leader's captures
+  // takes them as they come.
+  int solve_nonlinear_at(double at_depth, double from_depth, const Eigen::VectorXd& from_u) {
     int total = 0;
     for (int round = 0; round < kMaxCaptureRounds; ++round) {
       total += newton(at_depth);
       const auto start = Clock::now();
-      const auto found = find_new_captures(
+      auto found = find_new_captures(
           at_depth, [&](int node) -> Eigen::Vector3d { return u.segment<3>(3 * node); });
+      if (!found.empty() && !leader) {
+        const double step_start = kCaptureStartFraction;
+        std::vector<double> t;
+        for (const CapturedNode& c : found)
+          t.push_back(entry_fraction(c, from_depth, from_u, at_depth));
+        const double first = *std::min_element(t.begin(), t.end());
+        // The nodes entering within the group length of the first are captured with it.
+        const double end = from_depth + first * (at_depth - from_depth) + group_length();
+        if (first > step_start && end < at_depth - 1e-9 * (at_depth - from_depth)) {
+          timing.contact_s += seconds_since(start);
+          throw CaptureEvent{end};
+        }
+        if (first <= step_start) {
+          std::vector<CapturedNode> at_start;
+          for (std::size_t i = 0; i < found.size(); ++i)
+            if (t[i] <= step_start) at_start.push_back(found[i]);
+          found = std::move(at_start);
+        }
+      }
       timing.contact_s += seconds_since(start);
       if (found.empty()) return total;
       add_captures(found);
@@ -907,13 +962,20 @@ struct Indentation3d::Impl {
           frictionless() ? multipliers_of() : std::vector<double>{};
       try {
         const int used = frictionless() ? solve_frictionless_nonlinear_at(depth + h)
-                                        : solve_nonlinear_at(depth + h);
+                                        : solve_nonlinear_at(depth + h, depth, saved_u);
         total += used;
         depth += h;
         if (used <= 4) step = 1.5 * h;
         cuts = 0;
       } catch (const OutOfMemoryError&) {
         throw;  // a shorter step needs as much memory
+      } catch (const CaptureEvent& event) {
+        // The step ends where its first capture enters: not a failure, no cut counted.
+        u = saved_u;
+        for (std::size_t i = saved_captured; i < captured.size(); ++i)
+          captured_by[static_cast<std::size_t>(captured[i].node)] = -1;
+        captured.resize(saved_captured);
+        step = event.depth - depth;
       } catch (const SolverError& error) {
         u = saved_u;
         if (frictionless()) contact->set_multipliers(saved_multipliers);
