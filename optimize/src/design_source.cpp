@@ -142,7 +142,26 @@ std::optional<fe::AxisymmetricNeedle> axisymmetric_profile(const PluginRegistry&
   const std::map<std::string, double>& p = needle.params;
   const double radius = 0.5 * p.at("diameter");
   const double bore = p.count("bore") ? 0.5 * p.at("bore") : 0.0;
-  if (*needle.plugin == "cylinder") return fe::AxisymmetricNeedle::flat_punch(radius, bore);
+  if (*needle.plugin == "cylinder") {
+    const double edge = p.count("edge_radius") ? p.at("edge_radius") : 0.0;
+    if (!(edge > 0.0)) return fe::AxisymmetricNeedle::flat_punch(radius, bore);
+    // A rounded rim: the flat out to R - rho, then the quarter circle, sampled densely towards
+    // the flat where the radius grows as sqrt(2 rho h), from the plugin's own section.
+    fe::AxisymmetricNeedle profile;
+    profile.bore_radius_m = bore;
+    constexpr int kRimSamples = 48;
+    for (int k = 0; k <= kRimSamples; ++k) {
+      const double f = static_cast<double>(k) / kRimSamples;
+      const double h = edge * f * f;
+      const std::optional<double> area = registry.section_area(*needle.plugin, p, h);
+      if (!area) throw InputError(where + ": the cylinder plugin gives no section area");
+      const double r = std::sqrt(std::max(*area / M_PI + bore * bore, 0.0));
+      profile.heights_m.push_back(h);
+      profile.radii_m.push_back(
+          std::max({r, profile.radii_m.empty() ? 0.0 : profile.radii_m.back(), bore}));
+    }
+    return profile;
+  }
   // Cone: sample the section so that a rounded tip (tip_radius) is followed too.
   const double length = p.at("length");
   const double taper = (radius - bore) / std::tan(p.at("half_angle"));

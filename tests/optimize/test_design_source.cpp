@@ -111,6 +111,34 @@ TEST_F(DesignSource, ARoundedConesProfileFollowsItsSphericalCap) {
   EXPECT_LE(profile->radii_m.front(), 1e-9 * profile->max_radius());  // still pointed
 }
 
+// A cylinder whose rim is rounded (edge_radius rho) runs the axisymmetric model on its own
+// profile, not a flat punch: flat out to R - rho, then the quarter circle
+// R - rho + sqrt(rho^2 - (rho - h)^2) up to h = rho, sampled densely towards the flat.
+TEST_F(DesignSource, ARoundedCylindersProfileFollowsItsRim) {
+  const double rho = 10e-6, radius = 115e-6, bore = 45e-6;
+  const auto cylinder = mneedle::needle_from_plugin(registry_, "cylinder",
+                                                    {{"edge_radius", rho}, {"bore", 2 * bore}});
+  const auto profile = mneedle::axisymmetric_profile(registry_, cylinder, "cylinder");
+  ASSERT_TRUE(profile.has_value());
+  EXPECT_EQ(profile->bore_radius_m, bore);
+  EXPECT_NEAR(profile->radii_m.front(), radius - rho, 1e-12);
+  EXPECT_EQ(profile->heights_m.front(), 0.0);
+  EXPECT_NEAR(profile->max_radius(), radius, 1e-12);
+  EXPECT_GE(profile->heights_m.size(), 32u);
+  for (std::size_t i = 0; i < profile->heights_m.size(); ++i) {
+    const double h = profile->heights_m[i];
+    EXPECT_NEAR(profile->radii_m[i], radius - rho + std::sqrt(rho * rho - (rho - h) * (rho - h)),
+                1e-12)
+        << "h = " << h;
+  }
+  // Without rounding it is the flat punch.
+  const auto sharp = mneedle::axisymmetric_profile(
+      registry_, mneedle::needle_from_plugin(registry_, "cylinder", {}), "cylinder");
+  ASSERT_TRUE(sharp.has_value());
+  EXPECT_EQ(sharp->heights_m.size(), 1u);
+  EXPECT_EQ(sharp->radii_m.front(), radius);
+}
+
 TEST_F(DesignSource, ABevelOrAMeshThatIsNotRoundHasNoProfile) {
   const auto bevel = mneedle::needle_from_file(kRoot + "/designs/sharp_bevel.stl", 1e-3);
   EXPECT_FALSE(mneedle::revolution_profile(bevel.mesh).has_value());

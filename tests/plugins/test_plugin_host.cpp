@@ -244,11 +244,12 @@ TEST(PluginHost, NonFiniteParameterIsAnInputError) {
 TEST(PluginHost, MissingParametersTakeTheirDefaults) {
   const PluginRegistry registry = PluginRegistry::discover();
   const std::vector<double> values = registry.resolve_parameters("cylinder", {{"length", 2e-3}});
-  ASSERT_EQ(values.size(), 4u);
+  ASSERT_EQ(values.size(), 5u);
   EXPECT_DOUBLE_EQ(values[0], 230e-6);
   EXPECT_DOUBLE_EQ(values[1], 2e-3);
   EXPECT_DOUBLE_EQ(values[2], 0.0);
   EXPECT_DOUBLE_EQ(values[3], 64.0);
+  EXPECT_DOUBLE_EQ(values[4], 0.0);  // edge_radius: a sharp rim
 }
 
 TEST(PluginHost, MovedRegistryKeepsItsLibrariesLoaded) {
