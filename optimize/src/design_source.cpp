@@ -251,6 +251,51 @@ bool closes_round(const Coverage& c) {
 
 }  // namespace
 
+namespace {
+
+struct Polar {
+  double z, r, angle;
+};
+
+// One height's ring(s) of vertices off the axis: the outer radius (0 when none: a sharp point on
+// the axis) and, for a hollow needle, the bore's, each the equal-area radius of its polygon.
+struct Rings {
+  double outer = 0.0;
+  double bore = -1.0;  // < 0: no bore ring at this height
+};
+
+// The rings of the vertices [begin, end) (sorted by height), or nullopt when they are not one or
+// two circles all the way round. Two circles are the bore and the outer ring (a hollow end).
+std::optional<Rings> rings_of(const std::vector<Polar>& points, std::size_t begin, std::size_t end,
+                              double tol) {
+  std::vector<std::pair<double, std::vector<double>>> circles;  // radius, angles
+  for (std::size_t i = begin; i < end; ++i) {
+    if (points[i].r <= tol) continue;
+    auto it = std::find_if(circles.begin(), circles.end(),
+                           [&](const auto& c) { return std::abs(points[i].r - c.first) <= tol; });
+    if (it == circles.end()) {
+      if (circles.size() == 2) return std::nullopt;  // three radii: stepped
+      circles.push_back({points[i].r, {}});
+      it = circles.end() - 1;
+    }
+    it->second.push_back(points[i].angle);
+  }
+  std::sort(circles.begin(), circles.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<double> radii;
+  for (const auto& [radius, angles] : circles) {
+    const Coverage c = coverage(angles);
+    if (!closes_round(c)) return std::nullopt;
+    radii.push_back(radius * std::sqrt(c.sine_sum / (2.0 * std::numbers::pi)));
+  }
+  Rings r;
+  if (radii.size() == 1) r.outer = radii[0];
+  if (radii.size() == 2) r.bore = radii[0], r.outer = radii[1];
+  return r;
+}
+
+}  // namespace
+
 std::optional<fe::AxisymmetricNeedle> revolution_profile(const TriangleMesh& mesh) {
   if (mesh.vertices.empty() || mesh.triangles.empty()) return std::nullopt;
   const BoundingBox box = bounding_box(mesh);
@@ -259,67 +304,112 @@ std::optional<fe::AxisymmetricNeedle> revolution_profile(const TriangleMesh& mes
   for (const Vec3& v : mesh.vertices) widest = std::max(widest, std::hypot(v[0], v[1]));
   if (!(length > 0.0) || !(widest > 0.0)) return std::nullopt;
   // 1e-4 of the needle's size: far above the single precision an STL was written in (even far
-  // from its file's origin), far below any feature a design has.
-  const double tol = 1e-4 * std::max(widest, length);
-  struct Polar {
-    double z, r, angle;
-  };
+  // from its file's origin), far below any feature a design has. Heights closer than that are
+  // one ring unless they hold two radii that lie further apart than kFineHeight of the size
+  // (rings a rounded rim puts within 0.05 um of its flat): those are split at that finer scale,
+  // still ten times an STL's single precision 100 mm from its origin.
+  const double size = std::max(widest, length);
+  const double tol = 1e-4 * size;
+  constexpr double kFineHeight = 1e-6;
   std::vector<Polar> points;
   for (const Vec3& v : mesh.vertices)
     points.push_back({v[2] - box.min[2], std::hypot(v[0], v[1]), std::atan2(v[1], v[0])});
   std::sort(points.begin(), points.end(), [](const Polar& a, const Polar& b) { return a.z < b.z; });
-  // Each height's vertices off the axis: one radius, all the way round. Its section is the
-  // polygon through them, of area (r^2 / 2) sum sin(angle between neighbours).
-  std::vector<double> heights, radii;
+  // Each height's vertices off the axis: one radius (or the bore's and the outer one), all the
+  // way round. Its section is the polygon through them, of area (r^2 / 2) sum sin(angle between
+  // neighbours).
+  std::vector<double> heights;
+  std::vector<Rings> rings;
   for (std::size_t begin = 0; begin < points.size();) {
     std::size_t end = begin + 1;
     while (end < points.size() && points[end].z - points[begin].z <= tol) ++end;
-    std::vector<double> angles;
-    double radius = -1.0;
-    for (std::size_t i = begin; i < end; ++i) {
-      if (points[i].r <= tol) continue;
-      if (radius < 0.0) radius = points[i].r;
-      if (std::abs(points[i].r - radius) > tol) return std::nullopt;  // two radii: hollow, stepped
-      angles.push_back(points[i].angle);
+    std::optional<Rings> group = rings_of(points, begin, end, tol);
+    if (!group || group->bore >= 0.0) {
+      // Two radii: a bore beside the outer ring, or rings at distinct heights closer than tol.
+      std::vector<std::size_t> cuts{begin};
+      for (std::size_t i = begin + 1; i < end; ++i)
+        if (points[i].z - points[i - 1].z > kFineHeight * size) cuts.push_back(i);
+      cuts.push_back(end);
+      if (cuts.size() > 2) {
+        for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+          const std::optional<Rings> part = rings_of(points, cuts[k], cuts[k + 1], tol);
+          if (!part) return std::nullopt;
+          heights.push_back(points[cuts[k]].z);
+          rings.push_back(*part);
+        }
+        begin = end;
+        continue;
+      }
+      if (!group) return std::nullopt;
     }
     heights.push_back(points[begin].z);
-    if (angles.empty()) {
-      radii.push_back(0.0);  // on the axis only: a sharp point
-    } else {
-      const Coverage c = coverage(angles);
-      if (!closes_round(c)) return std::nullopt;
-      radii.push_back(radius * std::sqrt(c.sine_sum / (2.0 * std::numbers::pi)));
-    }
+    rings.push_back(*group);
     begin = end;
   }
-  // Between two heights the faces must close round the axis too, in one loop: a square pyramid
-  // on a round shaft has round rings and square sections, a sealed cavity two loops.
+  // One bore for the whole needle: the rings that hold two radii agree on the inner one, and a
+  // single ring of that radius above the lowest height is the bore alone (the outer profile has
+  // no vertex there).
+  double bore = -1.0;
+  for (const Rings& r : rings)
+    if (r.bore >= 0.0) {
+      if (bore >= 0.0 && std::abs(r.bore - bore) > tol) return std::nullopt;
+      bore = bore < 0.0 ? r.bore : bore;
+    }
+  std::vector<double> outer_heights, outer_radii;
+  for (std::size_t k = 0; k < rings.size(); ++k) {
+    const bool bore_only =
+        bore >= 0.0 && rings[k].bore < 0.0 && k > 0 && std::abs(rings[k].outer - bore) <= tol;
+    if (bore_only) continue;
+    outer_heights.push_back(heights[k]);
+    outer_radii.push_back(rings[k].outer);
+  }
+  // Between two heights the faces must close round the axis too, in one loop (two with a bore,
+  // one of them the bore's circle): a square pyramid on a round shaft has round rings and square
+  // sections, a sealed cavity two loops.
   std::optional<CrossSectionSlicer> slicer;
   try {
     slicer.emplace(mesh);
   } catch (const InputError&) {
     return std::nullopt;  // not a closed surface: the 3-D path says why
   }
+  // A slice's points lie on the facets, between a polygon's inscribed and circumscribed circles.
+  const double on_circle =
+      2.0 * tol + std::max(bore, 0.0) * (1.0 - std::cos(0.5 * kLargestRevolutionGap_rad));
   for (std::size_t k = 0; k + 1 < heights.size(); ++k) {
     const CrossSection section = slicer->slice(0.5 * (heights[k] + heights[k + 1]));
-    if (section.polygons.size() != 1) return std::nullopt;
-    std::vector<double> angles;
-    for (const auto& p : section.polygons.front()) angles.push_back(std::atan2(p[1], p[0]));
-    if (!closes_round(coverage(angles))) return std::nullopt;
+    const std::size_t loops = bore >= 0.0 ? 2 : 1;
+    if (section.polygons.size() != loops) return std::nullopt;
+    for (const auto& polygon : section.polygons) {
+      std::vector<double> angles;
+      bool on_bore = bore >= 0.0;
+      for (const auto& p : polygon) {
+        angles.push_back(std::atan2(p[1], p[0]));
+        on_bore = on_bore && std::abs(std::hypot(p[0], p[1]) - bore) <= on_circle;
+      }
+      if (!closes_round(coverage(angles))) return std::nullopt;
+      if (loops == 2 && &polygon == &section.polygons.front()) {
+        // One of the two loops is the bore's circle (either order).
+        bool other = true;
+        for (const auto& q : section.polygons.back())
+          other = other && std::abs(std::hypot(q[0], q[1]) - bore) <= on_circle;
+        if (!on_bore && !other) return std::nullopt;
+      }
+    }
   }
   // The profile through the rings (the faces are straight between them), heights from the tip,
   // kept non-decreasing (a narrower section above a wider one never meets the tissue first); a
   // flat end (the widest section already at the tip) is a flat punch.
   fe::AxisymmetricNeedle profile;
+  profile.bore_radius_m = std::max(bore, 0.0);
   double running = 0.0;
-  for (std::size_t k = 0; k < heights.size(); ++k) {
-    running = std::max(running, radii[k]);
-    profile.heights_m.push_back(k == 0 ? 0.0 : heights[k]);
+  for (std::size_t k = 0; k < outer_heights.size(); ++k) {
+    running = std::max(running, outer_radii[k]);
+    profile.heights_m.push_back(k == 0 ? 0.0 : outer_heights[k]);
     profile.radii_m.push_back(running);
   }
-  if (!(profile.max_radius() > 0.0)) return std::nullopt;
+  if (!(profile.max_radius() > profile.bore_radius_m)) return std::nullopt;
   if (profile.radii_m.front() >= profile.max_radius() * (1.0 - 1e-6))
-    return fe::AxisymmetricNeedle::flat_punch(profile.max_radius());
+    return fe::AxisymmetricNeedle::flat_punch(profile.max_radius(), profile.bore_radius_m);
   return profile;
 }
 
