@@ -288,6 +288,9 @@ std::vector<std::string> small_strain_warnings(const InsertionRun& run, const Sc
   std::vector<std::string> out;
   const auto& layers = scene.tissue.layers;
   if (layers.size() < 2 || layers[0].material.model != MaterialModel::Linear) return out;
+  // The closed-form path is small strain whatever the layer's model: the advice would not hold.
+  if (std::find(run.models_run.begin(), run.models_run.end(), "analytic") != run.models_run.end())
+    return out;
   const TissueLayer& top = layers[0];
   const double contrast = top.material.youngs_modulus / layers[1].material.youngs_modulus;
   if (!(contrast >= kStiffTopLayerContrast) || !(top.thickness > 0.0)) return out;

@@ -307,7 +307,8 @@ std::optional<fe::AxisymmetricNeedle> revolution_profile(const TriangleMesh& mes
   // from its file's origin), far below any feature a design has. Heights closer than that are
   // one ring unless they hold two radii that lie further apart than kFineHeight of the size
   // (rings a rounded rim puts within 0.05 um of its flat): those are split at that finer scale,
-  // still ten times an STL's single precision 100 mm from its origin.
+  // above an STL's single precision near its origin (a needle written far from its origin may
+  // then stay 3-D, as before).
   const double size = std::max(widest, length);
   const double tol = 1e-4 * size;
   constexpr double kFineHeight = 1e-6;

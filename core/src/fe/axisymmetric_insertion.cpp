@@ -102,12 +102,15 @@ double earliest_capture(const AxisymmetricNeedle& needle,
   return earliest;
 }
 
-// A capture inside a step ends the step there (docs/model.md, "Captures at their own depth"):
-// nodes are captured only when the earliest of them crosses within this fraction of the step's
-// end, or when the step left is shorter than kShortestCaptureStep of the sub-step. Capturing
-// every node inside the needle at the step's end instead pins nodes the tissue would have
-// carried away before the needle reached them (a stiff layer bends away from a rounded tip): the
-// depth then moved with the step (a 37 um rounded tip on skin fired at the first step).
+// A capture inside a step ends the step there (docs/model.md, "Contact with the rigid needle
+// (AxisymmetricNeedle)", sticking): the nodes found inside the needle at a step's end are
+// captured when the earliest of them crosses within kCaptureGroup of the step's end, or within
+// kShortestCaptureStep of a sub-step (linear) or an output interval (nonlinear; at least the
+// stepper's shortest step) of its start, where its crossing t = 0 (touching from the start);
+// otherwise the step is cut back to that crossing. Capturing every node inside the needle at the
+// step's end instead pins nodes the tissue would have carried away before the needle reached
+// them (a stiff layer bends away from a rounded tip): the depth then moved with the step (a
+// 37 um rounded tip on skin fired at the first step).
 constexpr double kCaptureGroup = 1e-3;
 constexpr double kShortestCaptureStep = 1e-6;
 
@@ -485,7 +488,10 @@ class NonlinearStepper : public Stepper {
           const double t =
               earliest_capture(needle_, candidates_, mesh, depth_, current_.displacement, next,
                                trial.displacement, trial_state);
-          const double start = kShortestCaptureStep * interval_ / (next - depth_);
+          // An event never cuts the step below the stepper's shortest one, which a failed
+          // solve right after it could not halve.
+          const double start =
+              std::max(kShortestCaptureStep * interval_, min_step_) / (next - depth_);
           if (t > start && t < 1.0 - kCaptureGroup) {
             event = depth_ + t * (next - depth_);
             break;
@@ -665,6 +671,9 @@ class LinearStepper : public Stepper {
     int solves = 0;
     while (depth_ < target * (1.0 - 1e-12)) {
       double next = std::min(target, depth_ + sub_step_ * (1.0 + 1e-9));
+      // Captures of this step's rounds at its end are undone when the step is cut back to an
+      // earlier crossing: they would be held above where the needle reaches them.
+      const ContactState at_start = state_;
       for (int round = 0; round < 1000; ++round) {
         solve_contact(next);
         ++solves;
@@ -681,6 +690,10 @@ class LinearStepper : public Stepper {
         }
         if (t < 1.0 - kCaptureGroup) {
           next = depth_ + t * (next - depth_);
+          for (auto it = state_.captured.begin(); it != state_.captured.end();)
+            it = at_start.captured.count(it->first) || it->second.depth <= next
+                     ? std::next(it)
+                     : state_.captured.erase(it);
           continue;
         }
         capture_new_nodes(needle_, candidates_, mesh_, depth_, previous_, next, u, state_);
