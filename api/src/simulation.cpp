@@ -285,15 +285,9 @@ std::vector<std::string> stress_warnings(const InsertionRun& run, const Scene& s
 // puncture depth are off by far more than the mesh's error (docs/validation.md, "Finite strain in
 // a stiff top layer"): 1.6x the depth, 0.65x the force for paper A's skin cylinder.
 std::vector<std::string> small_strain_warnings(const InsertionRun& run, const Scene& scene) {
-  std::vector<std::string> out;
-  const auto& layers = scene.tissue.layers;
-  if (layers.size() < 2 || layers[0].material.model != MaterialModel::Linear) return out;
   // The closed-form path is small strain whatever the layer's model: the advice would not hold.
   if (std::find(run.models_run.begin(), run.models_run.end(), "analytic") != run.models_run.end())
-    return out;
-  const TissueLayer& top = layers[0];
-  const double contrast = top.material.youngs_modulus / layers[1].material.youngs_modulus;
-  if (!(contrast >= kStiffTopLayerContrast) || !(top.thickness > 0.0)) return out;
+    return {};
   const NeedleRun* deepest = nullptr;
   double pushed = 0.0;
   for (const NeedleRun& n : run.needles) {
@@ -306,24 +300,38 @@ std::vector<std::string> small_strain_warnings(const InsertionRun& run, const Sc
     }
     if (d > pushed) pushed = d, deepest = &n;
   }
-  if (deepest == nullptr || !(pushed > top.thickness)) return out;
-  std::ostringstream ratio;
-  ratio << std::fixed << std::setprecision(1) << pushed / top.thickness;
-  const std::string softer = std::to_string(std::lround(contrast));
-  out.push_back(scene.source_name + ": tissue.layers[0] '" + top.name +
-                "' is linear (small strain) and is pushed " +
-                format_quantity(pushed, Dimension::Length) + " deep under needle '" +
-                deepest->name + "'" + (deepest->puncture ? " before it punctures" : "") + ", " +
-                ratio.str() + " times its " + format_quantity(top.thickness, Dimension::Length) +
-                " thickness, over a layer " + softer +
-                " times softer: past its thickness a stiff layer also carries the needle by "
-                "membrane tension, which small strain leaves out (material model \"svk\" or "
-                "\"neo_hookean\" keeps E and nu with finite strain; docs/validation.md, \"Finite "
-                "strain in a stiff top layer\")");
-  return out;
+  if (deepest == nullptr) return {};
+  std::optional<std::string> w = small_strain_warning(
+      scene, pushed,
+      "needle '" + deepest->name + "'" + (deepest->puncture ? " before it punctures" : ""));
+  if (!w) return {};
+  return {*w};
 }
 
 }  // namespace
+
+std::optional<std::string> small_strain_warning(const Scene& scene, double pushed_m,
+                                                const std::string& under) {
+  const auto& layers = scene.tissue.layers;
+  if (layers.size() < 2 || layers[0].material.model != MaterialModel::Linear) return std::nullopt;
+  const TissueLayer& top = layers[0];
+  const double contrast = top.material.youngs_modulus / layers[1].material.youngs_modulus;
+  if (!(contrast >= kStiffTopLayerContrast) || !(top.thickness > 0.0) ||
+      !(pushed_m > top.thickness) || !std::isfinite(pushed_m))
+    return std::nullopt;
+  std::ostringstream ratio;
+  ratio << std::fixed << std::setprecision(1) << pushed_m / top.thickness;
+  const std::string softer = std::to_string(std::lround(contrast));
+  return scene.source_name + ": tissue.layers[0] '" + top.name +
+         "' is linear (small strain) and is pushed " +
+         format_quantity(pushed_m, Dimension::Length) + " deep under " + under + ", " +
+         ratio.str() + " times its " + format_quantity(top.thickness, Dimension::Length) +
+         " thickness, over a layer " + softer +
+         " times softer: past its thickness a stiff layer also carries the needle by membrane "
+         "tension, which small strain leaves out (material model \"svk\" or \"neo_hookean\" "
+         "keeps E and nu with finite strain; docs/validation.md, \"Finite strain in a stiff top "
+         "layer\")";
+}
 
 std::vector<std::string> criterion_warnings(const InsertionRun& run, const Scene& scene) {
   std::vector<std::string> out = penetration_warnings(run, scene);

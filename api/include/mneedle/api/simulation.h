@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,13 @@ InsertionRunOptions simulate_run_options(const Scene& scene, const SimulateSetti
 /// (docs/validation.md, "Finite strain in a stiff top layer"). The CLI prints them on stderr,
 /// Python raises them as RuntimeWarnings.
 std::vector<std::string> criterion_warnings(const InsertionRun& run, const Scene& scene);
+
+/// The small-strain warning of criterion_warnings for a top layer pushed `pushed_m` deep before
+/// puncture under `under` (e.g. "needle 'cone' before it punctures"), or nullopt when it does
+/// not apply (the top layer not linear, not kStiffTopLayerContrast times stiffer than the next,
+/// or not pushed past its thickness). `screen` gives it the deepest design's puncture.
+std::optional<std::string> small_strain_warning(const Scene& scene, double pushed_m,
+                                                const std::string& under);
 
 /// E of the top layer over E of the one beneath from which a small-strain top layer pushed
 /// beyond its thickness is warned about: a stiff film on a soft base, which bends and stretches
