@@ -8,7 +8,6 @@
 #include "commands.h"
 #include "json_output.h"
 #include "mneedle/api/screening_report.h"
-#include "mneedle/api/simulation.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/files.h"
 #include "mneedle/base/units.h"
@@ -168,27 +167,6 @@ ScreenSetup prepare_screen(const ScreenArgs& args, bool writer) {
   return s;
 }
 
-// The small-strain top layer's warning of `simulate` (docs/validation.md, "Finite strain in a
-// stiff top layer"), once for the run, at the design that pushed the layer deepest before it
-// punctured (closed-form rows left out: small strain whatever the layer).
-void warn_small_strain(const std::vector<ScreeningRow>& rows, const Scene& scene) {
-  double deepest = 0.0;
-  std::string design;
-  for (const ScreeningRow& r : rows) {
-    if (!r.ok || !r.puncture_depth_m || r.puncture_at_first_contact) continue;
-    const nlohmann::json j = nlohmann::json::parse(r.json, nullptr, false);
-    bool analytic = false;
-    if (j.is_object() && j.contains("models_run") && j["models_run"].is_array())
-      for (const auto& m : j["models_run"]) analytic = analytic || m == "analytic";
-    if (!analytic && *r.puncture_depth_m > deepest)
-      deepest = *r.puncture_depth_m, design = r.design;
-  }
-  if (design.empty()) return;
-  if (const auto w =
-          small_strain_warning(scene, deepest, "design '" + design + "' before it punctures"))
-    std::cerr << "mneedle: warning: " << *w << "\n";
-}
-
 void run_screen(const ScreenArgs& args) {
   std::optional<MpiSession> session;
   start_mpi(session, args.mpi, args.jobs, "screen", "screen every design into the same files");
@@ -217,11 +195,12 @@ void run_screen(const ScreenArgs& args) {
   }
   const auto rows = rank_rows(std::move(screened));
   if (!writer) return;  // rank 0 reports the run
-  warn_small_strain(rows, scene);
+  const std::vector<std::string> warnings = screening_warnings(rows, scene);
+  for (const std::string& w : warnings) std::cerr << "mneedle: warning: " << w << "\n";
   std::size_t failed = 0;
   for (const auto& r : rows) failed += r.ok ? 0 : 1;
   if (args.json || !args.report.empty()) {
-    const nlohmann::json out = screening_json(rows, args.scene, options);
+    const nlohmann::json out = screening_json(rows, args.scene, options, warnings);
     // The report first: a design that failed still leaves every finished row in it.
     if (!args.report.empty()) write_report_folder(args.report, out, args.plugin_dirs);
     if (args.json) std::cout << with_provenance(out).dump(2) << "\n";

@@ -122,7 +122,8 @@ def simulate(
             f"{100 * check['tolerance']:.3g} % apart: the contact or the mesh is not resolved)",
             RuntimeWarning, stacklevel=2)
     for text in result.get("warnings", []):
-        # Where the penetration criterion does not hold, as the CLI says on stderr.
+        # Where a criterion does not hold, or a linear stiff top layer was pushed past its
+        # thickness, as the CLI says on stderr.
         warnings.warn(text, RuntimeWarning, stacklevel=2)
     return result
 
@@ -171,10 +172,14 @@ def screen(
     is a list of one). The scene is a file: write a changed dict with :func:`scene_toml` first.
     A design that fails is a row with ``"ok": False`` and its error; the others still run.
     """
-    return _core.screen(
+    result = _core.screen(
         _list(designs, "designs"), os.fspath(scene), fidelity, model, material, int(jobs),
         unit, axis, bool(repair), _list(plugin_dirs, "plugin_dirs"),
     )
+    for text in result.get("warnings", []):
+        # What holds for the whole run, as the CLI says on stderr.
+        warnings.warn(text, RuntimeWarning, stacklevel=2)
+    return result
 
 
 def fit(

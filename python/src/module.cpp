@@ -103,7 +103,7 @@ nlohmann::json screen(const std::vector<std::string>& designs, const std::string
   if (inputs.empty()) throw InputError("screen: no mesh files or designs found in the inputs");
   parse_axis_choice(options.axis);
   const auto rows = rank_rows(screen_designs(inputs, scene, file, registry, options));
-  return screening_json(rows, file, options);
+  return screening_json(rows, file, options, screening_warnings(rows, scene));
 }
 
 nlohmann::json fit(const std::vector<std::string>& files, const FitSettings& settings) {

@@ -45,6 +45,8 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
   EXPECT_NE(run.err.find("design 'cylinder"), std::string::npos) << run.err;
   EXPECT_EQ(run.err.find("membrane tension"), run.err.rfind("membrane tension")) << run.err;
   const auto j = nlohmann::json::parse(run.out);
+  ASSERT_EQ(j["warnings"].size(), 1u) << j["warnings"].dump();
+  EXPECT_NE(run.err.find(j["warnings"][0].get<std::string>()), std::string::npos) << run.err;
   ASSERT_EQ(j["designs"].size(), 4u);
   EXPECT_EQ(j["fidelity"], "fast");
   // What the README says of this table: with the scene's stress criterion every design punctures
@@ -198,6 +200,7 @@ TEST(ScreenCommand, AnalyticModelInSkinLetsNeitherFlatNorSharpStlPuncture) {
   }
   // Nothing punctures, and the closed form is small strain whatever the layer: no advice.
   EXPECT_EQ(run.err.find("membrane tension"), std::string::npos) << run.err;
+  EXPECT_TRUE(j["warnings"].empty()) << j["warnings"].dump();
 }
 
 // With a threshold below the pressure of the first depth step the criterion fires "at first

@@ -50,6 +50,18 @@ def test_one_folder_alone_is_screened_as_the_cli_screens_it(cli, source):
     assert len(ours["designs"]) == 4
 
 
+def test_screen_warns_of_a_small_strain_stiff_top_layer_as_the_cli_does(cli, source):
+    # Paper A's skin: the linear stratum corneum is pushed 7 times its thickness before the
+    # cylinder punctures it (docs/validation.md, "Finite strain in a stiff top layer").
+    design = source / "designs" / "cylinder.stl"
+    scene = source / "designs" / "scenes" / "human_skin.toml"
+    with pytest.warns(RuntimeWarning, match="membrane tension"):
+        ours = mneedle.screen(design, scene)
+    theirs = cli.json("screen", design, "--scene", scene)
+    assert strip_timing(ours) == strip_timing(theirs)
+    assert len(ours["warnings"]) == 1 and "design 'cylinder" in ours["warnings"][0]
+
+
 def test_fit_is_the_cli_fit(cli, source):
     curve = source / "tests" / "assets" / "curves" / "loading_hold_retraction.csv"
     ours = mneedle.fit([curve], starts=2)
