@@ -17,6 +17,7 @@
 
 #include "commands.h"
 #include "json_output.h"
+#include "mneedle/api/simulation.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/files.h"
 #include "mneedle/base/units.h"
@@ -467,6 +468,17 @@ void run_optimize(const OptimizeArgs& a) {
 
   const NeedleSource best = problem.needle(r.best);
   const DesignEvaluation e = problem.evaluate(best);
+  // The small-strain top layer's warning of `simulate` and `screen`, at the best design (not on a
+  // closed-form run, small strain whatever the layer; docs/validation.md, "Finite strain in a
+  // stiff top layer").
+  std::vector<std::string> warnings;
+  const bool analytic =
+      std::find(e.models_run.begin(), e.models_run.end(), "analytic") != e.models_run.end();
+  if (e.puncture && !e.puncture->at_first_contact && !analytic)
+    if (const auto w =
+            small_strain_warning(scene, e.puncture->depth_m, "the best design before it punctures"))
+      warnings.push_back(*w);
+  for (const std::string& w : warnings) std::cerr << "mneedle: warning: " << w << "\n";
   nlohmann::json summary = {
       {"best",
        {{"params", best.params},
@@ -499,7 +511,8 @@ void run_optimize(const OptimizeArgs& a) {
                                  : nlohmann::json(nullptr)},
       {"material", problem.material},
       {"optimum", optimum_json(report)},
-      {"history", history_json(r.history)}};
+      {"history", history_json(r.history)},
+      {"warnings", warnings}};
   if (!a.out.empty()) write_outputs(a.out, best.mesh, summary);
   if (!a.report.empty()) write_report_folder(a.report, summary, a.plugin_dirs);
   if (a.json) {
