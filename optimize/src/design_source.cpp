@@ -378,24 +378,19 @@ std::optional<fe::AxisymmetricNeedle> revolution_profile(const TriangleMesh& mes
       2.0 * tol + std::max(bore, 0.0) * (1.0 - std::cos(0.5 * kLargestRevolutionGap_rad));
   for (std::size_t k = 0; k + 1 < heights.size(); ++k) {
     const CrossSection section = slicer->slice(0.5 * (heights[k] + heights[k + 1]));
-    const std::size_t loops = bore >= 0.0 ? 2 : 1;
-    if (section.polygons.size() != loops) return std::nullopt;
+    if (section.polygons.size() != (bore >= 0.0 ? 2u : 1u)) return std::nullopt;
+    int on_bore = 0;  // loops on the bore's circle
     for (const auto& polygon : section.polygons) {
       std::vector<double> angles;
-      bool on_bore = bore >= 0.0;
+      bool round_bore = bore >= 0.0;
       for (const auto& p : polygon) {
         angles.push_back(std::atan2(p[1], p[0]));
-        on_bore = on_bore && std::abs(std::hypot(p[0], p[1]) - bore) <= on_circle;
+        round_bore = round_bore && std::abs(std::hypot(p[0], p[1]) - bore) <= on_circle;
       }
       if (!closes_round(coverage(angles))) return std::nullopt;
-      if (loops == 2 && &polygon == &section.polygons.front()) {
-        // One of the two loops is the bore's circle (either order).
-        bool other = true;
-        for (const auto& q : section.polygons.back())
-          other = other && std::abs(std::hypot(q[0], q[1]) - bore) <= on_circle;
-        if (!on_bore && !other) return std::nullopt;
-      }
+      on_bore += round_bore ? 1 : 0;
     }
+    if (bore >= 0.0 && on_bore == 0) return std::nullopt;
   }
   // The profile through the rings (the faces are straight between them), heights from the tip,
   // kept non-decreasing (a narrower section above a wider one never meets the tissue first); a

@@ -10,6 +10,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -60,6 +61,26 @@ double gap(const AxisymmetricNeedle& needle, double depth, const Eigen::Vector2d
   return -depth + needle.lowest_height_at(position.x()) - position.y();
 }
 
+// Where candidate `node`, inside the needle at (d1, u1), crossed its surface on the straight
+// path from (d0, u0): the fraction t of the step (0 when it was not outside at d0), and the
+// crossing point; nullopt when it is not inside at d1.
+struct Crossing {
+  double t;
+  Eigen::Vector2d point;
+};
+std::optional<Crossing> crossing(const AxisymmetricNeedle& needle, const AxisymmetricMesh& mesh,
+                                 std::uint32_t node, double d0, const Eigen::VectorXd& u0,
+                                 double d1, const Eigen::VectorXd& u1) {
+  const Eigen::Vector2d X = mesh.nodes[node];
+  const Eigen::Vector2d p0 = X + Eigen::Vector2d(u0[2 * node], u0[2 * node + 1]);
+  const Eigen::Vector2d p1 = X + Eigen::Vector2d(u1[2 * node], u1[2 * node + 1]);
+  const double g1 = gap(needle, d1, p1);
+  if (!(g1 < 0.0)) return std::nullopt;
+  const double g0 = gap(needle, d0, p0);
+  const double t = std::isfinite(g0) && g0 > 0.0 ? g0 / (g0 - g1) : 0.0;
+  return Crossing{t, p0 + t * (p1 - p0)};
+}
+
 // Captures every candidate node that entered the needle between (d0, u0) and (d1, u1), at the
 // linearly interpolated crossing, as long as that crossing lies within `latest` of the step.
 // Returns how many were added.
@@ -70,22 +91,16 @@ int capture_new_nodes(const AxisymmetricNeedle& needle,
   int added = 0;
   for (std::uint32_t node : candidates) {
     if (state.captured.count(node)) continue;
-    const Eigen::Vector2d X = mesh.nodes[node];
-    const Eigen::Vector2d p0 = X + Eigen::Vector2d(u0[2 * node], u0[2 * node + 1]);
-    const Eigen::Vector2d p1 = X + Eigen::Vector2d(u1[2 * node], u1[2 * node + 1]);
-    const double g1 = gap(needle, d1, p1);
-    if (!(g1 < 0.0)) continue;
-    const double g0 = gap(needle, d0, p0);
-    const double t = std::isfinite(g0) && g0 > 0.0 ? g0 / (g0 - g1) : 0.0;
-    if (t > latest) continue;
-    state.captured[node] = Capture{p0 + t * (p1 - p0), d0 + t * (d1 - d0)};
+    const std::optional<Crossing> c = crossing(needle, mesh, node, d0, u0, d1, u1);
+    if (!c || c->t > latest) continue;
+    state.captured[node] = Capture{c->point, d0 + c->t * (d1 - d0)};
     ++added;
   }
   return added;
 }
 
 // The earliest crossing, as a fraction t of the step (d0, d1], of the candidates not yet captured
-// that are inside the needle at d1 (as capture_new_nodes interpolates it); 2 when none is.
+// that are inside the needle at d1; 2 when none is.
 double earliest_capture(const AxisymmetricNeedle& needle,
                         const std::vector<std::uint32_t>& candidates, const AxisymmetricMesh& mesh,
                         double d0, const Eigen::VectorXd& u0, double d1, const Eigen::VectorXd& u1,
@@ -93,11 +108,8 @@ double earliest_capture(const AxisymmetricNeedle& needle,
   double earliest = 2.0;
   for (std::uint32_t node : candidates) {
     if (state.captured.count(node)) continue;
-    const Eigen::Vector2d X = mesh.nodes[node];
-    const double g1 = gap(needle, d1, X + Eigen::Vector2d(u1[2 * node], u1[2 * node + 1]));
-    if (!(g1 < 0.0)) continue;
-    const double g0 = gap(needle, d0, X + Eigen::Vector2d(u0[2 * node], u0[2 * node + 1]));
-    earliest = std::min(earliest, std::isfinite(g0) && g0 > 0.0 ? g0 / (g0 - g1) : 0.0);
+    if (const std::optional<Crossing> c = crossing(needle, mesh, node, d0, u0, d1, u1))
+      earliest = std::min(earliest, c->t);
   }
   return earliest;
 }
