@@ -91,6 +91,10 @@ void print_table(const InsertionRun& run) {
   std::cout << ")\n";
   for (const Reduction& r : run.reductions)
     std::cout << "  reduction " << r.name << ": " << r.detail << "\n";
+  if (run.stopped)
+    std::cout << "the finite element run stopped after its step at "
+              << format_quantity(run.stopped->depth_m, Dimension::Length) << " ("
+              << run.stopped->reason << "): the curves end there\n";
   for (const NeedleRun& n : run.needles) {
     std::cout << "needle " << n.name << ": ";
     if (n.puncture)
@@ -106,6 +110,9 @@ void print_table(const InsertionRun& run) {
                         ? " [flat tip: F_p is a sharp tip's, a flat end needs more, so this "
                           "depth is a lower bound]"
                         : "");
+    else if (run.criterion && run.stopped)
+      std::cout << "no puncture before " << format_quantity(run.stopped->depth_m, Dimension::Length)
+                << ", where the finite element run stopped";
     else if (run.criterion)
       std::cout << "no puncture within the insertion depth";
     else
@@ -189,6 +196,9 @@ void run(const SimulateOptions& o) {
                             double force) {
     progress.update({model, step, steps, depth, force});
   };
+  // A run whose FE stops part-way still prints what it reached, then fails (docs/cli.md,
+  // "simulate"): the curve up to there is what a user looking at the stop needs.
+  options.keep_reached = true;
   const InsertionRun result = run_insertion(scene, needles, options);
   progress.finish();
   // Every format prints the numbers of this tree: check them once, before anything is printed.
@@ -212,6 +222,10 @@ void run(const SimulateOptions& o) {
     print_csv(result);
   else
     print_table(result);
+  if (result.stopped) {
+    std::cout.flush();
+    throw SolverError(result.stopped->reason);  // exit status 3, the one-line error
+  }
 }
 
 }  // namespace

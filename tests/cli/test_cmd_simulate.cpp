@@ -585,6 +585,49 @@ TEST(CmdSimulate, AFiniteStrainStratumCorneumPuncturesShallowerAndTheLinearOneIs
   }
 }
 
+// A run whose FE stops part-way (a sharp cone on a finite-strain stratum corneum inverts the
+// element under its point between 40 and 50 um at fast) prints what it reached in every format,
+// then the one-line error, and exits 3 (docs/cli.md, "simulate").
+TEST(CmdSimulate, ARunWhoseSolverStopsPrintsWhatItReachedThenFails) {
+  std::string text = mneedle::test::file_text(std::string(MNEEDLE_SOURCE_ROOT) +
+                                              "/designs/scenes/human_skin.toml");
+  const std::string bevel =
+      "geometry = { plugin = \"sharp_bevel\", diameter = \"230 um\", length = \"1000 um\", "
+      "bevel_angle = \"30 deg\" }";
+  const std::string linear = "material = { model = \"linear\", E = \"1 GPa\", nu = 0.4 }";
+  ASSERT_NE(text.find(bevel), std::string::npos);
+  text.replace(text.find(bevel), bevel.size(),
+               "geometry = { plugin = \"cone\", diameter = \"230 um\", length = \"1000 um\" }");
+  ASSERT_NE(text.find(linear), std::string::npos);
+  text.replace(text.find(linear), linear.size(),
+               "material = { model = \"svk\", E = \"1 GPa\", nu = 0.4 }");
+  const fs::path file =
+      fs::temp_directory_path() / ("stops_" + std::to_string(::getpid()) + ".toml");
+  std::ofstream(file) << text;
+  const CommandRun json = run_mneedle("simulate '" + file.string() + "' --fidelity fast --json");
+  const CommandRun table = run_mneedle("simulate '" + file.string() + "' --fidelity fast --quiet");
+  fs::remove(file);
+  EXPECT_EQ(json.exit_code, 3) << json.err;
+  EXPECT_EQ(std::count(json.err.begin(), json.err.end(), '\n'), 1) << json.err;
+  EXPECT_EQ(json.err.rfind("mneedle: error: axisymmetric insertion stopped at depth ", 0), 0u)
+      << json.err;
+  EXPECT_NE(json.err.find("inverted element"), std::string::npos) << json.err;
+  const auto j = nlohmann::json::parse(json.out);
+  EXPECT_NEAR(j["stopped"]["depth_m"].get<double>(), 40e-6, 1e-12);
+  EXPECT_NE(j["stopped"]["reason"].get<std::string>().find("inverted element"), std::string::npos);
+  EXPECT_TRUE(j["mesh"].is_null());
+  const auto& needle = j["needles"].at(0);
+  EXPECT_TRUE(needle["puncture"].is_null());
+  ASSERT_EQ(needle["curve"].size(), 4u);  // 10, 20, 30, 40 um
+  EXPECT_NEAR(needle["curve"].back()["depth_m"].get<double>(), 40e-6, 1e-12);
+  EXPECT_GT(needle["curve"].back()["force_N"].get<double>(), 0.0);
+  EXPECT_EQ(table.exit_code, 3) << table.err;
+  EXPECT_NE(table.out.find("the finite element run stopped after its step at 40 um"),
+            std::string::npos)
+      << table.out;
+  EXPECT_NE(table.out.find("no puncture before 40 um"), std::string::npos) << table.out;
+}
+
 TEST(CmdSimulate, SharpBevelFiresAtFirstContactOnAHalfModelAndSaysSo) {
   const CommandRun run = run_mneedle("simulate '" + scene("puncture_bevel.toml") + "' --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -619,7 +662,8 @@ TEST(CmdSimulate, NoReductionsSolvesTheFullBevelModel) {
   const auto f = nlohmann::json::parse(full.out);
   EXPECT_TRUE(f["reductions"].empty()) << f["reductions"].dump();
   EXPECT_GT(f["mesh"]["nodes"].get<int>(), h["mesh"]["nodes"].get<int>());
-  // The half model is exact for a mirror-symmetric bevel (tests/core/test_insertion_run.cpp).
+  // The half model is exact for a mirror-symmetric bevel
+  // (tests/core/insertion/test_insertion_run.cpp).
   EXPECT_NEAR(f["needles"][0]["puncture"]["depth_m"].get<double>(),
               h["needles"][0]["puncture"]["depth_m"].get<double>(), 1e-9);
 }

@@ -83,7 +83,7 @@ PreKind choose_model(const Scene& scene, const std::vector<PreparedNeedle>& need
         {"axisymmetric",
          "one needle of revolution on the axis: axisymmetric model on a cylinder of the block's "
          "cross-section area instead of the 3-D block (tested against the 3-D model in "
-         "tests/core/test_insertion_run.cpp)",
+         "tests/core/insertion/test_insertion_run.cpp)",
          std::nullopt});
     return PreKind::Axisymmetric;
   }

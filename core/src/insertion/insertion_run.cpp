@@ -119,7 +119,19 @@ struct PreResult {
   int unresolved_flats = 0;
   std::string model;
   std::optional<fe::InpExport> exported;
+  std::optional<RunStop> stopped;  ///< run_3d / run_axisymmetric with keep_reached
 };
+
+// The main pre-puncture run stopped after `reached` steps with `e`: its steps are kept (and the
+// stop recorded) when the caller asked for them and there is at least one; otherwise, and always
+// for memory, the error goes on.
+template <typename Step>
+std::optional<RunStop> keep_or_rethrow(const SolverError& e, bool keep_reached,
+                                       const std::vector<Step>& reached) {
+  if (!keep_reached || reached.empty() || dynamic_cast<const OutOfMemoryError*>(&e) != nullptr)
+    throw;
+  return RunStop{reached.back().depth_m, e.what()};
+}
 
 fe::ContactMode to_fe(Contact c) {
   return c == Contact::Frictionless ? fe::ContactMode::Frictionless : fe::ContactMode::Sticking;
@@ -176,9 +188,10 @@ double tip_size_3d(const RunPlan& plan, const InsertionRunOptions& options) {
       .fine_size;
 }
 
+// keep_reached: a stop after the first step returns what was reached (InsertionRunOptions).
 PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles,
                  const std::vector<SectionArea>& areas, const InsertionRunOptions& options,
-                 double crack_depth) {
+                 double crack_depth, bool keep_reached = false) {
   fe::TissueBlockSpec block;
   block.size_x = plan.block_x_m;
   block.size_y = plan.block_y_m;
@@ -208,7 +221,9 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
   CrossingWatch watch(needles.size(), plan);
   int step_index = 0;
   bool past_shown = false;
+  std::vector<fe::Step3d> reached;  // kept for a run that stops (keep_reached)
   o.on_step = [&](const fe::Step3d& step) {
+    if (keep_reached) reached.push_back(step);
     bool more = true;
     double force = 0.0;
     for (std::size_t i = 0; i < step.needles.size(); ++i) {
@@ -225,9 +240,15 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
     return more;
   };
   fe::Simulation3dResult r;
+  std::optional<RunStop> stopped;
   {
     const StageTimer timer(plan.seconds, &RunSeconds::fe_3d_s);
-    r = fe::simulate_3d(block, fe_needles, o);
+    try {
+      r = fe::simulate_3d(block, fe_needles, o);
+    } catch (const SolverError& e) {
+      stopped = keep_or_rethrow(e, keep_reached, reached);
+      r.steps = std::move(reached);
+    }
   }
   if (plan.seconds != nullptr) {
     plan.seconds->meshing_s += r.timing.meshing_s;
@@ -266,6 +287,7 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
   out.unresolved_flats = r.unresolved_flats;
   out.model = "fe_3d";
   out.exported = r.exported;
+  out.stopped = std::move(stopped);
   return out;
 }
 
@@ -280,13 +302,14 @@ Reduction mirror_reduction(const RunPlan& plan) {
               " (each needle about its own axis, the array as a whole): the 3-D model solves the " +
               part +
               " (results reported for every needle; tested against the full model in "
-              "tests/core/test_insertion_run.cpp)",
+              "tests/core/insertion/test_insertion_run.cpp)",
           std::nullopt};
 }
 
+// keep_reached: a stop after the first step returns what was reached (InsertionRunOptions).
 PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
                            const SectionArea& area, const InsertionRunOptions& options,
-                           double crack_depth) {
+                           double crack_depth, bool keep_reached = false) {
   fe::AxisymmetricProblem p;
   for (const fe::TissueLayer& l : plan.layers) p.layers.push_back({l.thickness, l.material});
   p.radius_m = plan.axisymmetric_radius_m;
@@ -305,29 +328,37 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
   p.crack_face_contact = options.crack_face_contact;
   CrossingWatch watch(1, plan);
   int step_index = 0;
+  std::vector<fe::InsertionStep> reached;  // kept for a run that stops (keep_reached)
   p.on_step = [&](const fe::InsertionStep& step) {
+    if (keep_reached) reached.push_back(step);
     if (options.on_progress)
       options.on_progress("fe_axisymmetric", ++step_index,
                           p.overrides.steps.value_or(p.output_steps), step.depth_m, step.force_N);
     return watch.keep_going(0, sample_of(step.depth_m, step, area));
   };
   fe::InsertionResult r;
+  std::optional<RunStop> stopped;
   {
     const StageTimer timer(plan.seconds, &RunSeconds::axisymmetric_fe_s);
     try {
-      r = fe::simulate_axisymmetric(p);
-    } catch (const fe::CrackedTwinError& e) {
-      // On nonlinear layers the held crack faces can stop Newton first (docs/model.md, "Crack
-      // faces in contact"): say how to run without them.
-      const bool nonlinear = std::any_of(p.layers.begin(), p.layers.end(), [](const auto& l) {
-        return l.material.model != MaterialModel::Linear;
-      });
-      if (p.crack_face_contact && nonlinear)
-        throw SolverError(
-            std::string(e.what()) +
-            " ([model] crack_faces = \"free\" lets the crack's faces pass through each "
-            "other instead, G then too high)");
-      throw;
+      try {
+        r = fe::simulate_axisymmetric(p);
+      } catch (const fe::CrackedTwinError& e) {
+        // On nonlinear layers the held crack faces can stop Newton first (docs/model.md, "Crack
+        // faces in contact"): say how to run without them.
+        const bool nonlinear = std::any_of(p.layers.begin(), p.layers.end(), [](const auto& l) {
+          return l.material.model != MaterialModel::Linear;
+        });
+        if (p.crack_face_contact && nonlinear)
+          throw SolverError(
+              std::string(e.what()) +
+              " ([model] crack_faces = \"free\" lets the crack's faces pass through each "
+              "other instead, G then too high)");
+        throw;
+      }
+    } catch (const SolverError& e) {
+      stopped = keep_or_rethrow(e, keep_reached, reached);
+      r.steps = std::move(reached);
     }
   }
   PreResult out;
@@ -348,9 +379,10 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
   }
   out.nodes = static_cast<int>(r.nodes);
   out.elements = static_cast<int>(r.elements);
-  out.order = 2;
+  out.order = stopped ? 0 : 2;
   out.axisymmetric = true;
   out.model = "axisymmetric_fe";
+  out.stopped = std::move(stopped);
   return out;
 }
 
@@ -482,7 +514,7 @@ void check_layer_merge(const RunPlan& plan, const PreparedNeedle& needle, const 
     return;
   RunPlan unmerged = plan;
   unmerged.layers = plan.full_layers;
-  reduced = run_axisymmetric(unmerged, needle, area, options, crack_depth);
+  reduced = run_axisymmetric(unmerged, needle, area, options, crack_depth, options.keep_reached);
 }
 
 // The domain cut's truncation error, measured with the axisymmetric model (the needle itself, or
@@ -559,7 +591,16 @@ void check_axisymmetric_domain_cut(RunPlan& plan, const PreparedNeedle& needle,
   const RunPoint& last = reduced.needles[0].points.back();
   if (measure_domain_cut(plan, {needle}, {area}, options, last.depth_m, last.force_N, reductions))
     return;
-  reduced = run_axisymmetric(plan, needle, area, options, crack_depth);
+  reduced = run_axisymmetric(plan, needle, area, options, crack_depth, options.keep_reached);
+}
+
+// A run that stopped is not checked against its references (they would stop too, or cost a run
+// to a depth the answer never reached): the reductions measured after the run say so.
+void note_unmeasured(std::vector<Reduction>& reductions, const RunStop& stop) {
+  for (Reduction& r : reductions)
+    if (r.name == "layer_merge" || r.name == "domain_cut")
+      r.detail +=
+          "; not measured: the run stopped at " + format_quantity(stop.depth_m, Dimension::Length);
 }
 
 double axisymmetric_tip_size(const RunPlan& plan, const PreparedNeedle& needle,
@@ -694,7 +735,8 @@ NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const R
     // Up to the requested depth; a last step beyond it is cut there (linear in between).
     for (const RunPoint& p : pre.points)
       if (p.depth_m < plan.depth_m * (1.0 - 1e-12)) run.curve.push_back(p);
-    if (!pre.points.empty()) {
+    // A run that stopped before the depth (keep_reached) ends at its last step, listed above.
+    if (!pre.points.empty() && pre.points.back().depth_m >= plan.depth_m * (1.0 - 1e-12)) {
       RunPoint end = pre.points.back().depth_m > plan.depth_m
                          ? interpolated_point(pre.points, plan.depth_m)
                          : pre.points.back();
@@ -837,16 +879,25 @@ PreResult run_pre(RunPlan& plan, const Scene& scene, const std::vector<PreparedN
         run.crack_depth_m = crack_depth_for(plan.needle_radius_m, tip_size_3d(plan, options));
       measure_domain_cut(plan, needles, areas, options, plan.horizon_m, std::nullopt,
                          run.reductions);
-      pre = run_3d(plan, needles, areas, options, run.crack_depth_m);
+      pre = run_3d(plan, needles, areas, options, run.crack_depth_m, options.keep_reached);
       if (plan.half_model || plan.mirror_x) run.reductions.push_back(mirror_reduction(plan));
       break;
     case PreKind::Axisymmetric:
       if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
         run.crack_depth_m =
             crack_depth_for(plan.needle_radius_m, axisymmetric_tip_size(plan, needles[0], options));
-      pre = run_axisymmetric(plan, needles[0], areas[0], options, run.crack_depth_m);
+      pre = run_axisymmetric(plan, needles[0], areas[0], options, run.crack_depth_m,
+                             options.keep_reached);
+      if (pre.stopped) {
+        note_unmeasured(run.reductions, *pre.stopped);
+        break;
+      }
       check_layer_merge(plan, needles[0], areas[0], options, run.crack_depth_m, pre,
                         run.reductions);
+      if (pre.stopped) {  // the scene's own layers, run again, stopped
+        note_unmeasured(run.reductions, *pre.stopped);
+        break;
+      }
       check_axisymmetric_domain_cut(plan, needles[0], areas[0], options, run.crack_depth_m, pre,
                                     run.reductions);
       break;
@@ -1090,7 +1141,9 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
           const double crossed = deepest_first_crossing(plan, pre);
           if (crossed > 0.0 && crossed <= below * (1.0 + 1e-12)) return true;
         }
-        if (every_needle_crossed(plan, pre)) break;
+        // A rung that stopped ends the climb: a deeper rung of the same model would stop there
+        // too, and what it reached is the answer (keep_reached).
+        if (pre.stopped || every_needle_crossed(plan, pre)) break;
       }
       return false;
     };
@@ -1107,6 +1160,7 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     run.max_aspect_ratio = pre.max_aspect_ratio;
     run.contact_zone_m = pre.contact_zone_m;
     run.unresolved_flats = pre.unresolved_flats;
+    run.stopped = pre.stopped;
     bool any_post = false;
     for (std::size_t i = 0; i < needles.size(); ++i) {
       run.needles.push_back(assemble_needle(needles[i].name, pre.needles[i], plan, areas[i],

@@ -991,6 +991,68 @@ TEST(Arrays, EachNeedlePuncturesOnItsOwnAndTheTotalIsTheirSum) {
   EXPECT_GE(compared, 3);
 }
 
+// A sharp 15-degree cone on paper A's skin with a finite-strain stratum corneum (its strength
+// raised so that the criterion never fires) stops on an inverted element under its point
+// between 30 and 40 um at fast (docs/validation.md, "Finite strain in a stiff top layer"): the
+// run throws unless keep_reached asks for what it reached, and what it keeps is what a run asked
+// for exactly that depth gives, step for step.
+TEST(InsertionRun, AnFeRunThatStopsKeepsWhatItReachedOnlyWhenAsked) {
+  std::string layers = kPaperASkinLayers;
+  const std::string linear = "model = \"linear\", E = \"1 GPa\"";
+  layers.replace(layers.find(linear), linear.size(), "model = \"svk\", E = \"1 GPa\"");
+  layers.replace(layers.find("21.6 MPa"), 8, "10 GPa");
+  const auto text = [&](const std::string& depth) {
+    return "[tissue]\nsize = [\"3000 um\", \"3000 um\", \"1150 um\"]\n" + layers +
+           "[[needles]]\nname = \"cone\"\ngeometry = { plugin = \"cone\", diameter = \"230 um\" "
+           "}\n[insertion]\ndepth = \"" +
+           depth +
+           "\"\n[model]\nfidelity = \"fast\"\ncriterion = \"stress\"\n"
+           "outputs = [\"puncture\", \"force_curve\"]\n";
+  };
+  const double half_angle = 15.0 * std::numbers::pi / 180.0;
+  PreparedNeedle cone;
+  cone.name = "cone";
+  cone.mesh = test::cone_needle(half_angle, 115e-6, 1e-3, 64);
+  cone.axisymmetric = fe::AxisymmetricNeedle::cone(half_angle, 115e-6);
+  cone.mirror_symmetric_y0 = cone.mirror_symmetric_x0 = true;
+  InsertionRunOptions options = fast();
+  options.criterion = PunctureCriterion::Stress;
+  const Scene deep = parse_scene(text("800 um"), "skin.toml");
+  try {
+    run_insertion(deep, {cone}, options);
+    FAIL() << "expected the run to stop";
+  } catch (const OutOfMemoryError&) {
+    FAIL() << "not a memory stop";
+  } catch (const SolverError& e) {
+    EXPECT_NE(std::string(e.what()).find("inverted element"), std::string::npos) << e.what();
+  }
+  options.keep_reached = true;
+  const InsertionRun stopped = run_insertion(deep, {cone}, options);
+  ASSERT_TRUE(stopped.stopped.has_value());
+  EXPECT_NEAR(stopped.stopped->depth_m, 30e-6, 1e-12);  // fast: 10 um steps on the 100 um rung
+  EXPECT_NE(stopped.stopped->reason.find("inverted element"), std::string::npos);
+  const NeedleRun& reached = stopped.needles.front();
+  EXPECT_FALSE(reached.puncture.has_value());
+  ASSERT_EQ(reached.curve.size(), 3u);  // 10, 20, 30 um, the last once
+  EXPECT_NEAR(reached.curve.back().depth_m, 30e-6, 1e-12);
+  EXPECT_EQ(stopped.nodes, 0);  // the mesh summary comes with a finished run only
+
+  // The same needle and tissue asked for 30 um: a finished run with the same steps.
+  const InsertionRun asked =
+      run_insertion(parse_scene(text("30 um"), "skin.toml"), {cone}, options);
+  ASSERT_FALSE(asked.stopped.has_value());
+  const NeedleRun& full = asked.needles.front();
+  ASSERT_EQ(full.curve.size(), reached.curve.size());
+  // Equal to round-off: the asked run cuts its last step (3 x 10 um = 30.000000000000004 um) at
+  // the 30 um it was asked for, 4e-21 m away, by linear interpolation.
+  for (std::size_t i = 0; i < full.curve.size(); ++i) {
+    const RunPoint &a = full.curve[i], &b = reached.curve[i];
+    EXPECT_NEAR(a.depth_m, b.depth_m, 1e-15) << i;
+    EXPECT_NEAR(a.force_N, b.force_N, 1e-12 * b.force_N) << i;
+    EXPECT_NEAR(a.tip_stress_Pa, b.tip_stress_Pa, 1e-12 * b.tip_stress_Pa) << i;
+  }
+}
+
 TEST(InsertionRun, MoreNeedlesThanTheFiniteElementLimitIsRefusedBeforeAnyWork) {
   InsertionRunOptions o = fast();
   o.max_fe_needles = 3;

@@ -50,6 +50,11 @@ struct InsertionRunOptions {
   /// "Pre-puncture horizon"); false climbs it from rung 0 (to check that the skipped rungs would
   /// not have fired).
   bool start_from_closed_form = true;
+  /// When the pre-puncture FE stops (a SolverError: Newton, an inverted element, the crack's
+  /// faces) after at least one depth step, return what it reached, with InsertionRun::stopped
+  /// set, instead of throwing (docs/cli.md, "simulate"). False for every command that ranks or
+  /// optimises: a run that stopped is not a result to rank. Running out of memory always throws.
+  bool keep_reached = false;
   /// Largest relative force change a measured reduction may cause; empty: from the fidelity
   /// (fast 5 %, standard 2 %, fine 1 %).
   std::optional<double> reduction_tolerance;
@@ -155,6 +160,13 @@ struct RunSeconds {
   int fe_runs = 0;                 ///< FE runs (3-D and axisymmetric) started
 };
 
+/// Where and why a pre-puncture FE run stopped before its last depth step
+/// (InsertionRunOptions::keep_reached).
+struct RunStop {
+  double depth_m = 0.0;  ///< its deepest depth step, the curves' last point
+  std::string reason;    ///< the solver's message, naming the depth it could not reach
+};
+
 struct InsertionRun {
   std::vector<NeedleRun> needles;
   std::vector<RunPoint> total_curve;    ///< sum over the needles (stage of the first needle)
@@ -195,6 +207,10 @@ struct InsertionRun {
   std::size_t peak_memory_bytes = 0;
   /// What InsertionRunOptions::inp_path received (3-D model only).
   std::optional<fe::InpExport> exported;
+  /// Set when the pre-puncture FE stopped and keep_reached asked for what it reached: the curves
+  /// end at stopped->depth_m, a puncture before it is one, and none means none before it. The
+  /// mesh summary (nodes, elements, quality) comes with a finished run only: zeros here.
+  std::optional<RunStop> stopped;
 };
 
 /// The scene's [model] choices as run options: fidelity, contact and criterion (every other
