@@ -233,6 +233,14 @@ std::string simulate_body(const json& r, const ReportInput& in) {
   body +=
       ". The puncture at first contact is the first step's depth, not resolved (docs/model.md, "
       "&ldquo;Criteria&rdquo;).</p>\n";
+  // A run whose solver stopped part-way: its curves end there (docs/cli.md, "simulate").
+  if (r.contains("stopped") && r.at("stopped").is_object()) {
+    const json& stop = r.at("stopped");
+    body += "<p class=\"notes\">The finite element run stopped after its step at " +
+            quantity(stop, "depth_m", Dimension::Length) +
+            " and the curves end there: " + esc(text_of(stop.value("reason", json("")))) +
+            ". &ldquo;No puncture&rdquo; means none before that depth.</p>\n";
+  }
   if (r.contains("energy_check") && r.at("energy_check").is_object()) {
     const json& e = r.at("energy_check");
     body += "<p>Energy check at " + quantity(e, "depth_m", Dimension::Length) + ": strain energy " +

@@ -214,6 +214,25 @@ TEST(HtmlReport, NotesAndAMissingViewAreSaid) {
   EXPECT_NE(page.find("No needle could be shown"), std::string::npos);
 }
 
+TEST(HtmlReport, ASimulationWhoseSolverStoppedSaysWhereItsCurvesEnd) {
+  const json pre = json::array({{{"depth_m", 10e-6}, {"force_N", 1e-3}, {"stage", "pre"}},
+                                {{"depth_m", 40e-6}, {"force_N", 4e-3}, {"stage", "pre"}}});
+  ReportInput in;
+  in.result = {
+      {"needles",
+       {{{"name", "cone"}, {"curve", pre}, {"puncture", nullptr}, {"max_force_N", 4e-3}}}},
+      {"total_curve", pre},
+      {"stopped",
+       {{"depth_m", 40e-6},
+        {"reason", "axisymmetric insertion stopped at depth 42.47 um: inverted <element>"}}}};
+  in.source = "r.json";
+  const std::string page = mneedle::report::html_report(in);
+  EXPECT_NE(page.find("The finite element run stopped after its step at 40 "), std::string::npos);
+  EXPECT_NE(page.find("inverted &lt;element&gt;"), std::string::npos);  // escaped
+  in.result.erase("stopped");
+  EXPECT_EQ(mneedle::report::html_report(in).find("run stopped"), std::string::npos);
+}
+
 TEST(WriteReport, UnwritableFileIsNamedAndLeavesNothing) {
   ReportInput in;
   in.result = screen_result();
