@@ -195,6 +195,7 @@ InsertionRunOptions simulate_run_options(const Scene& scene, const SimulateSetti
                                         : PreModel::Auto;
   r.max_fe_needles = s.max_needles;
   r.allow_reductions = !s.no_reductions;
+  r.keep_reached = s.keep_reached;
   return r;
 }
 

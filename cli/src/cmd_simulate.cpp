@@ -174,7 +174,10 @@ plot::Figure simulate_figure(const InsertionRun& run, const std::string& title) 
   return f;
 }
 
-void run(const SimulateOptions& o) {
+void run(SimulateOptions o) {
+  // A run whose FE stops part-way still prints what it reached, then fails (docs/cli.md, "A run
+  // whose solver stops"): the curve up to there is what a user looking at the stop needs.
+  o.settings.keep_reached = true;
   Scene scene = load_scene(o.scene);
   apply_simulate_settings(scene, o.settings);
   const PluginRegistry registry =
@@ -196,9 +199,6 @@ void run(const SimulateOptions& o) {
                             double force) {
     progress.update({model, step, steps, depth, force});
   };
-  // A run whose FE stops part-way still prints what it reached, then fails (docs/cli.md,
-  // "simulate"): the curve up to there is what a user looking at the stop needs.
-  options.keep_reached = true;
   const InsertionRun result = run_insertion(scene, needles, options);
   progress.finish();
   // Every format prints the numbers of this tree: check them once, before anything is printed.

@@ -101,18 +101,24 @@ def simulate(
     no_reductions: bool = False,
     plugin_dirs: Iterable[Union[str, "PathLike[str]"]] = (),
     source: Optional[str] = None,
+    keep_reached: bool = False,
 ) -> Dict[str, Any]:
     """``mneedle simulate SCENE --json``: the two-stage insertion of every needle in the scene.
 
     ``scene`` is a file or a dict (``read_scene``'s, changed); ``source`` names a dict in
     messages and anchors its relative STL paths (default: the working folder). Empty settings
-    keep the scene's own choices.
+    keep the scene's own choices. A finite element run that stops part-way raises
+    ``SolverError``; with ``keep_reached=True`` it returns what it reached instead, with
+    ``"stopped"`` set, and warns (docs/cli.md, "A run whose solver stops").
     """
     file, values, name = _scene_args(scene, source)
     result = _core.simulate(
         file, values, name, fidelity, contact, criterion, model, axis, int(max_needles),
-        bool(no_reductions), _list(plugin_dirs, "plugin_dirs"),
+        bool(no_reductions), _list(plugin_dirs, "plugin_dirs"), bool(keep_reached),
     )
+    if result.get("stopped"):
+        # The CLI's one-line error, as a warning: the curves end at the stop.
+        warnings.warn(result["stopped"]["reason"], RuntimeWarning, stacklevel=2)
     check = result.get("energy_check")
     if check and not check["passes"]:
         # As the CLI warns on stderr (docs/model.md, "Energy check").

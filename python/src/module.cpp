@@ -135,8 +135,9 @@ PYBIND11_MODULE(_core, m) {
       [](const std::string& file, const nlohmann::json& values, const std::string& source,
          const std::string& fidelity, const std::string& contact, const std::string& criterion,
          const std::string& model, const std::string& axis, std::size_t max_needles,
-         bool no_reductions, const std::vector<std::string>& plugin_dirs) {
-        SimulateSettings s{fidelity, contact, criterion, model, axis, max_needles, no_reductions};
+         bool no_reductions, const std::vector<std::string>& plugin_dirs, bool keep_reached) {
+        SimulateSettings s{fidelity, contact,     criterion,     model,
+                           axis,     max_needles, no_reductions, keep_reached};
         return simulate(file, values, source, s, plugin_dirs);
       },
       py::call_guard<py::gil_scoped_release>());

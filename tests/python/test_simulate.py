@@ -149,3 +149,23 @@ def test_where_the_penetration_criterion_does_not_hold_python_warns_as_the_cli_d
     assert result["warnings"][0].startswith("brittle gel: tissue.layers[0] 'silicone'")
     # Paper A's toughness: no warning, and an empty list.
     assert mneedle.simulate(source / PUNCH, criterion="penetration")["warnings"] == []
+
+
+def test_a_stopped_run_raises_unless_asked_to_keep_what_it_reached(cli, source, tmp_path):
+    # A sharp cone on a finite-strain stratum corneum inverts the element under its point after
+    # the step at 40 um (fast): SolverError with the CLI's message, or with keep_reached the
+    # curve to there, "stopped" set and a RuntimeWarning (docs/cli.md, "A run whose solver stops").
+    values = mneedle.read_scene(source / "designs/scenes/human_skin.toml")
+    values["needles"][0]["geometry"] = {"plugin": "cone", "diameter": "230 um",
+                                        "length": "1000 um"}
+    values["tissue"]["layers"][0]["material"]["model"] = "svk"
+    scene = tmp_path / "stops.toml"
+    scene.write_text(mneedle.scene_toml(values))
+    with pytest.raises(mneedle.SolverError) as raised:
+        mneedle.simulate(scene, fidelity="fast")
+    assert str(raised.value) == cli.error("simulate", scene, "--fidelity", "fast")
+    with pytest.warns(RuntimeWarning, match="inverted element"):
+        kept = mneedle.simulate(scene, fidelity="fast", keep_reached=True)
+    assert kept["stopped"]["depth_m"] == pytest.approx(40e-6, abs=1e-12)
+    assert kept["needles"][0]["puncture"] is None
+    assert kept["needles"][0]["curve"][-1]["depth_m"] == pytest.approx(40e-6, abs=1e-12)

@@ -122,15 +122,11 @@ struct PreResult {
   std::optional<RunStop> stopped;  ///< run_3d / run_axisymmetric with keep_reached
 };
 
-// The main pre-puncture run stopped after `reached` steps with `e`: its steps are kept (and the
-// stop recorded) when the caller asked for them and there is at least one; otherwise, and always
-// for memory, the error goes on.
+// True when the main pre-puncture run that stopped with `e` after `reached` steps keeps them
+// (the caller asked, there is at least one, and it is not memory); the caller rethrows otherwise.
 template <typename Step>
-std::optional<RunStop> keep_or_rethrow(const SolverError& e, bool keep_reached,
-                                       const std::vector<Step>& reached) {
-  if (!keep_reached || reached.empty() || dynamic_cast<const OutOfMemoryError*>(&e) != nullptr)
-    throw;
-  return RunStop{reached.back().depth_m, e.what()};
+bool keeps_reached(const SolverError& e, bool keep_reached, const std::vector<Step>& reached) {
+  return keep_reached && !reached.empty() && dynamic_cast<const OutOfMemoryError*>(&e) == nullptr;
 }
 
 fe::ContactMode to_fe(Contact c) {
@@ -246,7 +242,8 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
     try {
       r = fe::simulate_3d(block, fe_needles, o);
     } catch (const SolverError& e) {
-      stopped = keep_or_rethrow(e, keep_reached, reached);
+      if (!keeps_reached(e, keep_reached, reached)) throw;
+      stopped = RunStop{reached.back().depth_m, e.what()};
       r.steps = std::move(reached);
     }
   }
@@ -357,7 +354,8 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
         throw;
       }
     } catch (const SolverError& e) {
-      stopped = keep_or_rethrow(e, keep_reached, reached);
+      if (!keeps_reached(e, keep_reached, reached)) throw;
+      stopped = RunStop{reached.back().depth_m, e.what()};
       r.steps = std::move(reached);
     }
   }
@@ -1138,11 +1136,14 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
         if (deciding) {
           plan.depth_m = scene.insertion.depth;
           plan.shown_depth_m = 0.0;
+          // A deciding rung that stopped cannot decide (it may have stopped beyond the requested
+          // depth, which only the decision looks at): climb from rung 0 as the decision would.
+          if (pre.stopped) return true;
           const double crossed = deepest_first_crossing(plan, pre);
           if (crossed > 0.0 && crossed <= below * (1.0 + 1e-12)) return true;
         }
-        // A rung that stopped ends the climb: a deeper rung of the same model would stop there
-        // too, and what it reached is the answer (keep_reached).
+        // A rung that stopped ends the climb (keep_reached): what it reached is the answer; a
+        // deeper rung, built for a longer horizon, may stop too or elsewhere.
         if (pre.stopped || every_needle_crossed(plan, pre)) break;
       }
       return false;
@@ -1170,6 +1171,12 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     if (any_post) run.models_run.push_back("surface_loads");
   }
   run.total_curve = total_curve(run.needles);
+  // Past a stop the needles that did not puncture have no force: the sum ends there too (a
+  // needle that punctured before it keeps its own post-puncture curve, which needs no FE).
+  if (run.stopped)
+    std::erase_if(run.total_curve, [&](const RunPoint& p) {
+      return p.depth_m > run.stopped->depth_m * (1.0 + 1e-12);
+    });
   // The energy ledger of the pre-puncture stage, up to the first needle's puncture (after it
   // the tissue is cut and the ledger would need the fracture energy; docs/model.md).
   std::vector<double> depth, force, energy;

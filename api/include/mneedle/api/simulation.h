@@ -25,6 +25,9 @@ struct SimulateSettings {
   std::string axis;            // the scene's STL needles' axis (parse_axis_choice)
   std::size_t max_needles = 16;
   bool no_reductions = false;
+  /// Return what a stopped pre-puncture FE reached, with "stopped" set, instead of failing
+  /// (InsertionRunOptions::keep_reached; docs/cli.md, "A run whose solver stops").
+  bool keep_reached = false;
 };
 
 /// Checks every setting (one-line InputError naming it) and applies `axis` to the scene's mesh
