@@ -118,12 +118,10 @@ nlohmann::json run_json(const InsertionRun& run, const Scene& scene) {
                        {"puncture", puncture},
                        {"max_force_N", n.max_force_N}});
   }
-  // A run that stopped has no mesh summary (it comes with a finished run): null, not zeros.
   nlohmann::json mesh = {{"nodes", run.nodes},
                          {"elements", run.elements},
                          {"order", run.order},
                          {"axisymmetric", run.axisymmetric}};
-  if (run.stopped && run.nodes == 0) mesh = nullptr;
   if (run.min_dihedral_deg > 0.0) {
     mesh["min_dihedral_deg"] = run.min_dihedral_deg;
     mesh["max_aspect_ratio"] = run.max_aspect_ratio;

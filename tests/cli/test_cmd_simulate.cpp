@@ -615,7 +615,7 @@ TEST(CmdSimulate, ARunWhoseSolverStopsPrintsWhatItReachedThenFails) {
   const auto j = nlohmann::json::parse(json.out);
   EXPECT_NEAR(j["stopped"]["depth_m"].get<double>(), 40e-6, 1e-12);
   EXPECT_NE(j["stopped"]["reason"].get<std::string>().find("inverted element"), std::string::npos);
-  EXPECT_TRUE(j["mesh"].is_null());
+  EXPECT_GT(j["mesh"]["nodes"].get<int>(), 0);  // the mesh it stopped on
   const auto& needle = j["needles"].at(0);
   EXPECT_TRUE(needle["puncture"].is_null());
   ASSERT_EQ(needle["curve"].size(), 4u);  // 10, 20, 30, 40 um

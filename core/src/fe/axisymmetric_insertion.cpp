@@ -1138,6 +1138,13 @@ InsertionResult simulate_axisymmetric(const AxisymmetricProblem& problem) {
   AxisymmetricModel model(std::move(mesh), materials);
   const double mesh_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (problem.on_mesh) {
+    InsertionResult built;
+    built.nodes = model.mesh().nodes.size();
+    built.elements = model.mesh().elements.size();
+    built.mesh_seconds = mesh_seconds;
+    problem.on_mesh(built);
+  }
   InsertionOptions options;
   options.depth_m = problem.depth_m;
   options.contact = problem.contact;

@@ -1779,6 +1779,7 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   result.quality = mesh_quality(mesh);
   result.contact_zone_m = mesh.contact_zone_m;
   result.unresolved_flats = mesh.unresolved_flats;
+  if (options.on_mesh) options.on_mesh(result);
   Indentation3dOptions solver_options;
   solver_options.contact = options.contact;
   if (options.overrides.tolerance) solver_options.tolerance = *options.overrides.tolerance;

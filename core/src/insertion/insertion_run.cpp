@@ -217,7 +217,9 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
   CrossingWatch watch(needles.size(), plan);
   int step_index = 0;
   bool past_shown = false;
-  std::vector<fe::Step3d> reached;  // kept for a run that stops (keep_reached)
+  std::vector<fe::Step3d> reached;  // kept for a run that stops (keep_reached), with its mesh
+  fe::Simulation3dResult built;
+  o.on_mesh = [&](const fe::Simulation3dResult& summary) { built = summary; };
   o.on_step = [&](const fe::Step3d& step) {
     if (keep_reached) reached.push_back(step);
     bool more = true;
@@ -244,6 +246,7 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
     } catch (const SolverError& e) {
       if (!keeps_reached(e, keep_reached, reached)) throw;
       stopped = RunStop{reached.back().depth_m, e.what()};
+      r = std::move(built);
       r.steps = std::move(reached);
     }
   }
@@ -326,6 +329,8 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
   CrossingWatch watch(1, plan);
   int step_index = 0;
   std::vector<fe::InsertionStep> reached;  // kept for a run that stops (keep_reached)
+  fe::InsertionResult built;               // and the mesh it ran on
+  p.on_mesh = [&](const fe::InsertionResult& summary) { built = summary; };
   p.on_step = [&](const fe::InsertionStep& step) {
     if (keep_reached) reached.push_back(step);
     if (options.on_progress)
@@ -356,6 +361,7 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
     } catch (const SolverError& e) {
       if (!keeps_reached(e, keep_reached, reached)) throw;
       stopped = RunStop{reached.back().depth_m, e.what()};
+      r = std::move(built);
       r.steps = std::move(reached);
     }
   }
@@ -377,7 +383,7 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
   }
   out.nodes = static_cast<int>(r.nodes);
   out.elements = static_cast<int>(r.elements);
-  out.order = stopped ? 0 : 2;
+  out.order = 2;
   out.axisymmetric = true;
   out.model = "axisymmetric_fe";
   out.stopped = std::move(stopped);

@@ -278,6 +278,10 @@ struct AxisymmetricProblem {
   double crack_depth_m = 0.0;            ///< as InsertionOptions
   bool crack_face_contact = true;        ///< as InsertionOptions
   std::function<bool(const InsertionStep&)> on_step;
+  /// Called once the mesh is built, before the first step, with the result's nodes, elements and
+  /// mesh_seconds filled and no steps: a caller that keeps what a run reached before it stopped
+  /// keeps the mesh it ran on too.
+  std::function<void(const InsertionResult&)> on_mesh;
   std::string vtu_directory;
   std::string vtu_comment;
 };

@@ -178,6 +178,8 @@ class Indentation3d {
   std::unique_ptr<Impl> impl_;
 };
 
+struct Simulation3dResult;
+
 struct Simulation3dOptions {
   Fidelity fidelity = Fidelity::Standard;
   int order = 2;       ///< 1: TET4, 2: TET10 (overrides.order wins when set)
@@ -209,6 +211,10 @@ struct Simulation3dOptions {
   bool crack_face_contact = true;
   /// Called after each output step; returning false stops the insertion there.
   std::function<bool(const Step3d&)> on_step;
+  /// Called once the mesh is built, before the first step, with Simulation3dResult's mesh
+  /// summary filled (nodes, elements, order, quality, contact zone, unresolved flats) and no
+  /// steps: a caller that keeps what a run reached before it stopped keeps the mesh it ran on too.
+  std::function<void(const Simulation3dResult&)> on_mesh;
   /// When set, the problem at the last step not deeper than inp_depth_m is written there
   /// as a CalculiX/Abaqus deck (Indentation3d::write_inp; linear layers, sticking contact).
   std::string inp_path;

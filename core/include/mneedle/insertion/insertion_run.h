@@ -209,7 +209,7 @@ struct InsertionRun {
   std::optional<fe::InpExport> exported;
   /// Set when the pre-puncture FE stopped and keep_reached asked for what it reached: the curves
   /// end at stopped->depth_m, a puncture before it is one, and none means none before it. The
-  /// mesh summary (nodes, elements, quality) comes with a finished run only: zeros here.
+  /// mesh summary is the mesh it ran on; the 3-D run's phase timings are not kept.
   std::optional<RunStop> stopped;
 };
 
