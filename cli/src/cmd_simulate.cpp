@@ -171,6 +171,11 @@ plot::Figure simulate_figure(const InsertionRun& run, const std::string& title) 
     }
     f.series.push_back(std::move(s));
   }
+  // Where a stopped run's curves end (docs/cli.md, "A run whose solver stops"): marked, so the
+  // end of a curve is not read as the end of the insertion.
+  if (run.stopped && !run.total_curve.empty())
+    f.points.push_back(
+        {"FE stopped", run.total_curve.back().depth_m, run.total_curve.back().force_N});
   return f;
 }
 

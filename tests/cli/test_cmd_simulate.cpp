@@ -606,7 +606,14 @@ TEST(CmdSimulate, ARunWhoseSolverStopsPrintsWhatItReachedThenFails) {
   std::ofstream(file) << text;
   const CommandRun json = run_mneedle("simulate '" + file.string() + "' --fidelity fast --json");
   const CommandRun table = run_mneedle("simulate '" + file.string() + "' --fidelity fast --quiet");
+  const fs::path svg = fs::temp_directory_path() / ("stops_" + std::to_string(::getpid()) + ".svg");
+  const CommandRun plot = run_mneedle("simulate '" + file.string() +
+                                      "' --fidelity fast --quiet --plot '" + svg.string() + "'");
   fs::remove(file);
+  EXPECT_EQ(plot.exit_code, 3) << plot.err;
+  const std::string drawn = mneedle::test::read_svg(svg);
+  fs::remove(svg);
+  EXPECT_TRUE(mneedle::test::has_text(mneedle::test::texts(drawn), "FE stopped")) << drawn.size();
   EXPECT_EQ(json.exit_code, 3) << json.err;
   EXPECT_EQ(std::count(json.err.begin(), json.err.end(), '\n'), 1) << json.err;
   EXPECT_EQ(json.err.rfind("mneedle: error: axisymmetric insertion stopped at depth ", 0), 0u)
