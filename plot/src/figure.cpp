@@ -236,7 +236,11 @@ void write_svg(const std::filesystem::path& file, const Figure& f) {
     plcol0(kForeground);
     plpoin(1, &x, &y, 4);
     plschr(0, 0.8);
-    plptex(x + 0.01 * (x1 - x0), y, 1.0, 0.0, 0.0, escaped(p.label).c_str());
+    // Right of the point, or left of it in the last quarter of the axis, where a label written
+    // rightwards would run out of the frame and be cut (a curve that ends at a marked point).
+    const bool left = x > x0 + 0.75 * (x1 - x0);
+    plptex(x + (left ? -0.01 : 0.01) * (x1 - x0), y, 1.0, 0.0, left ? 1.0 : 0.0,
+           escaped(p.label).c_str());
     plschr(0, 1.0);
   }
 

@@ -137,6 +137,29 @@ TEST(WriteSvg, CurvePointsLieWhereTheAxisTicksPutTheirValues) {
     EXPECT_NEAR(line[i].second, y0 + slope * std::pow(i / 40.0, 2), 0.05) << i;
 }
 
+// A point's label is written rightwards from it, except in the last quarter of the x axis,
+// where it would run out of the frame and be cut: a curve that ends at a marked point (simulate's
+// "FE stopped") keeps its label in view.
+TEST(WriteSvg, APointsLabelNearTheRightEdgeIsWrittenLeftOfIt) {
+  fs::create_directories(kWork);
+  const auto file = kWork / "labels.svg";
+  Figure f = force_figure();
+  f.points = {{"early", 40e-6, 2e-3 * 0.04}, {"at the end", 200e-6, 2e-3}};
+  mneedle::plot::write_svg(file, f);
+  const std::string svg = read(file);
+  const auto line = polyline(svg, "#1F77B4");
+  ASSERT_EQ(line.size(), 41u);
+  double early = -1.0, end = -1.0;
+  for (const auto& t : texts(svg)) {
+    if (t.text == "early") early = t.x;
+    if (t.text == "at the end") end = t.x;
+  }
+  ASSERT_GE(early, 0.0);
+  ASSERT_GE(end, 0.0);
+  EXPECT_GT(early, line[8].first);    // right of the point at 40 um (the curve's 9th point)
+  EXPECT_LT(end, line.back().first);  // left of the point at 200 um, the curve's last
+}
+
 TEST(WriteSvg, OneCurveHasNoLegend) {
   fs::create_directories(kWork);
   const auto file = kWork / "single.svg";
