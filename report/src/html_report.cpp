@@ -130,6 +130,12 @@ std::vector<plot::Figure> simulate_figures(const json& r, const std::string& whe
     if (!total.x.empty()) f.series.push_back(std::move(total));
   }
   if (f.series.empty()) return {};
+  // A stopped run's curves end at its last step (docs/cli.md, "A run whose solver stops"): marked
+  // there on the total (the one needle's curve, or the sum), as simulate --plot marks it.
+  if (r.contains("stopped") && r.at("stopped").is_object()) {
+    const plot::Series& last = f.series.back();
+    f.points.push_back({"FE stopped", last.x.back(), last.y.back()});
+  }
   return {f};
 }
 

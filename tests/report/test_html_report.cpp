@@ -229,6 +229,12 @@ TEST(HtmlReport, ASimulationWhoseSolverStoppedSaysWhereItsCurvesEnd) {
   const std::string page = mneedle::report::html_report(in);
   EXPECT_NE(page.find("The finite element run stopped after its step at 40 "), std::string::npos);
   EXPECT_NE(page.find("inverted &lt;element&gt;"), std::string::npos);  // escaped
+  const auto figures = mneedle::report::report_figures(in.result, "r.json");
+  ASSERT_EQ(figures.size(), 1u);
+  ASSERT_EQ(figures[0].points.size(), 1u);  // no puncture: the stop is the only marked point
+  EXPECT_EQ(figures[0].points[0].label, "FE stopped");
+  EXPECT_EQ(figures[0].points[0].x, 40e-6);
+  EXPECT_EQ(figures[0].points[0].y, 4e-3);
   in.result.erase("stopped");
   EXPECT_EQ(mneedle::report::html_report(in).find("run stopped"), std::string::npos);
 }
