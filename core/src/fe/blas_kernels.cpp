@@ -120,4 +120,10 @@ BlasKernels select_blas_kernels(BlasKernelChoice choice) {
   return selected;
 }
 
+int openblas_threads() {
+  using Threads = int (*)();
+  const auto threads = reinterpret_cast<Threads>(blas_symbol("openblas_get_num_threads"));
+  return threads != nullptr ? std::max(0, threads()) : 0;
+}
+
 }  // namespace mneedle::fe

@@ -3,13 +3,14 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
-#include <cassert>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 #include <vector>
 
 #include "mneedle/base/error.h"
 #include "mneedle/fe/material.h"
+#include "mneedle/fe/parallel.h"
 
 namespace mneedle::fe {
 
@@ -463,11 +464,12 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
     }
     sub_children[i] = children_of(corners);
   }
-  // The pieces of elements_[k] are points_[piece_start[k] .. piece_start[k + 1]).
-  std::vector<std::size_t> piece_start{0};
+  // The pieces of elements_[k] are points_[piece_start_[k] .. piece_start_[k + 1]).
+  piece_start_.assign(1, 0);
   for (std::size_t i = 0; i < points_.size(); ++i)
     if (i + 1 == points_.size() || points_[i + 1].element != points_[i].element)
-      piece_start.push_back(i + 1);
+      piece_start_.push_back(i + 1);
+  const std::vector<std::size_t>& piece_start = piece_start_;
   // The balls of a half (quarter) model see the mirror image of the meshed part as the whole
   // block's do: an element with a sub-tetrahedron that reaches within L of a symmetry plane is
   // reflected across it (its other pieces are too far to enter a ball and weigh nothing).
@@ -506,35 +508,47 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
   // Counting a sub-tetrahedron by its centroid instead made the ball's edge ragged by a quarter
   // element: on the fast skin mesh the sharp bevel's puncture moved from 64.8 to 99.9 um when the
   // elements were split eight times finer (docs/model.md, "Tip stress").
-  ball_start_.push_back(0);
-  for (const Candidate& c : candidates_) {
-    const Cell home = cell_of(c.x, cell);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const auto bucket = buckets.find(cell_key({home[0] + dx, home[1] + dy, home[2] + dz}));
-          if (bucket == buckets.end()) continue;
-          for (int q : bucket->second) {
-            const Image& image = images[static_cast<std::size_t>(q)];
-            const double apart = (image.mid - c.x).norm();
-            if (apart - image.reach > length_m) continue;
-            // The image's pieces against the centre are the source's against the centre's image.
-            Eigen::Vector3d centre = c.x;
-            if (image.mirror & 1) centre.y() = -centre.y();
-            if (image.mirror & 2) centre.x() = -centre.x();
-            const bool whole = apart + image.reach <= length_m;
-            const auto k = static_cast<std::size_t>(image.element);
-            for (std::size_t i = piece_start[k]; i < piece_start[k + 1]; ++i) {
-              const double volume =
-                  whole ? points_[i].volume
-                        : volume_in_ball(sub_children[i], points_[i].volume, sub_reach[i],
-                                         points_[i].x, centre, length_m);
-              if (volume <= 0.0) continue;
-              ball_source_.push_back(static_cast<int>(i));
-              ball_volume_.push_back(volume);
+  // Centres are independent: chunks of them run on the factorisations' threads, each ball into
+  // its own list, joined in centre order, so the lists do not depend on the thread count.
+  std::vector<std::vector<std::pair<int, double>>> balls(candidates_.size());
+  parallel_chunks(candidates_.size(), loop_threads(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const Candidate& c = candidates_[k];
+      std::vector<std::pair<int, double>>& ball = balls[k];
+      const Cell home = cell_of(c.x, cell);
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz) {
+            const auto bucket = buckets.find(cell_key({home[0] + dx, home[1] + dy, home[2] + dz}));
+            if (bucket == buckets.end()) continue;
+            for (int q : bucket->second) {
+              const Image& image = images[static_cast<std::size_t>(q)];
+              const double apart = (image.mid - c.x).norm();
+              if (apart - image.reach > length_m) continue;
+              // The image's pieces against the centre are the source's against the centre's
+              // image.
+              Eigen::Vector3d centre = c.x;
+              if (image.mirror & 1) centre.y() = -centre.y();
+              if (image.mirror & 2) centre.x() = -centre.x();
+              const bool whole = apart + image.reach <= length_m;
+              const auto e = static_cast<std::size_t>(image.element);
+              for (std::size_t i = piece_start[e]; i < piece_start[e + 1]; ++i) {
+                const double volume =
+                    whole ? points_[i].volume
+                          : volume_in_ball(sub_children[i], points_[i].volume, sub_reach[i],
+                                           points_[i].x, centre, length_m);
+                if (volume > 0.0) ball.emplace_back(static_cast<int>(i), volume);
+              }
             }
           }
-        }
+    }
+  });
+  ball_start_.push_back(0);
+  for (const auto& ball : balls) {
+    for (const auto& [source, volume] : ball) {
+      ball_source_.push_back(source);
+      ball_volume_.push_back(volume);
+    }
     ball_start_.push_back(ball_source_.size());
   }
 }
@@ -564,46 +578,57 @@ std::vector<double> PeakStressProbe::peak(const Eigen::VectorXd& u,
     eigen.computeDirect(sigma, Eigen::EigenvaluesOnly);
     return eigen.eigenvalues().maxCoeff();
   };
-  std::size_t i = 0;
-  for (int e : elements_) {
-    const ElementField field =
-        element_field(mesh, u, static_cast<std::size_t>(e), material, all_linear);
-    // The sub-points' barycentrics are over the canonical corners; the field's over the local.
-    const std::array<int, 4> order = canonical_corners(mesh, static_cast<std::size_t>(e));
-    const auto local = [&](const Barycentric& l) {
-      Barycentric out;
-      for (int a = 0; a < 4; ++a) out(order[static_cast<std::size_t>(a)]) = l(a);
-      return out;
-    };
-    if (all_linear) {
-      Eigen::Matrix3d at_corner[4];
-      for (int c = 0; c < 4; ++c) at_corner[c] = field.cauchy(corner[c]);
-      for (; i < points_.size() && points_[i].element == e; ++i) {
-        const Barycentric l = local(centroid_of(subs[static_cast<std::size_t>(points_[i].sub)]));
-        stress[i] = largest(l(0) * at_corner[0] + l(1) * at_corner[1] + l(2) * at_corner[2] +
-                            l(3) * at_corner[3]);
+  // Elements, then centres, in chunks on the factorisations' threads: each writes its own
+  // entries, and the peak is taken in centre order, so the answer does not depend on the count.
+  const int threads = loop_threads();
+  parallel_chunks(elements_.size(), threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const auto e = static_cast<std::size_t>(elements_[k]);
+      const ElementField field = element_field(mesh, u, e, material, all_linear);
+      // The sub-points' barycentrics are over the canonical corners; the field's over the local.
+      const std::array<int, 4> order = canonical_corners(mesh, e);
+      const auto local = [&](const Barycentric& l) {
+        Barycentric out;
+        for (int a = 0; a < 4; ++a) out(order[static_cast<std::size_t>(a)]) = l(a);
+        return out;
+      };
+      const auto centroid = [&](std::size_t i) {
+        return local(centroid_of(subs[static_cast<std::size_t>(points_[i].sub)]));
+      };
+      if (all_linear) {
+        Eigen::Matrix3d at_corner[4];
+        for (int c = 0; c < 4; ++c) at_corner[c] = field.cauchy(corner[c]);
+        for (std::size_t i = piece_start_[k]; i < piece_start_[k + 1]; ++i) {
+          const Barycentric l = centroid(i);
+          stress[i] = largest(l(0) * at_corner[0] + l(1) * at_corner[1] + l(2) * at_corner[2] +
+                              l(3) * at_corner[3]);
+        }
+      } else {
+        for (std::size_t i = piece_start_[k]; i < piece_start_[k + 1]; ++i)
+          stress[i] = field.max_principal(centroid(i));
       }
-    } else {
-      for (; i < points_.size() && points_[i].element == e; ++i)
-        stress[i] =
-            field.max_principal(local(centroid_of(subs[static_cast<std::size_t>(points_[i].sub)])));
     }
-  }
-  assert(i == points_.size() && "the probe's sub-points are grouped by element");
+  });
+  // Each centre's mean (NaN: outside its site's radius now, or an empty ball).
+  std::vector<double> mean(candidates_.size(), std::numeric_limits<double>::quiet_NaN());
+  parallel_chunks(candidates_.size(), threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const Candidate& c = candidates_[k];
+      if (c.distance > search_radius_m[static_cast<std::size_t>(c.site)]) continue;
+      double stress_volume = 0.0, volume = 0.0;
+      for (std::size_t j = ball_start_[k]; j < ball_start_[k + 1]; ++j) {
+        stress_volume += ball_volume_[j] * stress[static_cast<std::size_t>(ball_source_[j])];
+        volume += ball_volume_[j];
+      }
+      if (volume > 0.0) mean[k] = stress_volume / volume;
+    }
+  });
   std::vector<double> best(site_count_, 0.0);
   std::vector<char> found(site_count_, 0);
   for (std::size_t k = 0; k < candidates_.size(); ++k) {
-    const Candidate& c = candidates_[k];
-    if (c.distance > search_radius_m[static_cast<std::size_t>(c.site)]) continue;
-    double stress_volume = 0.0, volume = 0.0;
-    for (std::size_t j = ball_start_[k]; j < ball_start_[k + 1]; ++j) {
-      stress_volume += ball_volume_[j] * stress[static_cast<std::size_t>(ball_source_[j])];
-      volume += ball_volume_[j];
-    }
-    if (!(volume > 0.0)) continue;
-    const double mean = stress_volume / volume;
-    const auto s = static_cast<std::size_t>(c.site);
-    if (!found[s] || mean > best[s]) best[s] = mean;
+    if (std::isnan(mean[k])) continue;
+    const auto s = static_cast<std::size_t>(candidates_[k].site);
+    if (!found[s] || mean[k] > best[s]) best[s] = mean[k];
     found[s] = 1;
   }
   return best;

@@ -1,5 +1,6 @@
 #include "mneedle/fe/stress_probe.h"
 
+#include <dlfcn.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -8,6 +9,7 @@
 #include <numbers>
 
 #include "mneedle/base/error.h"
+#include "mneedle/fe/blas_kernels.h"
 #include "mneedle/fe/indentation3d.h"
 #include "mneedle/fe/material.h"
 #include "mneedle/fe/tissue_mesh.h"
@@ -290,6 +292,36 @@ TEST(StressProbe, PeakDoesNotDependOnHowElementsNumberTheirCorners) {
     ASSERT_GT(std::abs(pa), 0.0);
     EXPECT_NEAR(pb / pa, 1.0, 1e-12) << (model == MaterialModel::Linear ? "linear" : "neo-Hookean");
   }
+}
+
+// The probe splits its elements and centres over OpenBLAS's threads (mneedle/fe/parallel.h):
+// each writes its own entries and the peak is taken in centre order, so one thread and two read
+// the same stress and the same balls to the last bit, on the linear and the finite-strain path.
+TEST(StressProbe, PeakAndBallsDoNotDependOnTheThreadCount) {
+  using SetThreads = void (*)(int);
+  const auto set = reinterpret_cast<SetThreads>(::dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+  if (set == nullptr || openblas_threads() == 0) GTEST_SKIP() << "the BLAS is not OpenBLAS";
+  const int saved = openblas_threads();
+  for (const MaterialModel model : {MaterialModel::Linear, MaterialModel::NeoHookean}) {
+    const TetMesh mesh = two_layer_block(2, 0.3, model);
+    const auto field = [](const Eigen::Vector3d& x) {
+      return Eigen::Vector3d(1e-7 * std::sin(3e3 * x.x()) * std::cos(2e3 * x.y()),
+                             2e-7 * std::sin(2.5e3 * x.x() * x.y() * 1e3),
+                             1e-7 * std::cos(2.5e3 * x.z()) * (1.0 + 1e3 * x.x()));
+    };
+    const auto read = [&](int threads) {
+      set(threads);
+      const PeakStressProbe probe(mesh, {{0.0, 0.0}}, {0.3e-3}, 1e-3, 0.04e-3, 0);
+      std::vector<double> out = probe.ball_volumes();
+      out.push_back(probe.peak(interpolate(mesh, field), {0.3e-3})[0]);
+      return out;
+    };
+    const std::vector<double> one = read(1);
+    const std::vector<double> two = read(2);
+    ASSERT_GT(one.size(), 1u);
+    EXPECT_EQ(one, two) << (model == MaterialModel::Linear ? "linear" : "neo-Hookean");
+  }
+  set(saved);
 }
 
 // A point load on a stiff layer over a soft substrate (a sharp cone on a 1 GPa, 20 um layer over

@@ -47,4 +47,7 @@ struct BlasKernels {
 /// Auto), and the drivers that factorise on several threads call it before they start them.
 BlasKernels select_blas_kernels(BlasKernelChoice choice = BlasKernelChoice::Auto);
 
+/// The threads OpenBLAS runs now (openblas_get_num_threads), or 0 where the BLAS is not OpenBLAS.
+int openblas_threads();
+
 }  // namespace mneedle::fe

@@ -70,7 +70,8 @@ class PeakStressProbe {
   std::vector<int> elements_;  // the layer's elements within reach of a site
   std::vector<int> nodes_;     // their nodes, ascending
   std::vector<SubPoint> points_;
-  std::vector<double> search_radius_;  // the constructor's, per site
+  std::vector<std::size_t> piece_start_;  // elements_[k]'s pieces: points_[start[k], start[k + 1])
+  std::vector<double> search_radius_;     // the constructor's, per site
   std::vector<Candidate> candidates_;
   // Each candidate's ball (compressed rows): the sub-points it holds, with the volume of each
   // (or of its mirror image) inside it; a sub-point may appear twice through its image.
