@@ -47,7 +47,23 @@ struct NeedleCurve {
 struct ForceResult {
   Scene scene;
   std::vector<NeedleCurve> curves;
+  std::vector<std::string> notes;  // what the curves leave out that `simulate` keeps
 };
+
+// The broken top layer's grip (docs/model.md, "The broken top layer") needs the pre-puncture
+// curve, which `force` does not run: say so, or the table's stratum corneum loads (tens of mN
+// from the first micrometres) read as what `simulate` reports.
+std::vector<std::string> grip_notes(const Scene& scene) {
+  std::vector<double> moduli;
+  for (const TissueLayer& layer : scene.tissue.layers)
+    moduli.push_back(layer.material.youngs_modulus);
+  if (!top_layer_grips(scene.model.criterion, moduli)) return {};
+  return {"layer '" + scene.tissue.layers.front().name +
+          "' is stiffer than the one below and the scene's criterion is stress: after the "
+          "puncture `simulate` keeps it gripped to the shaft, continuing the pre-puncture curve "
+          "until its own loads are exceeded (docs/model.md, \"The broken top layer\"); these "
+          "curves are the distributed loads alone, as if the needle had punctured at the surface"};
+}
 
 // 0, step, 2 step, ... up to the scene's insertion depth, which is always the last point.
 std::vector<double> depth_grid(double max_depth, double step, double max_points) {
@@ -67,7 +83,7 @@ std::vector<double> depth_grid(double max_depth, double step, double max_points)
 }
 
 ForceResult compute(const ForceOptions& options) {
-  ForceResult result{load_scene(options.scene), {}};
+  ForceResult result{load_scene(options.scene), {}, {}};
   const Scene& scene = result.scene;
   const double step = parse_quantity(options.step, Dimension::Length);
   if (!(step > 0.0)) throw InputError("--step " + options.step + ": must be a positive length");
@@ -90,6 +106,7 @@ ForceResult compute(const ForceOptions& options) {
     const SurfaceLoadModel model(needle.mesh, constants);
     result.curves.push_back({needle.name, model.curve(depths), model.beta_length_m()});
   }
+  result.notes = grip_notes(scene);
   return result;
 }
 
@@ -106,7 +123,8 @@ nlohmann::json to_json(const ForceResult& result) {
     }
     needles.push_back({{"name", c.name}, {"beta_length_m", c.beta_length_m}, {"curve", points}});
   }
-  return nlohmann::json{{"loads", resolved_loads_json(result.scene)}, {"needles", needles}};
+  return nlohmann::json{
+      {"loads", resolved_loads_json(result.scene)}, {"needles", needles}, {"notes", result.notes}};
 }
 
 void print_csv(const std::vector<NeedleCurve>& curves) {
@@ -123,6 +141,7 @@ void print_csv(const std::vector<NeedleCurve>& curves) {
 void print_table(const ForceResult& result) {
   std::cout << "pressure scale per layer (docs/model.md, \"Pressure scale\"):\n"
             << resolved_loads_text(result.scene);
+  for (const std::string& note : result.notes) std::cout << "note: " << note << "\n";
   for (const NeedleCurve& c : result.curves) {
     std::cout << c.name << " (beta length " << format_quantity(c.beta_length_m, Dimension::Length)
               << ")\n  depth_um    force_mN    alpha_mN     beta_mN  friction_mN\n";

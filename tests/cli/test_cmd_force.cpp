@@ -178,6 +178,27 @@ TEST_F(ForceCommand, ForceJsonNamesEachLayersPressureScaleAndItsSource) {
   EXPECT_NE(layers[1]["source"].get<std::string>().find("not fitted"), std::string::npos);
 }
 
+// `force` runs no pre-puncture model, so it cannot continue the curve while a broken stiff top
+// layer grips the shaft, as `simulate` does (docs/model.md, "The broken top layer"): in skin
+// its stratum corneum loads read 88 mN at 200 um where `simulate` reads 19.6 mN. It says so, in
+// the table and the JSON; a single-layer silicone has no such layer and no note.
+TEST_F(ForceCommand, LoadsLeavingOutABrokenLayersGripSaySo) {
+  const CommandRun table = run_mneedle("force '" + design("human_skin.toml") + "' --step 100um");
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  EXPECT_NE(table.out.find("note: layer 'stratum_corneum' is stiffer than the one below"),
+            std::string::npos)
+      << table.out;
+  const CommandRun skin = run_mneedle("force '" + design("human_skin.toml") + "' --json");
+  ASSERT_EQ(skin.exit_code, 0) << skin.err;
+  const auto notes = nlohmann::json::parse(skin.out)["notes"];
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].get<std::string>().find("The broken top layer"), std::string::npos);
+  const CommandRun silicone =
+      run_mneedle("force '" + design("silicone_phantom.toml") + "' --json --step 500um");
+  ASSERT_EQ(silicone.exit_code, 0) << silicone.err;
+  EXPECT_TRUE(nlohmann::json::parse(silicone.out)["notes"].empty());
+}
+
 TEST_F(ForceCommand, NonPositiveStepIsAnErrorNamingTheOption) {
   const CommandRun run = run_mneedle("force '" + scene_asset("stl_needle.toml") + "' --step 0um");
   EXPECT_EQ(run.exit_code, 1);

@@ -764,9 +764,10 @@ NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const R
       // A stiff top layer broken by the stress criterion over softer layers keeps its grip
       // (gripped_point); the pre-puncture stiffness at the puncture is the slope of the step it
       // lies in (from the origin in the first step).
-      const bool gripped = plan.threshold->criterion == PunctureCriterion::Stress &&
-                           post->layers().size() >= 2 && plan.full_layers.size() >= 2 &&
-                           plan.full_layers[0].material.E > plan.full_layers[1].material.E;
+      std::vector<double> moduli;
+      for (const fe::TissueLayer& layer : plan.full_layers) moduli.push_back(layer.material.E);
+      const bool gripped =
+          post->layers().size() >= 2 && top_layer_grips(plan.threshold->criterion, moduli);
       const RunPoint* below = nullptr;
       const RunPoint* above = nullptr;
       for (const RunPoint& p : pre.points) {
@@ -1031,6 +1032,11 @@ void check_needle_placement(const Scene& scene, const std::vector<PreparedNeedle
             " apart, radii " + format_quantity(radius[i], Dimension::Length) + " and " +
             format_quantity(radius[j], Dimension::Length) + ")");
   }
+}
+
+bool top_layer_grips(PunctureCriterion criterion, const std::vector<double>& layer_moduli_Pa) {
+  return criterion == PunctureCriterion::Stress && layer_moduli_Pa.size() >= 2 &&
+         layer_moduli_Pa[0] > layer_moduli_Pa[1];
 }
 
 InsertionRunOptions scene_run_options(const Scene& scene) {

@@ -217,6 +217,13 @@ struct InsertionRun {
 /// option at its default). Commands start from this and apply their command line on top.
 InsertionRunOptions scene_run_options(const Scene& scene);
 
+/// Whether a top layer broken by `criterion` keeps its grip on the shaft after the puncture
+/// (docs/model.md, "The broken top layer"): the stress criterion, two layers or more, the top
+/// one stiffer than the next (`layer_moduli_Pa`: each layer's E, top first). `simulate` then
+/// continues the pre-puncture curve; `force`, which runs no pre-puncture model, says that its
+/// loads leave the grip out.
+bool top_layer_grips(PunctureCriterion criterion, const std::vector<double>& layer_moduli_Pa);
+
 /// Runs the scene's insertion for the prepared needles (one per scene needle, same order).
 /// Throws InputError for a scene that cannot be run as asked and SolverError (naming the depth)
 /// when the FE stage fails.
