@@ -18,6 +18,7 @@
 #include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
 #include "mneedle/insertion/insertion_run.h"
+#include "mneedle/insertion/puncture.h"
 #include "mneedle/insertion/surface_loads.h"
 #include "mneedle/plot/figure.h"
 #include "mneedle/plugin_host.h"
@@ -57,7 +58,13 @@ std::vector<std::string> grip_notes(const Scene& scene) {
   std::vector<double> moduli;
   for (const TissueLayer& layer : scene.tissue.layers)
     moduli.push_back(layer.material.youngs_modulus);
-  if (!top_layer_grips(scene.model.criterion, moduli)) return {};
+  // As `simulate` plans it: a pre-puncture model runs (outputs other than the curve alone) and
+  // the scene holds the criterion's constants.
+  const bool pre_puncture_runs =
+      scene.model.wants(Output::Puncture) || scene.model.wants(Output::Fields);
+  if (!pre_puncture_runs || !has_puncture_data(scene) ||
+      !top_layer_grips(scene.model.criterion, moduli))
+    return {};
   return {"layer '" + scene.tissue.layers.front().name +
           "' is stiffer than the one below and the scene's criterion is stress: after the "
           "puncture `simulate` keeps it gripped to the shaft, continuing the pre-puncture curve "
@@ -127,8 +134,10 @@ nlohmann::json to_json(const ForceResult& result) {
       {"loads", resolved_loads_json(result.scene)}, {"needles", needles}, {"notes", result.notes}};
 }
 
-void print_csv(const std::vector<NeedleCurve>& curves) {
+void print_csv(const ForceResult& result) {
+  const std::vector<NeedleCurve>& curves = result.curves;
   std::cout << provenance_comment() << "\n";
+  for (const std::string& note : result.notes) std::cout << "# note: " << note << "\n";
   std::cout << "needle,depth_m,force_N,alpha_N,beta_N,friction_N\n" << std::setprecision(10);
   for (const NeedleCurve& c : curves) {
     for (const LoadSample& s : c.curve) {
@@ -198,7 +207,7 @@ void add_force_command(CLI::App& app) {
     if (options->json) {
       std::cout << with_provenance(tree).dump(2) << "\n";
     } else if (options->csv) {
-      print_csv(result.curves);
+      print_csv(result);
     } else {
       print_table(result);
     }

@@ -181,7 +181,9 @@ TEST_F(ForceCommand, ForceJsonNamesEachLayersPressureScaleAndItsSource) {
 // `force` runs no pre-puncture model, so it cannot continue the curve while a broken stiff top
 // layer grips the shaft, as `simulate` does (docs/model.md, "The broken top layer"): in skin
 // its stratum corneum loads read 88 mN at 200 um where `simulate` reads 19.6 mN. It says so, in
-// the table and the JSON; a single-layer silicone has no such layer and no note.
+// the table, the CSV and the JSON; a single-layer silicone has no such layer and no note, nor has
+// a skin scene that asks for the force curve alone (`simulate` then runs no pre-puncture model
+// and prints the same loads).
 TEST_F(ForceCommand, LoadsLeavingOutABrokenLayersGripSaySo) {
   const CommandRun table = run_mneedle("force '" + design("human_skin.toml") + "' --step 100um");
   ASSERT_EQ(table.exit_code, 0) << table.err;
@@ -197,6 +199,20 @@ TEST_F(ForceCommand, LoadsLeavingOutABrokenLayersGripSaySo) {
       run_mneedle("force '" + design("silicone_phantom.toml") + "' --json --step 500um");
   ASSERT_EQ(silicone.exit_code, 0) << silicone.err;
   EXPECT_TRUE(nlohmann::json::parse(silicone.out)["notes"].empty());
+  const CommandRun csv = run_mneedle("force '" + design("human_skin.toml") + "' --csv");
+  ASSERT_EQ(csv.exit_code, 0) << csv.err;
+  EXPECT_NE(csv.out.find("\n# note: layer 'stratum_corneum'"), std::string::npos);
+  std::string text = mneedle::test::file_text(design("human_skin.toml"));
+  const std::string outputs = "outputs = [\"puncture\", \"force_curve\"]";
+  ASSERT_NE(text.find(outputs), std::string::npos);
+  text.replace(text.find(outputs), outputs.size(), "outputs = [\"force_curve\"]");
+  const auto curve_only = std::filesystem::temp_directory_path() /
+                          ("skin_curve_only_" + std::to_string(::getpid()) + ".toml");
+  std::ofstream(curve_only) << text;
+  const CommandRun plain = run_mneedle("force '" + curve_only.string() + "' --json --step 500um");
+  std::filesystem::remove(curve_only);
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_TRUE(nlohmann::json::parse(plain.out)["notes"].empty());
 }
 
 TEST_F(ForceCommand, NonPositiveStepIsAnErrorNamingTheOption) {

@@ -10,7 +10,10 @@
 namespace mneedle::fe {
 
 int loop_threads() {
-  return std::max(1, openblas_threads());
+  // OpenBLAS takes OPENBLAS_NUM_THREADS above the core count as given; a loop gains nothing from
+  // more threads than cores.
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return std::clamp(openblas_threads(), 1, cores);
 }
 
 void parallel_chunks(std::size_t count, int threads,
@@ -34,8 +37,16 @@ void parallel_chunks(std::size_t count, int threads,
   };
   std::vector<std::thread> workers;
   workers.reserve(chunks - 1);
-  for (std::size_t c = 1; c < chunks; ++c) workers.emplace_back(run, c);
+  std::size_t started = 1;
+  try {
+    for (; started < chunks; ++started) workers.emplace_back(run, started);
+  } catch (...) {
+    // No thread to be had (std::system_error, or std::bad_alloc from its start): the calling
+    // thread runs the chunks not started, and the started threads are still joined below (an
+    // unjoined one would end the process).
+  }
   run(0);
+  for (std::size_t c = started; c < chunks; ++c) run(c);
   for (std::thread& worker : workers) worker.join();
   for (const std::exception_ptr& error : failed)
     if (error) std::rethrow_exception(error);

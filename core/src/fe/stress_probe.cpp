@@ -543,13 +543,19 @@ PeakStressProbe::PeakStressProbe(const TetMesh& mesh, std::vector<Eigen::Vector2
           }
     }
   });
+  std::size_t entries = 0;
+  for (const auto& ball : balls) entries += ball.size();
+  ball_source_.reserve(entries);
+  ball_volume_.reserve(entries);
+  ball_start_.reserve(balls.size() + 1);
   ball_start_.push_back(0);
-  for (const auto& ball : balls) {
+  for (auto& ball : balls) {
     for (const auto& [source, volume] : ball) {
       ball_source_.push_back(source);
       ball_volume_.push_back(volume);
     }
     ball_start_.push_back(ball_source_.size());
+    std::vector<std::pair<int, double>>().swap(ball);  // freed as it is copied
   }
 }
 

@@ -686,8 +686,8 @@ MeshSizing mesh_sizing(Fidelity fidelity, int order, double needle_radius, doubl
   // by up to 18 %. The growth is set by a flat face in skin against the skin run's time: the
   // blunt bevel's force 6 % above fine at 1.8 (11 % at 2.0; 4 % at 1.6, which took 1.07 s against
   // the 1 s target); docs/model.md, "Tissue block and mesh". TET4 keeps its former level. Fine
-  // grows at 1.6 (1.35 until 2026-12-07): paper A's sharp bevel in skin on 60 373 nodes in about
-  // 10 s instead of 100 204 in 19 s, as close to the converged depth (63.1 against 62.7 um).
+  // grows at 1.6 (1.35 until 2026-12-07): paper A's sharp bevel in skin on 60 373 nodes instead
+  // of 100 204, 63.1 um against 62.7 um at 1.35 (converged: 63.4-63.8 um).
   Level level = fidelity == Fidelity::Fast ? Level{2.5, 2.0, 1}
                 : fidelity == Fidelity::Standard
                     ? (order == 2 ? Level{5.5, 1.8, 1} : Level{3.5, 1.6, 1})
