@@ -1807,6 +1807,20 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
   // tip's depth plus two averaging lengths (docs/model.md, "Criteria", stress).
   std::optional<PeakStressProbe> stress_probe;
   double stress_seconds = 0.0;
+  // A run that ends by an exception from here on still says what its phases cost
+  // (Simulation3dOptions::on_stop_timing); a finished one sets result.timing instead.
+  bool finished = false;
+  struct OnExit {
+    std::function<void()> call;
+    ~OnExit() { call(); }
+  } timing_on_stop{[&] {
+    if (finished || !options.on_stop_timing) return;
+    Timing3d timing = run.timing();
+    timing.meshing_s = meshing;
+    timing.stress_s = stress_seconds;
+    timing.total_s = seconds_since(start);
+    options.on_stop_timing(timing);
+  }};
   std::vector<NeedleShape> probe_shapes;
   const double stress_length = options.stress_average_length_m;
   const auto search_radii = [&](double depth) {
@@ -1941,6 +1955,7 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
     result.steps.push_back(whole_scene_step(step, selection, all_needles));
     if (options.on_step && !options.on_step(result.steps.back())) break;
   }
+  finished = true;
   result.timing = run.timing();
   result.timing.meshing_s = meshing;
   result.timing.stress_s = stress_seconds;

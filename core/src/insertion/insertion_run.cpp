@@ -220,6 +220,7 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
   std::vector<fe::Step3d> reached;  // kept for a run that stops (keep_reached), with its mesh
   fe::Simulation3dResult built;
   o.on_mesh = [&](const fe::Simulation3dResult& summary) { built = summary; };
+  o.on_stop_timing = [&](const fe::Timing3d& timing) { built.timing = timing; };
   o.on_step = [&](const fe::Step3d& step) {
     if (keep_reached) reached.push_back(step);
     bool more = true;

@@ -420,6 +420,45 @@ TEST(Indentation3d, SimulateThreeDimensionalReportsMeshAndCurve) {
   EXPECT_GE(result.quality.min_dihedral_deg, kMinDihedralFloorDeg);
 }
 
+// A run that ends by an exception part-way (here its on_step throws the SolverError a Newton
+// stall would) still reports what its phases cost, once, and a finished run does not call it:
+// `simulate` keeps what a stopped run reached, its timings included (InsertionRun::stopped).
+TEST(Indentation3d, ARunThatStopsReportsItsPhaseTimingsAndAFinishedOneDoesNot) {
+  TissueBlockSpec block;
+  block.size_x = block.size_y = 1000e-6;
+  block.layers = {{"stratum corneum", 15e-6, {MaterialModel::Linear, 1e9, 0.4, 0.0, 0.0}},
+                  {"dermis", 500e-6, {MaterialModel::Linear, 0.08e6, 0.4, 0.0, 0.0}}};
+  const std::vector<Needle3d> needles{
+      {"cone", cone_needle(std::numbers::pi / 6, 115e-6, 1e-3), 0.0, 0.0}};
+  Simulation3dOptions options;
+  options.fidelity = Fidelity::Fast;
+  options.order = 1;
+  options.depth = 20e-6;
+  options.steps = 3;
+  options.half_model = options.mirror_x = true;  // a quarter: the cone is symmetric
+  int calls = 0;
+  Timing3d stopped;
+  options.on_stop_timing = [&](const Timing3d& timing) {
+    ++calls;
+    stopped = timing;
+  };
+  int step = 0;
+  options.on_step = [&](const Step3d&) {
+    if (++step == 2) throw mneedle::SolverError("stalled at the second step");
+    return true;
+  };
+  EXPECT_THROW(simulate_3d(block, needles, options), mneedle::SolverError);
+  EXPECT_EQ(calls, 1);
+  EXPECT_GT(stopped.meshing_s, 0.0);
+  EXPECT_GE(stopped.factorizations, 1);
+  EXPECT_GT(stopped.factorization_s, 0.0);
+  EXPECT_GE(stopped.total_s, stopped.meshing_s + stopped.factorization_s);
+  options.on_step = nullptr;
+  calls = 0;
+  EXPECT_EQ(simulate_3d(block, needles, options).steps.size(), 3U);
+  EXPECT_EQ(calls, 0);
+}
+
 // A soft two-layer block for the options tests: small enough for a fraction of a second.
 using mneedle::test::small_skin;
 

@@ -215,6 +215,10 @@ struct Simulation3dOptions {
   /// summary filled (nodes, elements, order, quality, contact zone, unresolved flats) and no
   /// steps: a caller that keeps what a run reached before it stopped keeps the mesh it ran on too.
   std::function<void(const Simulation3dResult&)> on_mesh;
+  /// Called when the run ends by an exception after the mesh was built and the solver set up (a
+  /// SolverError at some step, or one thrown by on_step), with what each phase cost up to there:
+  /// a caller that keeps what a stopped run reached keeps its timings too. Must not throw.
+  std::function<void(const Timing3d&)> on_stop_timing;
   /// When set, the problem at the last step not deeper than inp_depth_m is written there
   /// as a CalculiX/Abaqus deck (Indentation3d::write_inp; linear layers, sticking contact).
   std::string inp_path;

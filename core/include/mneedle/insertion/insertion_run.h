@@ -209,7 +209,7 @@ struct InsertionRun {
   std::optional<fe::InpExport> exported;
   /// Set when the pre-puncture FE stopped and keep_reached asked for what it reached: the curves
   /// end at stopped->depth_m, a puncture before it is one, and none means none before it. The
-  /// mesh summary is the mesh it ran on; the 3-D run's phase timings are not kept.
+  /// mesh summary and the phase timings are those of the run that stopped.
   std::optional<RunStop> stopped;
 };
 
