@@ -94,11 +94,11 @@ Case level(const Scene& scene, const char* label, fe::Fidelity f) {
 
 // The contact zone and tip size of a pointed tip's reference, per criterion length: cells of
 // L/4 (asking 0.3 L gives the starting boxes' halving at or below it) graded to L/32 at the tip,
-// finer than the fine level's own zone (cells of L, tip L/8).
+// finer than the fine level's own zone (1.2 L, graded to 0.12 L at the tip).
 constexpr double kZonePerLength = 0.3;
-// The 3-D references' growth: the fine level's until 2026-12-07.
-constexpr double kReferenceGrowth = 1.35;
 constexpr double kTipPerLength = 0.03;
+// The 3-D references' growth: the fine level's until 2026-12-07 (1.6 since).
+constexpr double kReferenceGrowth = 1.35;
 
 // The top layer's criterion length (m; 0 without one).
 double criterion_length(const Scene& scene) {
@@ -148,9 +148,8 @@ Case reference(const SceneEntry& entry, const Scene& scene, const PreparedNeedle
   c.run.overrides.order = 2;
   c.run.overrides.tolerance = kTightTolerance;
   c.label = std::string(quick ? "standard" : "fine") + ", 3-D half TET10, tolerance 1e-10";
-  // The fine level grew its elements by 1.35 until 2026-12-07 and by 1.6
-  // since (docs/model.md, "Tissue block and mesh"): the references keep the finer grading, so
-  // that fine is measured against something finer than itself.
+  // The references keep the fine level's former, finer grading (docs/model.md, "Fine's growth"),
+  // so that fine is measured against something finer than itself.
   if (!quick) {
     c.run.overrides.growth = kReferenceGrowth;
     c.label = "fine graded at 1.35, 3-D half TET10, tolerance 1e-10";
