@@ -341,26 +341,27 @@ TEST(CmdSimulate, ASharpBevelWithItsTipResolvedPuncturesSkinShallowerThanTheShip
 // The blunt bevel's flat meets the stratum corneum along an edge, where the stress criterion
 // fires: every level meshes the flat with cells of 2 L (L = 10 um, the layer's strength_length;
 // docs/model.md, "Tissue block and mesh"), so a scene's own zone of 20 um is the shipped mesh
-// itself, to round-off. Measured 2026-12-06 at fast: 85.64 um shipped, 82.64 um with cells of L
-// (which read what 5 um cells read, docs/validation.md "How fine the flat must be"; 85.81 and
-// 82.59 um before the stress probe's mirror-invariant cut, docs/model.md "Tip stress and cracked
-// meshes"); before the zone the level read 100.03 um. Pinned to 1 % (deterministic runs: a move is
-// a change to explain); the 2 L zone's remaining error against L asked to stay below 5 % (3.6 %
-// measured at fast, 2.0 % at fine).
+// itself, to round-off. Measured 2026-12-07 at fast: 85.68 um shipped, 82.68 um with cells of L
+// (which read what 5 um cells read, docs/validation.md "How fine the flat must be"; 85.64 and
+// 82.64 um before fast graded the column under the flat, docs/model.md "Tissue block and mesh";
+// 85.81 and 82.59 um before the stress probe's mirror-invariant cut, docs/model.md "Tip stress and
+// cracked meshes"); before the zone the level read 100.03 um. Pinned to 1 % (deterministic runs: a
+// move is a change to explain); the 2 L zone's remaining error against L asked to stay below 5 %
+// (3.6 % measured at fast, 2.0 % at fine).
 TEST(CmdSimulate, ABluntBevelsFlatIsMeshedWithCellsOfTwiceTheCriterionLength) {
   const auto [twice, shipped] = punctures_with_zone("paper_a_skin_blunt_bevel.toml",
                                                     "contact_zone = \"20 um\"", "--fidelity fast");
   ASSERT_TRUE(twice.is_object() && shipped.is_object());
   EXPECT_FALSE(shipped["at_first_contact"].get<bool>());
   const double d = shipped["depth_m"].get<double>();
-  EXPECT_NEAR(d, 85.64e-6, 0.01 * 85.64e-6);
+  EXPECT_NEAR(d, 85.68e-6, 0.01 * 85.68e-6);
   EXPECT_NEAR(twice["depth_m"].get<double>(), d, 1e-12 * d);
   const nlohmann::json once = simulate_with_zone("paper_a_skin_blunt_bevel.toml",
                                                  "contact_zone = \"10 um\"", "--fidelity fast");
   ASSERT_TRUE(once.is_object());
   EXPECT_DOUBLE_EQ(once["mesh"]["contact_zone_m"].get<double>(), 10e-6);
   const double finer = once["needles"][0]["puncture"]["depth_m"].get<double>();
-  EXPECT_NEAR(finer, 82.64e-6, 0.01 * 82.64e-6);
+  EXPECT_NEAR(finer, 82.68e-6, 0.01 * 82.68e-6);
   EXPECT_LT(d / finer, 1.05);
   EXPECT_GT(d / finer, 1.0);
 }
