@@ -246,17 +246,13 @@ double refinement_target(const Eigen::Vector3d& p, const std::vector<NeedleSite>
 constexpr double kZoneBoxAspect = 2.0;
 
 // The windows' lines run down the whole block, so under the zone the starting grid's boxes are
-// the windows' spacing wide and as tall as the z axis makes them: at fast 40 um wide and 350 um
-// tall under paper A's blunt bevel in skin. Bisected down to the size wanted there (about 250
-// um) such a box keeps its shape and ends in cells 20 um wide: a column of cells several times
-// finer than anything asks for, 20 % of the mesh. At fast the z axis is therefore also graded
-// from the zone's depth, from kColumnPerWindow times the windows' spacing at the sizing's growth
-// (paper A's blunt bevel in skin: 20 203 nodes instead of 25 453, 2.3 s instead of 3.1 s, the
-// depth 85.68 um instead of 85.64 um, the force the same to 0.01 %; its four-needle array 37 392
-// nodes instead of 54 372, 8.1 s instead of 11.0 s). Standard's z axis has that line already
-// (24 113 nodes, 23 884 with it). Fine keeps its column: without it paper A's blunt bevel runs on
-// 57 127 nodes instead of 101 067 in half the time but reads its force 2.7 % above fine's
-// reference instead of 1.0 % (docs/model.md, "Tissue block and mesh").
+// the windows' spacing wide and as tall as the z axis makes them (at fast 40 um wide and 350 um
+// tall under paper A's blunt bevel in skin). Bisected down to the size wanted there such a box
+// keeps its shape and ends in cells several times narrower than anything asks for. At fast the
+// z axis therefore takes no cell taller than kColumnPerWindow times the windows' spacing down to
+// the zone's depth, growing at the sizing's growth below it. Standard's z axis has such a line
+// already; fine keeps its column, which holds its force within 1 % of its reference (what each
+// measured: docs/model.md, "Tissue block and mesh").
 constexpr double kColumnPerWindow = 2.0;
 
 std::array<std::vector<AxisWindow>, 2> zone_windows(const TissueBlockSpec& spec,
@@ -445,16 +441,23 @@ std::vector<double> lateral_coordinates(double half, const std::vector<double>& 
   return coordinates;
 }
 
+// A cap on the z axis's cell height under a zone (kColumnPerWindow): `size` (m) down to `depth`
+// (m below the surface), growing by `growth` per element below it.
+struct ColumnGrading {
+  double depth = 0.0, size = 0.0, growth = 2.0;
+};
+
 // z coordinates from the bottom (-total) to the top surface (0), conforming to every layer
-// interface; element size grows with the distance below the fine depth, and below a column
-// window's depth (`hi`, m below the surface) from its size at its growth.
+// interface; element size grows with the distance below the fine depth, and stays within a
+// column's cap when one is given.
 std::vector<double> vertical_coordinates(const std::vector<TissueLayer>& layers,
                                          const MeshSizing& sizing, double fine_depth,
-                                         const AxisWindow* column = nullptr) {
+                                         const ColumnGrading* column = nullptr) {
   auto size_at = [&](double z) {
     const double size = graded_size(-z - fine_depth, sizing);
     if (!column) return size;
-    return std::min(size, column->fine + (column->growth - 1.0) * std::max(0.0, -z - column->hi));
+    return std::min(size,
+                    column->size + (column->growth - 1.0) * std::max(0.0, -z - column->depth));
   };
   std::vector<double> z_top_down{0.0};
   double top = 0.0;
@@ -804,16 +807,26 @@ TetMesh generate_tissue_mesh(const TissueBlockSpec& spec) {
   const std::array<std::vector<AxisWindow>, 2> windows =
       levels > 0 ? zone_windows(spec, zone, z, lateral) : std::array<std::vector<AxisWindow>, 2>{};
   if (spec.fidelity == Fidelity::Fast && !windows[0].empty()) {
+    // Every window has the same spacing (2 x the top cell) and growth (zone_windows).
     const AxisWindow& window = windows[0].front();
-    const AxisWindow column{0.0, zone.depth, kColumnPerWindow * window.fine, lateral.growth};
+    const ColumnGrading column{zone.depth, kColumnPerWindow * window.fine, lateral.growth};
     std::vector<double> graded =
         vertical_coordinates(spec.layers, base, spec.insertion_depth, &column);
-    // The column starts above the top cell's height, so it cannot make the thinnest cell (which
-    // capped the lateral size above) thinner; kept only if it did not.
-    double thinnest_graded = graded.back() - graded.front();
-    for (std::size_t k = 0; k + 1 < graded.size(); ++k)
-      thinnest_graded = std::min(thinnest_graded, graded[k + 1] - graded[k]);
-    if (thinnest_graded >= thinnest) z = std::move(graded);
+    // The cap lies above the top cell's height, but every layer it touches is divided anew:
+    // kept only if neither the top cell (the windows' spacing rests on it) nor the thinnest cell
+    // (the lateral size cap rests on it) got thinner.
+    auto thinnest_of = [](const std::vector<double>& axis) {
+      double cell = axis.back() - axis.front();
+      for (std::size_t k = 0; k + 1 < axis.size(); ++k)
+        cell = std::min(cell, axis[k + 1] - axis[k]);
+      return cell;
+    };
+    auto top_of = [](const std::vector<double>& axis) {
+      return axis[axis.size() - 1] - axis[axis.size() - 2];
+    };
+    constexpr double kRoundOff = 1.0 - 1e-9;
+    if (thinnest_of(graded) >= kRoundOff * thinnest && top_of(graded) >= kRoundOff * top_of(z))
+      z = std::move(graded);
   }
   std::array<std::vector<char>, 2> mirrored;
   std::array<std::vector<double>, 3> axes = {
