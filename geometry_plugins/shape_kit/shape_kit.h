@@ -96,6 +96,28 @@ SectionProperties annulus_segment_properties(double outer_radius, double bore_ra
 /// Full annulus (or disc when bore_radius = 0).
 SectionProperties annulus_properties(double outer_radius, double bore_radius);
 
+/// A tube cut by one plane at an angle to the axis (the sharp bevel), every edge of the cut
+/// rounded to `edge_radius_m`: the union of every ball of that radius inside the sharp shape.
+/// Tip (the lowest point) at z = 0 on the +x side, body along +z up to `length_m`.
+struct RoundedBevel {
+  double outer_radius_m = 0;
+  double bore_radius_m = 0;  // 0: solid
+  double tan_angle = 0;      // tan of the angle between the cut and the axis
+  double edge_radius_m = 0;  // > 0
+  double length_m = 0;
+  int segments = 64;  // polygon sides around the circumference (more near the tip)
+};
+
+/// Throws ParameterError unless the rounding fits: edge radius in (0, wall / 4) (diameter / 4
+/// for a solid tube), positive tan, a bore narrower than the tube.
+void check_rounded_bevel(const RoundedBevel& bevel);
+MeshBuilder build_rounded_bevel(const RoundedBevel& bevel);
+/// How far the rounded tip lies above the sharp bevel's tip (m): rho (1 + cos t - sin t) / sin t.
+double rounded_bevel_tip_height(const RoundedBevel& bevel);
+/// The section at height h above the rounded tip, by polar integration of the opening's
+/// membership (2048 rays, each interval's ends bisected to round-off).
+SectionProperties rounded_bevel_section(const RoundedBevel& bevel, double h_m);
+
 /// Reads an integral polygon side count from a parameter value.
 int segment_count(double value);
 

@@ -1,5 +1,6 @@
 // Built-in tip shape: a tube cut by one plane at bevel_angle to the axis (paper A's sharp
-// bevel). The tip is the rim point on +x at z = 0.
+// bevel). The tip is the rim point on +x at z = 0; with tip_radius > 0 every edge of the cut is
+// rounded to it (shape_kit's RoundedBevel) and the tip is the rounded edge's lowest point.
 #include <cmath>
 #include <iterator>
 #include <numbers>
@@ -17,22 +18,37 @@ constexpr mneedle_parameter kParameters[] = {
     kResolutionParameter,
     {"bevel_angle", "rad", std::numbers::pi / 6, 5 * std::numbers::pi / 180,
      85 * std::numbers::pi / 180, "angle between the bevel face and the needle axis"},
+    {"tip_radius", "m", 0.0, 0.0, 5e-3,
+     "radius every edge of the bevel is rounded to (its tip, cutting edge and bore rim); 0 = "
+     "sharp"},
 };
 constexpr std::size_t kParameterCount = std::size(kParameters);
 
 struct Bevel {
   TubeParameters tube;
   double tan_angle;
+  double tip_radius;
 };
 
 Bevel read(const double* params) {
-  const Bevel bevel{read_tube_parameters(params), std::tan(params[4])};
+  const Bevel bevel{read_tube_parameters(params), std::tan(params[4]), params[5]};
   if (!(bevel.tan_angle > 0)) throw ParameterError("bevel_angle must lie in (0, 90) degrees");
+  if (!(bevel.tip_radius >= 0)) throw ParameterError("tip_radius must not be negative");
   return bevel;
+}
+
+RoundedBevel rounded(const Bevel& bevel) {
+  return {.outer_radius_m = bevel.tube.radius_m,
+          .bore_radius_m = bevel.tube.bore_radius_m,
+          .tan_angle = bevel.tan_angle,
+          .edge_radius_m = bevel.tip_radius,
+          .length_m = bevel.tube.length_m,
+          .segments = bevel.tube.segments};
 }
 
 MeshBuilder make_mesh(const double* params) {
   const Bevel bevel = read(params);
+  if (bevel.tip_radius > 0) return build_rounded_bevel(rounded(bevel));
   const double r = bevel.tube.radius_m;
   CutPrism prism;
   prism.outer_radius_m = r;
@@ -51,6 +67,7 @@ MeshBuilder make_mesh(const double* params) {
 SectionProperties section(const double* params, double h) {
   const Bevel bevel = read(params);
   if (h < 0 || h > bevel.tube.length_m) return {0, 0};
+  if (bevel.tip_radius > 0) return rounded_bevel_section(rounded(bevel), h);
   const double b = bevel.tube.radius_m - h * bevel.tan_angle;
   return annulus_segment_properties(bevel.tube.radius_m, bevel.tube.bore_radius_m, b);
 }
