@@ -1,16 +1,18 @@
 // A bevelled tube whose edges are rounded: the union of every ball of radius rho inside the
-// sharp bevel (its morphological opening; docs/plugins.md). In the frame used here the sharp
-// bevel's tip is the rim point (R, 0, 0), the cut is the plane x cos(t) + z sin(t) = R cos(t)
-// (t the bevel angle to the axis) and the material lies above it. Shrinking the shape by rho
-// gives K': the shell r_i <= r <= R' (r_i = bore + rho, R' = R - rho) above the plane moved rho
-// into the material. The opening is K' grown by rho, so its surface is made of
+// sharp bevel (its morphological opening; docs/model.md, "Sharp bevel with a rounded edge"). In the
+// frame used here the sharp bevel's tip is the rim point (R, 0, 0), the cut is the plane x cos(t) +
+// z sin(t) = R cos(t) (t the bevel angle to the axis) and the material lies above it. Shrinking the
+// shape by rho gives K': the shell r_i <= r <= R' (r_i = bore + rho, R' = R - rho; a solid tube has
+// no inner bound) above the plane moved rho into the material. The opening is K' grown by rho, so
+// its surface is made of
 //   the face: K''s plane face moved back by rho along the plane's outward normal n_p,
 //   two pipes of radius rho around K''s two edges (the ellipses where that plane meets r = R'
 //   and r = r_i), their normals swept from n_p to the cylinder's outward normal,
 //   the walls r = R and r = bore above the pipes, and the flat top.
-// The patches share their edge points, so the mesh closes without welding by search.
+// The patches are built from the same edge points, so MeshBuilder's weld joins them exactly.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -21,8 +23,9 @@ namespace mneedle::shape_kit {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-// Steps across a pipe: the normal turns by at most pi - 5 deg (the bevel angle's lower bound),
-// so each step is under 11 deg and the chord stays within 0.5 % of rho of the circle.
+// Steps across a pipe: the normal turns by less than pi - t (t the bevel angle, at least 5 deg
+// in the plugin), so each step is under 11 deg and the chord stays within 0.5 % of rho of the
+// circle.
 constexpr int kPipeSteps = 16;
 
 struct Frame {
@@ -79,9 +82,14 @@ std::vector<double> sweep_fractions(const Frame& f) {
   // From n_p = (-c, 0, -s) to (1, 0, 0) the normal turns by pi - t; down is pi/2 - t of it.
   const double t = std::atan2(f.s, f.c);
   const double down = (0.5 * kPi - t) / (kPi - t);
-  const bool near = std::any_of(fractions.begin(), fractions.end(),
-                                [&](double x) { return std::abs(x - down) < 1e-3 / kPipeSteps; });
-  if (!near) fractions.push_back(down);
+  // A uniform fraction within a thousandth of a step of it is moved onto it.
+  auto nearest = std::min_element(fractions.begin(), fractions.end(), [&](double x, double y) {
+    return std::abs(x - down) < std::abs(y - down);
+  });
+  if (std::abs(*nearest - down) < 1e-3 / kPipeSteps)
+    *nearest = down;
+  else
+    fractions.push_back(down);
   std::sort(fractions.begin(), fractions.end());
   return fractions;
 }
@@ -137,11 +145,26 @@ bool in_opening(const Frame& f, double x, double y, double z) {
       const double ez = f.plane_z(ex);
       return (x - ex) * (x - ex) + (y - ey) * (y - ey) + (z - ez) * (z - ez);
     };
-    // The nearest edge point lies near q's own angle: within the arc rho wide on each side.
+    // The nearest edge point lies within asin(rho / radius) of q's own angle (q is within rho
+    // of it in plan); the arc searched is 4 rho / radius wide on each side, sampled at 32 points
+    // (the distance may have two minima there near the ellipse's ends), then the best sample's
+    // bracket refined by ternary search.
     const double centre = std::atan2(y, x);
     const double half = std::min(kPi, 4.0 * f.rho / radius + 1e-3);
-    double lo = centre - half, hi = centre + half;
-    for (int k = 0; k < 60; ++k) {
+    constexpr int kScan = 32;
+    int best = 0;
+    double best_d2 = std::numeric_limits<double>::max();
+    for (int i = 0; i <= kScan; ++i) {
+      const double d2 = distance2(centre - half + 2 * half * i / kScan);
+      if (d2 < best_d2) {
+        best_d2 = d2;
+        best = i;
+      }
+    }
+    if (best_d2 <= rho2) return true;
+    double lo = centre - half + 2 * half * std::max(best - 1, 0) / kScan;
+    double hi = centre - half + 2 * half * std::min(best + 1, kScan) / kScan;
+    for (int k = 0; k < 40; ++k) {
       const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
       if (distance2(m1) < distance2(m2))
         hi = m2;
@@ -170,21 +193,33 @@ void check_rounded_bevel(const RoundedBevel& b) {
     throw ParameterError("bevel_angle must lie in (0, 90) degrees");
   if (!(b.edge_radius_m > 0) || !std::isfinite(b.edge_radius_m))
     throw ParameterError("tip_radius must be positive for a rounded bevel");
-  // Both pipes must fit in the wall, which must keep some shell between them.
+  // Below a millionth of the radius the pipes' vertices would weld into each other.
+  if (b.edge_radius_m < 1e-6 * b.outer_radius_m)
+    throw ParameterError("tip_radius must be 0 (sharp) or at least 1e-6 of the radius");
+  // Both pipes must fit in the wall with some shell left between them: a quarter of the wall,
+  // half the radius for a solid tube.
   const double wall = b.outer_radius_m - b.bore_radius_m;
-  const double most = b.bore_radius_m > 0 ? 0.5 * wall : b.outer_radius_m;
-  if (!(b.edge_radius_m < 0.5 * most))
+  const double most = b.bore_radius_m > 0 ? 0.25 * wall : 0.5 * b.outer_radius_m;
+  if (!(b.edge_radius_m < most))
     throw ParameterError(
-        std::string("tip_radius is too large: it must stay below a quarter of ") +
-        (b.bore_radius_m > 0 ? "the wall, (diameter - bore) / 4" : "the diameter, diameter / 4"));
+        std::string("tip_radius is too large: it must stay below ") +
+        (b.bore_radius_m > 0 ? "(diameter - bore) / 8, a quarter of the wall" : "diameter / 4"));
+  // The bore's pipe sweeps toward the bore's axis at the ends of its ellipse, whose in-plane
+  // radius of curvature there is r_i sin(t): a larger rho would fold the pipe onto itself.
+  const double sine = b.tan_angle / std::sqrt(1 + b.tan_angle * b.tan_angle);
+  if (b.bore_radius_m > 0 && !(b.edge_radius_m < (b.bore_radius_m + b.edge_radius_m) * sine))
+    throw ParameterError(
+        "tip_radius is too large for this bore and bevel_angle: it must stay below "
+        "bore / 2 * sin(bevel_angle) / (1 - sin(bevel_angle)), or the rounded bore rim folds");
   if (b.segments < 8) throw ParameterError("resolution must be at least 8 segments");
+  const Frame f = frame_of(b);
+  if (!(f.plane_z(-f.R) + f.rho < f.top))
+    throw ParameterError("the bevel (diameter / tan(bevel_angle)) is longer than length");
 }
 
 MeshBuilder build_rounded_bevel(const RoundedBevel& b) {
   check_rounded_bevel(b);
   const Frame f = frame_of(b);
-  if (!(f.plane_z(-f.R) + f.rho < f.top))
-    throw ParameterError("the bevel (diameter / tan(bevel_angle)) is longer than length");
   const double dz = rounded_bevel_tip_height(b);
   MeshBuilder mesh(1e-9 * b.outer_radius_m);
   const std::vector<double> angles = angles_of(b);

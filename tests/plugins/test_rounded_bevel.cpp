@@ -131,6 +131,16 @@ TEST(RoundedBevel, RefusesAnEdgeRadiusThatDoesNotFitTheWall) {
   EXPECT_NO_THROW(build_rounded_bevel(bevel(17.4e-6, 45e-6)));
   EXPECT_THROW(build_rounded_bevel(bevel(57.5e-6, 0.0)), ParameterError);  // diameter / 4
   EXPECT_THROW(rounded_bevel_section(bevel(std::nan(""), 0.0), 1e-6), ParameterError);
+  EXPECT_THROW(build_rounded_bevel(bevel(1e-12, 45e-6)), ParameterError);  // welds
+  // At 10 deg the bore's ellipse ends curve at r_i sin(t): rho < 45 um x 0.174 / 0.826 = 9.5 um.
+  RoundedBevel steep = bevel(12e-6, 45e-6);
+  steep.tan_angle = std::tan(kPi / 18);
+  steep.length_m = 3e-3;
+  EXPECT_THROW(build_rounded_bevel(steep), ParameterError);
+  steep.edge_radius_m = 9e-6;
+  EXPECT_TRUE(closed_and_consistent(build_rounded_bevel(steep)));
+  steep.length_m = 1e-3;  // the 1.3 mm bevel no longer fits
+  EXPECT_THROW(rounded_bevel_section(steep, 1e-5), ParameterError);
 }
 
 }  // namespace

@@ -95,9 +95,10 @@ constexpr std::size_t kWatchedBlockNodes = 16;
 // and the dense copies of the field it may hold for them: 256 MiB, as kWatchedRowsBudget.
 constexpr Eigen::Index kBackSolveColumns = 8;
 constexpr double kBackSolveBudget = 256.0 * 1024 * 1024;
-// A first contact narrower than this fraction of the needle's radius is a point
-// (simulate_3d): a rounded tip of tip_radius 1 um puts vertices 0.25 um apart within 1 nm of
-// its lowest one, a blunt bevel's flat (50 um) or a flat end spans tens of percent of it.
+// A first contact narrower than this fraction of the needle's radius, with no face in it, is a
+// point (simulate_3d): a rounded bevel of tip_radius 1 um puts vertices about 0.35 um apart
+// within 1 nm of its lowest one; a blunt bevel's flat (50 um) or a flat end spans tens of
+// percent of the radius, and has faces there.
 constexpr double kPointContactPerRadius = 0.05;
 // Largest dense factor of the contact block (Impl::contact_block_fits): 256 MiB, 3 × 1900
 // surface nodes.
@@ -1750,13 +1751,14 @@ Simulation3dResult simulate_3d(TissueBlockSpec block, const std::vector<Needle3d
     if ((tips.back() - axis).norm() > 1e-3 * site.radius) site.tip = tips.back();
     for (const Eigen::Vector2d& corner : shape.first_contact_outline(1e-9))
       site.first_contact.push_back(axis + corner);
-    // Lowest vertices within 1 nm of each other over less than kPointContactPerRadius of the
-    // radius are one rounded point (a rounded tip's finely spaced vertices), not a flat: a flat
-    // end spans a good part of the radius (docs/model.md, "Tissue block and mesh").
+    // Lowest vertices within 1 nm of each other, over less than kPointContactPerRadius of the
+    // radius and with no face among them, are one rounded point (a rounded tip's finely spaced
+    // vertices), not a flat (docs/model.md, "Tissue block and mesh").
     double extent = 0.0;
     for (const Eigen::Vector2d& a : site.first_contact)
       for (const Eigen::Vector2d& b : site.first_contact) extent = std::max(extent, (a - b).norm());
-    if (site.first_contact.size() > 1 && extent < kPointContactPerRadius * site.radius)
+    if (site.first_contact.size() > 1 && extent < kPointContactPerRadius * site.radius &&
+        !shape.first_contact_has_a_face(1e-9))
       site.first_contact = {tips.back()};
     block.sites.push_back(site);
   }

@@ -184,4 +184,17 @@ std::vector<Eigen::Vector2d> NeedleShape::first_contact_outline(double tolerance
   return outline;
 }
 
+bool NeedleShape::first_contact_has_a_face(double tolerance) const {
+  double lowest = std::numeric_limits<double>::max();
+  for (const Eigen::Vector3d& v : impl_->vertices) lowest = std::min(lowest, v.z());
+  for (const auto& t : impl_->triangles) {
+    bool low = true;
+    for (int i = 0; i < 3 && low; ++i)
+      low = impl_->vertices[static_cast<std::size_t>(t[static_cast<std::size_t>(i)])].z() <=
+            lowest + tolerance;
+    if (low) return true;
+  }
+  return false;
+}
+
 }  // namespace mneedle::fe

@@ -48,6 +48,9 @@ class NeedleShape {
   /// Convex hull (x, y) of the same lowest vertices, counter-clockwise, needle frame: one point
   /// for a pointed tip, a polygon for a flat end.
   std::vector<Eigen::Vector2d> first_contact_outline(double tolerance) const;
+  /// True when some face has all three corners within `tolerance` of the lowest z: the first
+  /// contact is a flat. A rounded point or a knife edge has none.
+  bool first_contact_has_a_face(double tolerance) const;
 
  private:
   struct Impl;

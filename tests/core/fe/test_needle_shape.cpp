@@ -54,4 +54,18 @@ TEST(NeedleShape, AFlatEndFirstTouchesOverItsRimPolygon) {
   EXPECT_NEAR(0.5 * twice_signed_area(outline), polygon, 1e-12 * polygon);
 }
 
+// A flat end has faces among its lowest vertices; a point (cone, bevel) has none: the 3-D
+// planner takes a narrow set of lowest vertices without a face for one rounded point
+// (docs/model.md, "Tissue block and mesh").
+TEST(NeedleShape, OnlyAFlatEndHasAFaceAtItsFirstContact) {
+  const double radius = 115e-6;
+  EXPECT_TRUE(
+      NeedleShape(mneedle::test::cylinder_needle(radius, 1e-3, 48)).first_contact_has_a_face(1e-9));
+  EXPECT_FALSE(
+      NeedleShape(mneedle::test::cone_needle(15.0 * std::numbers::pi / 180.0, radius, 1e-3))
+          .first_contact_has_a_face(1e-9));
+  EXPECT_FALSE(NeedleShape(mneedle::test::bevel_needle(radius, std::numbers::pi / 6.0, 1e-3))
+                   .first_contact_has_a_face(1e-9));
+}
+
 }  // namespace
