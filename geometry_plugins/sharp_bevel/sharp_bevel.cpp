@@ -74,7 +74,8 @@ SectionProperties section(const double* params, double h) {
 
 constexpr mneedle_shape kShapes[] = {{
     "sharp_bevel",
-    "tube cut by one plane at bevel_angle to the axis; the tip is a point on the rim",
+    "tube cut by one plane at bevel_angle to the axis; the tip is a point on the rim, its edges "
+    "rounded to tip_radius",
     kParameters,
     kParameterCount,
     1,

@@ -108,13 +108,14 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
 // um; the sharp bevel's gap to fast at fine is now -3.8 %. Fine's growth 1.35 -> 1.6
 // (2026-12-07, docs/model.md "Tissue block and mesh") moved its bevels to 63.06 / 84.55 um
 // (+0.6 % / -1.4 %), both inside their converged bands (63.4-63.8 um and 84.0-85.8 um,
-// docs/validation.md, "The stress criterion in skin").
+// docs/validation.md, "The stress criterion in skin"). Fast's blunt bevel reads 85.68 um since
+// its column under the flat was graded (2026-12-07; 85.64 um before).
 // Each level is also pinned to 1 % of its own reading, so that a move inside the 6 % is seen and
 // explained.
 TEST(ScreenCommand, ReadmeMainJobReadsWithinSixPercentOfFastAtStandardAndFine) {
   const std::map<std::string, double> fast = {{"cone", 62.8e-6},
                                               {"sharp_bevel", 65.16e-6},
-                                              {"blunt_bevel", 85.64e-6},
+                                              {"blunt_bevel", 85.68e-6},
                                               {"cylinder", 148.0e-6}};
   const std::map<std::string, std::map<std::string, double>> level = {{"standard",
                                                                        {{"cone", 65.44e-6},
