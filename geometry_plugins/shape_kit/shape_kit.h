@@ -108,8 +108,10 @@ struct RoundedBevel {
   int segments = 64;  // polygon sides around the circumference (more near the tip)
 };
 
-/// Throws ParameterError unless the rounding fits: edge radius in (0, wall / 4) (diameter / 4
-/// for a solid tube), positive tan, a bore narrower than the tube.
+/// Throws ParameterError unless the rounding fits: edge radius at least 1e-6 R and below a
+/// quarter of the wall (half the radius for a solid tube) and, with a bore, below
+/// r_b sin t / (1 - sin t) (the bore rim would fold); positive tan, a bore narrower than the
+/// tube, a cut shorter than the needle.
 void check_rounded_bevel(const RoundedBevel& bevel);
 MeshBuilder build_rounded_bevel(const RoundedBevel& bevel);
 /// How far the rounded tip lies above the sharp bevel's tip (m): rho (1 + cos t - sin t) / sin t.

@@ -535,12 +535,12 @@ TEST(CmdSimulate, RoundedConeTipsInSkinPunctureFarBelowTheForcesRoemgensMeasured
 }
 
 // A sharp bevel whose edges are rounded (tip_radius; docs/model.md, "Sharp bevel with a rounded
-// edge") meets the skin with one rounded point: its lowest vertices, about 0.35 um apart within 1 nm
-// at 1 um, are one point to the planner, not a flat with a 2 L zone (which read 57.3 um on
-// 11 387 nodes before the rule; docs/model.md, "Tissue block and mesh"). Paper A's skin sharp
-// bevel at fast, measured 2026-12-07: 65.12 um at 1 um and 65.06 um at 5 um against the sharp
-// bevel's 65.16 um, pinned to 1 % (deterministic runs: a move is a change to explain). The
-// stress criterion averages over L = 10 um, far wider than these roundings.
+// edge") meets the skin with one rounded point: its lowest vertices, about 0.35 um apart within 1
+// nm at 1 um, are one point to the planner, not a flat with a 2 L zone (which read 57.3 um on 11
+// 387 nodes before the rule; docs/model.md, "Tissue block and mesh"). Paper A's skin sharp bevel at
+// fast, measured 2026-12-07: 65.12 um at 1 um and 65.06 um at 5 um against the sharp bevel's 65.16
+// um, pinned to 1 % (deterministic runs: a move is a change to explain). The stress criterion
+// averages over L = 10 um, far wider than these roundings.
 TEST(CmdSimulate, ARoundedBevelTipIsAPointContactAndPuncturesWhereTheSharpOneDoes) {
   std::string text = mneedle::test::file_text(std::string(MNEEDLE_SOURCE_ROOT) +
                                               "/designs/scenes/paper_a_skin_sharp_bevel.toml");
