@@ -99,22 +99,28 @@ SectionProperties annulus_properties(double outer_radius, double bore_radius);
 /// A tube cut by one plane at an angle to the axis (the sharp bevel), every edge of the cut
 /// rounded to `edge_radius_m`: the union of every ball of that radius inside the sharp shape.
 /// Tip (the lowest point) at z = 0 on the +x side, body along +z up to `length_m`.
+/// With `flat_width_m` > 0 the shape is the blunt bevel: the sharp bevel cut flat,
+/// perpendicular to the axis, where the flat is that wide from the rim; the flat lies at z = 0
+/// and its rim, the crease and the corners where they meet the walls are rounded too.
 struct RoundedBevel {
   double outer_radius_m = 0;
   double bore_radius_m = 0;  // 0: solid
   double tan_angle = 0;      // tan of the angle between the cut and the axis
   double edge_radius_m = 0;  // > 0
   double length_m = 0;
-  int segments = 64;  // polygon sides around the circumference (more near the tip)
+  int segments = 64;        // polygon sides around the circumference (more near the tip)
+  double flat_width_m = 0;  // 0: the sharp bevel; > 0: the blunt bevel's flat
 };
 
 /// Throws ParameterError unless the rounding fits: edge radius at least 1e-6 R and below a
 /// quarter of the wall (half the radius for a solid tube) and, with a bore, below
 /// r_b sin t / (1 - sin t) (the bore rim would fold); positive tan, a bore narrower than the
-/// tube, a cut shorter than the needle.
+/// tube, a cut shorter than the needle. A flat must stay wider than
+/// rho (1 + (1 - sin t) / cos t) (the rounding would take all of it) and leave some bevel.
 void check_rounded_bevel(const RoundedBevel& bevel);
 MeshBuilder build_rounded_bevel(const RoundedBevel& bevel);
-/// How far the rounded tip lies above the sharp bevel's tip (m): rho (1 + cos t - sin t) / sin t.
+/// How far the rounded tip lies above the sharp bevel's tip (m): rho (1 + cos t - sin t) / sin t;
+/// 0 with a flat, which stays at z = 0.
 double rounded_bevel_tip_height(const RoundedBevel& bevel);
 /// The section at height h above the rounded tip, by polar integration of the opening's
 /// membership (2048 rays, each interval's ends bisected to round-off).

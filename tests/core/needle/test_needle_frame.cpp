@@ -200,6 +200,48 @@ TEST(NeedleFrame, BevelIsPlacedByItsShaftAxisNotByItsTip) {
   EXPECT_NEAR(info.tip_offset_m, o.radius, 1e-12);
 }
 
+// A rod of radius r whose lower edge is chamfered on the +x half only: the chamfer's faces lie
+// 8.5 deg from the axis, inside the first pass's 11.5 deg, and one-sided they tilt that pass's
+// axis (as a rounded blunt bevel's last pipe steps did: 4.6e-5 rad, lifting part of its flat
+// 2 nm). The second pass keeps only the shaft's own walls: the axis comes back exact, so every
+// vertex of the top ring sits at one height and at r from the axis after placement.
+TEST(NeedleFrame, FacesNearlyAlongTheShaftDoNotTiltItsAxis) {
+  constexpr double r = 115e-6, length = 2.5e-3, chamfer = 20e-6, inset = 3e-6;
+  constexpr std::uint32_t n = 64;
+  TriangleMesh mesh;
+  mesh.vertices.push_back({0, 0, 0});
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const double phi = 2.0 * std::numbers::pi * i / n;
+    const double low = std::cos(phi) > 0 ? r - inset : r;
+    mesh.vertices.push_back({low * std::cos(phi), low * std::sin(phi), 0.0});
+    mesh.vertices.push_back({r * std::cos(phi), r * std::sin(phi), chamfer});
+    mesh.vertices.push_back({r * std::cos(phi), r * std::sin(phi), length});
+  }
+  mesh.vertices.push_back({0, 0, length});
+  const std::uint32_t top = 1 + 3 * n;
+  auto ring = [](std::uint32_t i, std::uint32_t level) { return 1 + 3 * (i % n) + level; };
+  for (std::uint32_t i = 0; i < n; ++i) {
+    mesh.triangles.push_back({0, ring(i + 1, 0), ring(i, 0)});
+    for (std::uint32_t level = 0; level < 2; ++level) {
+      mesh.triangles.push_back({ring(i, level), ring(i + 1, level), ring(i + 1, level + 1)});
+      mesh.triangles.push_back({ring(i, level), ring(i + 1, level + 1), ring(i, level + 1)});
+    }
+    mesh.triangles.push_back({top, ring(i, 2), ring(i + 1, 2)});
+  }
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(0.4, Eigen::Vector3d(2, -1, 1).normalized()).toRotationMatrix();
+  TriangleMesh placed = moved(mesh, rotation, {3e-4, 1e-4, -2e-4});
+  AxisChoice choice;
+  choice.kind = AxisChoice::Kind::automatic;
+  mneedle::place_in_needle_frame(placed, choice);
+  // Round-off of millimetre-sized sums over micrometre features: 1e-13 m.
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Vec3& p = placed.vertices[ring(i, 2)];
+    EXPECT_NEAR(p[2], placed.vertices[ring(0, 2)][2], 1e-13) << "vertex " << i;
+    EXPECT_NEAR(std::hypot(p[0], p[1]), r, 1e-13) << "vertex " << i;
+  }
+}
+
 TEST(NeedleFrame, ZeroOrNonFiniteDirectionIsAnInputError) {
   TriangleMesh mesh = square_needle();
   EXPECT_THROW(mneedle::place_in_needle_frame(mesh, Vec3{0, 0, 0}), mneedle::InputError);
