@@ -134,42 +134,49 @@ Point3 shifted(Point3 p, double dz) {
 // z), on its part |angle| >= end (0: all of it; the rest is a blunt bevel's flat's, whose end is
 // a corner checked on its own). The nearest edge point lies within asin(rho / radius) of q's own
 // angle (q is within rho of it in plan); the arc searched is 4 rho / radius wide on each side,
-// sampled at 32 points (the distance may have two minima there near the ellipse's ends), then the
-// best sample's bracket refined by ternary search, every angle clamped into the part.
+// less any of it outside the part, sampled at 32 points (the distance may have two minima there
+// near the ellipse's ends), then the best sample's bracket refined by ternary search.
 bool near_ellipse(const Frame& f, double radius, double end, double x, double y, double z) {
   auto distance2 = [&](double a) {
-    if (end > 0) {
-      a = std::remainder(a, 2 * kPi);
-      if (std::abs(a) < end) a = a < 0 ? -end : end;
-    }
     const double ex = radius * std::cos(a), ey = radius * std::sin(a);
     const double ez = f.plane_z(ex);
     return (x - ex) * (x - ex) + (y - ey) * (y - ey) + (z - ez) * (z - ez);
   };
   const double rho2 = f.rho * f.rho;
+  constexpr int kScan = 32;
+  // Sampled on [lo, lo + width], then refined.
+  auto within = [&](double lo, double width) {
+    int best = 0;
+    double best_d2 = std::numeric_limits<double>::max();
+    for (int i = 0; i <= kScan; ++i) {
+      const double d2 = distance2(lo + width * i / kScan);
+      if (d2 < best_d2) {
+        best_d2 = d2;
+        best = i;
+      }
+    }
+    if (best_d2 <= rho2) return true;
+    double a = lo + width * std::max(best - 1, 0) / kScan;
+    double b = lo + width * std::min(best + 1, kScan) / kScan;
+    for (int k = 0; k < 40; ++k) {
+      const double m1 = a + (b - a) / 3, m2 = b - (b - a) / 3;
+      if (distance2(m1) < distance2(m2))
+        b = m2;
+      else
+        a = m1;
+    }
+    return distance2(0.5 * (a + b)) <= rho2;
+  };
   const double centre = std::atan2(y, x);
   const double half = std::min(kPi, 4.0 * f.rho / radius + 1e-3);
-  constexpr int kScan = 32;
-  int best = 0;
-  double best_d2 = std::numeric_limits<double>::max();
-  for (int i = 0; i <= kScan; ++i) {
-    const double d2 = distance2(centre - half + 2 * half * i / kScan);
-    if (d2 < best_d2) {
-      best_d2 = d2;
-      best = i;
-    }
+  if (end <= 0) return within(centre - half, 2 * half);
+  // The part is [end, 2 pi - end] around the circle; the window lies within (-2 pi, 2 pi].
+  for (const double shift : {-2 * kPi, 0.0}) {
+    const double lo = std::max(centre - half, end + shift);
+    const double hi = std::min(centre + half, 2 * kPi - end + shift);
+    if (hi > lo && within(lo, hi - lo)) return true;
   }
-  if (best_d2 <= rho2) return true;
-  double lo = centre - half + 2 * half * std::max(best - 1, 0) / kScan;
-  double hi = centre - half + 2 * half * std::min(best + 1, kScan) / kScan;
-  for (int k = 0; k < 40; ++k) {
-    const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
-    if (distance2(m1) < distance2(m2))
-      hi = m2;
-    else
-      lo = m1;
-  }
-  return distance2(0.5 * (lo + hi)) <= rho2;
+  return false;
 }
 
 // Points of the shell K' that lie within rho of q (x, y, z in the internal frame): q lies in
@@ -321,7 +328,22 @@ void add_strip(MeshBuilder& mesh, const std::vector<Surfel>& r0, const std::vect
 // neighbours each ray is of one kind. Each angle carries the pipes' rings (normals swept from
 // the face's to the wall's), each corner a sphere patch (normals in the triangle of the flat's,
 // the plane's and the wall's) whose rows end on the rings and on the crease's pipe.
-MeshBuilder build_blunt(const RoundedBevel& b, const Frame& f) {
+MeshBuilder build_blunt(const RoundedBevel& b, const Frame& exact) {
+  // A crease within 10^-6 R of touching the bore is moved onto the bore's edge, and one within
+  // 10^-6 R of the axis 10^-6 R off it (with a bore): the corners' spheres would be slivers
+  // whose points weld, a crease just inside the bore would fold the face between them, and one
+  // through the axis would put the bore's corners at the outer ones' angles. The cut then moves
+  // by at most 10^-6 R (0.1 nm for paper A's needle).
+  Frame f = exact;
+  {
+    const double tiny = 1e-6 * f.R, ri = f.inner(), xc = f.crease();
+    double moved = xc;
+    if (ri > 0 && std::abs(std::abs(xc) - ri) < tiny)
+      moved = std::copysign(ri, xc);
+    else if (ri > 0 && std::abs(xc) < tiny)
+      moved = tiny;
+    f.X += moved - xc;
+  }
   const double ro = f.outer(), ri = f.inner(), xc = f.crease(), rho = f.rho;
   const Point3 n_flat{0.0, 0.0, -1.0}, n_plane{-f.c, 0.0, -f.s};
   auto radial = [](double a, double sign) {
@@ -336,10 +358,8 @@ MeshBuilder build_blunt(const RoundedBevel& b, const Frame& f) {
   const double outer_corner = std::acos(xc / ro);
   corners.push_back({outer_corner, ro, 1.0});
   corners.push_back({2 * kPi - outer_corner, ro, 1.0});
-  // A crease within a millionth of the radius of touching the bore is taken to miss it: the
-  // corners' spheres would be slivers whose points weld. The bevel's pipe then dips below the
-  // flat by at most that millionth times cos t / sin t (0.2 nm for paper A's needle).
-  const bool crosses_bore = ri > 0 && std::abs(xc) < ri - 1e-6 * f.R;
+  // (A crease moved onto the bore's edge, above, touches it at one point: no corners there.)
+  const bool crosses_bore = ri > 0 && std::abs(xc) < ri - 0.5e-6 * f.R;
   if (crosses_bore) {
     const double inner_corner = std::acos(xc / ri);
     corners.push_back({inner_corner, ri, -1.0});
@@ -487,17 +507,20 @@ void check_rounded_bevel(const RoundedBevel& b) {
     throw ParameterError(
         std::string("tip_radius is too large: it must stay below ") +
         (b.bore_radius_m > 0 ? "(diameter - bore) / 8, a quarter of the wall" : "diameter / 4"));
+  if (!(b.flat_width_m >= 0) || !(b.flat_width_m < 2 * b.outer_radius_m))
+    throw ParameterError("flat_width must lie in [0, diameter)");
   // The bore's pipe sweeps toward the bore's axis at the ends of its ellipse, whose in-plane
-  // radius of curvature there is r_i sin(t): a larger rho would fold the pipe onto itself.
+  // radius of curvature there is r_i sin(t): a larger rho would fold the pipe onto itself. A flat
+  // that takes the whole bore rim (a crease at x <= -r_i) leaves no ellipse.
   const double sine = b.tan_angle / std::sqrt(1 + b.tan_angle * b.tan_angle);
-  if (b.bore_radius_m > 0 && !(b.edge_radius_m < (b.bore_radius_m + b.edge_radius_m) * sine))
+  const Frame f = frame_of(b);
+  const bool bore_ellipse = !f.flat || f.crease() > -f.inner();
+  if (b.bore_radius_m > 0 && bore_ellipse &&
+      !(b.edge_radius_m < (b.bore_radius_m + b.edge_radius_m) * sine))
     throw ParameterError(
         "tip_radius is too large for this bore and bevel_angle: it must stay below "
         "bore / 2 * sin(bevel_angle) / (1 - sin(bevel_angle)), or the rounded bore rim folds");
   if (b.segments < 8) throw ParameterError("resolution must be at least 8 segments");
-  if (!(b.flat_width_m >= 0) || !(b.flat_width_m < 2 * b.outer_radius_m))
-    throw ParameterError("flat_width must lie in [0, diameter)");
-  const Frame f = frame_of(b);
   if (f.flat) {
     // K''s flat runs from the crease X' to R - rho; a millionth of the radius at least on
     // either side keeps the two corners apart and some of the plane.
@@ -560,6 +583,13 @@ MeshBuilder build_rounded_bevel(const RoundedBevel& b) {
     }
   }
   return mesh;
+}
+
+bool rounded_bevel_contains(const RoundedBevel& b, Point3 p) {
+  check_rounded_bevel(b);
+  const Frame f = frame_of(b);
+  const double z = p.z + rounded_bevel_tip_height(b);
+  return f.flat ? in_blunt_opening(f, p.x, p.y, z) : in_opening(f, p.x, p.y, z);
 }
 
 SectionProperties rounded_bevel_section(const RoundedBevel& b, double h) {

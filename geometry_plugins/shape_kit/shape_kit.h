@@ -125,6 +125,9 @@ double rounded_bevel_tip_height(const RoundedBevel& bevel);
 /// The section at height h above the rounded tip, by polar integration of the opening's
 /// membership (2048 rays, each interval's ends bisected to round-off).
 SectionProperties rounded_bevel_section(const RoundedBevel& bevel, double h_m);
+/// Whether p (m, the mesh's frame: tip or flat at z = 0) lies in the opening: the membership
+/// the section integrates.
+bool rounded_bevel_contains(const RoundedBevel& bevel, Point3 p);
 
 /// Reads an integral polygon side count from a parameter value.
 int segment_count(double value);

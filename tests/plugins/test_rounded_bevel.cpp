@@ -4,6 +4,7 @@
 #include <limits>
 #include <numbers>
 #include <set>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -173,14 +174,17 @@ RoundedBevel blunt(double edge_radius, double bore_radius, double flat_width) {
 }
 
 // The crease X' = R - w + rho (1 - sin t) / cos t of K' against the bore's r_b + rho: widths
-// that put it outside the bore (paper A's 50 um), on its edge within 10^-9, through it, beyond
-// it; for a solid needle on either side of the axis and through it within round-off.
+// that put it outside the bore (paper A's 50 um), on its edge, within 10^-6 R of it either side
+// (moved onto it; docs/model.md) and 2e-6 R either side (corners of their own), through it and
+// on the axis, beyond it; for a solid needle on either side of the axis and through it. And a
+// 10 um bore at 2048 sides, where a crease just inside the bore once folded the face between.
 TEST(RoundedBevel, WithAFlatTheMeshIsClosedAndOutwardWhereverTheCreaseFalls) {
   const double rho = 2e-6;
   const double lift = rho * (1 - std::sin(kPi / 6)) / std::cos(kPi / 6);
   const double touching = kRadius - (45e-6 + rho) + lift;  // X' = r_i
-  for (const double w : {50e-6, touching, touching * (1 + 1e-9), touching * (1 - 1e-9), 100e-6,
-                         130e-6, 180e-6, 215e-6}) {
+  for (const double w : {50e-6, touching, touching + 0.3e-6 * kRadius, touching - 0.3e-6 * kRadius,
+                         touching + 2e-6 * kRadius, touching - 2e-6 * kRadius, 100e-6, 130e-6,
+                         kRadius + lift, 180e-6, 215e-6}) {
     const MeshBuilder mesh = build_rounded_bevel(blunt(rho, 45e-6, w));
     EXPECT_TRUE(closed_and_consistent(mesh)) << "flat " << w;
     EXPECT_GT(mesh.signed_volume(), 0.0) << "flat " << w;
@@ -190,6 +194,11 @@ TEST(RoundedBevel, WithAFlatTheMeshIsClosedAndOutwardWhereverTheCreaseFalls) {
     EXPECT_TRUE(closed_and_consistent(mesh)) << "solid, flat " << w;
     EXPECT_GT(mesh.signed_volume(), 0.0) << "solid, flat " << w;
   }
+  RoundedBevel narrow = blunt(rho, 10e-6, kRadius - (10e-6 + rho) + lift + 0.3e-6 * kRadius);
+  narrow.segments = 2048;
+  const MeshBuilder mesh = build_rounded_bevel(narrow);
+  EXPECT_TRUE(closed_and_consistent(mesh));
+  EXPECT_GT(mesh.signed_volume(), 0.0);
 }
 
 // The flat stays at z = 0 and is K''s flat: the annulus part x >= X' within R - rho and outside
@@ -294,6 +303,57 @@ TEST(RoundedBevel, WithAFlatTheRemovedVolumeExceedsTheEdgeFormulaOnlyByItsCorner
   }
 }
 
+// Near a corner of K' (where the crease meets the outer wall) every point e of an edge, the
+// crease or the corner itself is the nearest point of K' to e + s n for any n in K''s normal
+// cone there (K' is convex near the outer wall): at s = rho (1 - 1e-3) such a point lies in
+// the opening, at s = rho (1 + 1e-3) it does not. Probed on the cut's ellipse and the flat's
+// circle from 1e-4 to 3e-2 rad past the corner (40 steps; the ellipse's search once clamped its
+// samples to the corner and returned the corner's distance from about 2e-3 rad on), along the
+// crease and over the corner's sphere, on both sides of y = 0.
+TEST(RoundedBevel, WithAFlatMembershipNearTheCornersIsExact) {
+  const double rho = 5e-6, w = 50e-6, t = kPi / 6;
+  const double c = std::cos(t), s = std::sin(t);
+  for (const double bore : {0.0, 45e-6}) {
+    const RoundedBevel b = blunt(rho, bore, w);
+    const double ro = kRadius - rho, xc = kRadius - w + rho * (1 - s) / c;
+    const double corner = std::acos(xc / ro);
+    auto plane_z = [&](double x) { return ((kRadius - w) * c + rho - x * c) / s; };
+    const Point3 n_flat{0, 0, -1}, n_plane{-c, 0, -s};
+    auto unit = [](Point3 a) {
+      const double n = std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
+      return Point3{a.x / n, a.y / n, a.z / n};
+    };
+    auto mix = [&](Point3 a, Point3 b, double u) {
+      return unit({(1 - u) * a.x + u * b.x, (1 - u) * a.y + u * b.y, (1 - u) * a.z + u * b.z});
+    };
+    auto probe = [&](Point3 e, Point3 n, const std::string& what) {
+      for (const double share : {1 - 1e-3, 1 + 1e-3}) {
+        const Point3 q{e.x + share * rho * n.x, e.y + share * rho * n.y, e.z + share * rho * n.z};
+        EXPECT_EQ(rounded_bevel_contains(b, q), share < 1) << what << " bore " << bore;
+      }
+    };
+    for (const double sign : {1.0, -1.0}) {
+      const Point3 wall{std::cos(corner), sign * std::sin(corner), 0};
+      const Point3 q0{xc, sign * ro * std::sin(corner), rho};
+      for (int k = 0; k < 40; ++k) {
+        const double past = 1e-4 * std::pow(300.0, k / 39.0);  // 1e-4 ... 3e-2 rad
+        for (const double u : {0.1, 0.5, 0.9}) {
+          const double a = sign * (corner + past);  // the cut's side
+          const Point3 e{ro * std::cos(a), ro * std::sin(a), plane_z(ro * std::cos(a))};
+          probe(e, mix(n_plane, {std::cos(a), std::sin(a), 0}, u), "ellipse");
+          const double f = sign * (corner - past);  // the flat's side
+          probe({ro * std::cos(f), ro * std::sin(f), rho},
+                mix(n_flat, {std::cos(f), std::sin(f), 0}, u), "circle");
+          probe({xc, q0.y - sign * past * ro, rho}, mix(n_flat, n_plane, u), "crease");
+        }
+      }
+      for (const double u : {0.2, 0.5, 0.8})
+        for (const double v : {0.2, 0.5})
+          probe(q0, mix(mix(n_flat, n_plane, u), wall, v), "sphere");
+    }
+  }
+}
+
 TEST(RoundedBevel, WithAFlatRefusesARadiusThatTakesTheWholeFlat) {
   // K''s flat is w - rho (1 + (1 - sin t) / cos t) wide: 1.577 rho is taken at 30 deg.
   EXPECT_THROW(build_rounded_bevel(blunt(10e-6, 45e-6, 15e-6)), ParameterError);
@@ -303,6 +363,14 @@ TEST(RoundedBevel, WithAFlatRefusesARadiusThatTakesTheWholeFlat) {
   EXPECT_TRUE(closed_and_consistent(build_rounded_bevel(blunt(2e-6, 0.0, 229.1e-6))));
   EXPECT_THROW(build_rounded_bevel(blunt(2e-6, 0.0, 230e-6)), ParameterError);
   EXPECT_THROW(rounded_bevel_section(blunt(2e-6, 0.0, -1e-6), 1e-6), ParameterError);
+  // At 10 deg the bore rim folds above 9.5 um (RefusesAnEdgeRadiusThatDoesNotFitTheWall), but a
+  // flat that takes the whole rim (X' = -64.9 um beyond r_i = -57 um) leaves no ellipse to fold.
+  RoundedBevel steep = blunt(12e-6, 45e-6, 190e-6);
+  steep.tan_angle = std::tan(kPi / 18);
+  EXPECT_TRUE(closed_and_consistent(build_rounded_bevel(steep)));
+  steep.flat_width_m = 50e-6;
+  steep.length_m = 3e-3;
+  EXPECT_THROW(build_rounded_bevel(steep), ParameterError);
 }
 
 }  // namespace

@@ -42,6 +42,8 @@ constexpr double kHolderNarrowing = 0.25;
 constexpr double kSideFaceSlope = 0.2;
 // The second pass's: within asin(0.01) = 0.57 deg of parallel (refined_by_side_faces).
 constexpr double kShaftFaceSlope = 0.01;
+// ... and the share of the first pass's face area those must carry to be the shaft.
+constexpr double kShaftFaceShare = 0.5;
 
 double size_of(const TriangleMesh& mesh) {
   const BoundingBox box = bounding_box(mesh);
@@ -180,10 +182,12 @@ std::string format_vector(const Vector3d& v) {
 // A principal axis is tilted by whatever breaks the body's symmetry (a bevel's cut tilts it by
 // degrees). The shaft's side faces are exactly parallel to the true axis: among the faces
 // within `slope` of parallel to `axis`, the direction their normals avoid (the smallest
-// eigenvector of sum A n n^T) is the shaft's axis. Empty without a clear shaft.
-std::optional<Vector3d> side_face_axis(const TriangleMesh& mesh, const Vector3d& axis,
-                                       double slope) {
+// eigenvector of sum A n n^T) is the shaft's axis. Empty without a clear shaft; `area` (m^2)
+// is what the faces taken in add up to.
+std::optional<Vector3d> side_face_axis(const TriangleMesh& mesh, const Vector3d& axis, double slope,
+                                       double* area) {
   Matrix3d tensor = Matrix3d::Zero();
+  *area = 0.0;
   for (const Triangle& t : mesh.triangles) {
     const Vector3d a = to_eigen(mesh.vertices[t[0]]);
     const Vector3d n2 =
@@ -191,7 +195,10 @@ std::optional<Vector3d> side_face_axis(const TriangleMesh& mesh, const Vector3d&
     const double twice_area = n2.norm();
     if (!(twice_area > 0.0)) continue;
     const Vector3d n = n2 / twice_area;
-    if (std::abs(n.dot(axis)) < slope) tensor += 0.5 * twice_area * n * n.transpose();
+    if (std::abs(n.dot(axis)) < slope) {
+      tensor += 0.5 * twice_area * n * n.transpose();
+      *area += 0.5 * twice_area;
+    }
   }
   const Eigen::SelfAdjointEigenSolver<Matrix3d> solver(tensor);
   const auto& lambda = solver.eigenvalues();
@@ -204,12 +211,16 @@ std::optional<Vector3d> side_face_axis(const TriangleMesh& mesh, const Vector3d&
 // steps before the wall (within 6 deg of it for 16 steps a quarter turn) tilt the axis where they
 // are not spread evenly around it (4.6e-5 rad for a rounded blunt bevel, which lifted part of its
 // flat 2 nm and its base out of the base's level). A second pass keeps only the faces within
-// kShaftFaceSlope of the first pass's axis, the shaft's own walls; without a clear shaft among
-// them (a tapered one) the first pass stands. Returns `axis` unchanged without a clear shaft.
+// kShaftFaceSlope of the first pass's axis, the shaft's own walls. It stands only if they are
+// most of the first pass's faces (kShaftFaceShare of their area): a tapered shaft has none, and
+// a few exactly parallel faces elsewhere (a hub, a holder's side) must not decide the axis.
+// Returns `axis` unchanged without a clear shaft.
 Vector3d refined_by_side_faces(const TriangleMesh& mesh, const Vector3d& axis) {
-  const std::optional<Vector3d> first = side_face_axis(mesh, axis, kSideFaceSlope);
+  double first_area = 0.0, shaft_area = 0.0;
+  const std::optional<Vector3d> first = side_face_axis(mesh, axis, kSideFaceSlope, &first_area);
   if (!first) return axis;
-  return side_face_axis(mesh, *first, kShaftFaceSlope).value_or(*first);
+  const std::optional<Vector3d> shaft = side_face_axis(mesh, *first, kShaftFaceSlope, &shaft_area);
+  return shaft && shaft_area >= kShaftFaceShare * first_area ? *shaft : *first;
 }
 
 // `axis` (either sign; the principal axis when empty), signed so that it points toward the
