@@ -300,6 +300,9 @@ Eigen::VectorXd AxisymmetricModel::pair_penalties() const {
 
 namespace {
 
+// SparseSolver's backend when the matrix was not positive definite.
+const std::string kIndefinite = "eigen-simplicial-ldlt";
+
 double free_norm(const Eigen::VectorXd& v, const std::vector<char>& is_constrained) {
   double sum = 0.0;
   for (Eigen::Index i = 0; i < v.size(); ++i)
@@ -337,6 +340,19 @@ Equilibrium AxisymmetricModel::solve(const std::vector<std::uint32_t>& prescribe
   double previous_residual = std::numeric_limits<double>::infinity();
   Eigen::VectorXd cached;  // internal force at the accepted line-search point
   double cached_energy = 0.0;
+  // The potential energy the descent steps lower: the strain energy plus the closed crack-face
+  // pairs' augmented-Lagrangian term (lambda g + k g^2 / 2, g their radial gap).
+  auto potential = [&](const Eigen::VectorXd& u, double strain_energy) {
+    double total = strain_energy;
+    for (std::size_t p = 0; p < m.face_pairs.size(); ++p) {
+      if (!m.pair_closed[p]) continue;
+      const auto i = static_cast<Eigen::Index>(p);
+      const double gap = u[2 * m.face_pairs[p][1]] - u[2 * m.face_pairs[p][0]];
+      total += m.pair_multiplier[i] * gap + 0.5 * m.pair_penalty[i] * gap * gap;
+    }
+    return total;
+  };
+  bool shifted = false;  // the current factorisation is of a shifted tangent
   for (int iteration = 0;; ++iteration) {
     const bool applied = remaining.lpNorm<Eigen::Infinity>() == 0.0;
     const bool may_reuse = options.modified_newton && applied && m.has_factor &&
@@ -359,7 +375,7 @@ Equilibrium AxisymmetricModel::solve(const std::vector<std::uint32_t>& prescribe
       eq.newton_iterations = iteration;
       return eq;
     }
-    if (iteration >= options.max_iterations)
+    if (iteration >= (m.bifurcated ? options.max_descent_iterations : options.max_iterations))
       throw SolverError("Newton did not converge in " + std::to_string(iteration) +
                         " iterations (relative residual " + std::to_string(residual / reference) +
                         ")");
@@ -386,6 +402,29 @@ Equilibrium AxisymmetricModel::solve(const std::vector<std::uint32_t>& prescribe
       m.has_factor = false;
       m.solver.factorize(K);
       ++m.factorizations;
+      shifted = false;
+      if (!m.linear && applied && m.solver.ok() && m.solver.backend() == kIndefinite) {
+        // Past a bifurcation (docs/model.md, "Solver"): the free diagonal raised by sigma of
+        // itself, sigma from 1e-6 up fourfold, until the factorisation is positive definite.
+        const Eigen::VectorXd diagonal_k = K.diagonal();
+        double sigma = 1e-6;
+        for (int attempt = 0; attempt < 20; ++attempt, sigma *= 4.0) {
+          for (Eigen::Index i = 0; i < n; ++i)
+            if (!is_constrained[i])
+              K.coeffRef(i, i) = diagonal_k[i] + sigma * std::abs(diagonal_k[i]);
+          m.solver.factorize(K);
+          ++m.factorizations;
+          if (m.solver.ok() && m.solver.backend() != kIndefinite) {
+            shifted = true;
+            break;
+          }
+        }
+        if (!shifted) {  // back to the indefinite tangent itself
+          for (Eigen::Index i = 0; i < n; ++i) K.coeffRef(i, i) = diagonal_k[i];
+          m.solver.factorize(K);
+          ++m.factorizations;
+        }
+      }
       if (!m.solver.ok()) throw SolverError("singular stiffness matrix");
       m.has_factor = true;
       m.factored_constraints = is_constrained;
@@ -393,16 +432,23 @@ Equilibrium AxisymmetricModel::solve(const std::vector<std::uint32_t>& prescribe
     }
     const Eigen::VectorXd step = m.solver.solve(rhs);
     if (!step.allFinite()) throw SolverError("singular stiffness matrix (non-finite solution)");
-    // Backtracking line search on the free residual once the prescribed values are in place.
+    // Backtracking line search once the prescribed values are in place: on the free residual,
+    // or after a shifted factorisation on the potential energy (a step toward the stable branch
+    // raises the residual before it lowers it).
     double alpha = 1.0;
     if (applied && !m.linear) {
+      const double start_potential = potential(eq.displacement, eq.strain_energy_J);
       for (int trial = 0; trial < 8; ++trial, alpha *= 0.5) {
         try {
           double energy = 0.0;
-          Eigen::VectorXd r = internal_force(eq.displacement + alpha * step, &energy, nullptr);
-          if (free_norm(r, is_constrained) < residual) {
+          const Eigen::VectorXd trial_u = eq.displacement + alpha * step;
+          Eigen::VectorXd r = internal_force(trial_u, &energy, nullptr);
+          const bool better = shifted ? potential(trial_u, energy) < start_potential
+                                      : free_norm(r, is_constrained) < residual;
+          if (better) {
             cached = std::move(r);
             cached_energy = energy;
+            m.bifurcated = m.bifurcated || shifted;
             break;
           }
         } catch (const OutOfMemoryError&) {

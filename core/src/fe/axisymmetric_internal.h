@@ -120,6 +120,9 @@ struct AxisymmetricModel::Impl {
   bool has_factor = false;                 // the solver holds a usable factorisation
   std::vector<char> factored_constraints;  // constrained dofs of that factorisation
   int factorizations = 0;
+  // A solve took a step along a shifted tangent (past a bifurcation): every later solve may take
+  // NewtonOptions::max_descent_iterations, the path settling onto the stable branch.
+  bool bifurcated = false;
   // Crack-face pairs {inner, outer} held by an augmented Lagrangian when closed
   // (AxisymmetricModel::set_face_pairs): penalty, state and multiplier per pair, and the value
   // slots of (inner_r, inner_r), (outer_r, outer_r), (inner_r, outer_r), (outer_r, inner_r).

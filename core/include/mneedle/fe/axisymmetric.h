@@ -110,6 +110,11 @@ struct NewtonOptions {
   /// Reuse the last factorisation (of this solve, or of an earlier one with the same constrained
   /// dofs) while the residual falls by 4x per iteration.
   bool modified_newton = true;
+  /// Past a bifurcation the tangent is indefinite and Newton heads for the unstable branch: its
+  /// diagonal is then shifted until it is positive definite and the step is taken where the
+  /// potential energy falls (docs/model.md, "Solver"). While such steps lower the energy the
+  /// solve may take up to this many iterations in all (the way to the stable branch is long).
+  int max_descent_iterations = 400;
 };
 
 /// Assembly and equilibrium on a fixed mesh; reuses the sparsity pattern and its symbolic
