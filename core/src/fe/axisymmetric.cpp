@@ -352,7 +352,6 @@ Equilibrium AxisymmetricModel::solve(const std::vector<std::uint32_t>& prescribe
     }
     return total;
   };
-  bool shifted = false;  // the current factorisation is of a shifted tangent
   for (int iteration = 0;; ++iteration) {
     const bool applied = remaining.lpNorm<Eigen::Infinity>() == 0.0;
     const bool may_reuse = options.modified_newton && applied && m.has_factor &&
@@ -402,12 +401,13 @@ Equilibrium AxisymmetricModel::solve(const std::vector<std::uint32_t>& prescribe
       m.has_factor = false;
       m.solver.factorize(K);
       ++m.factorizations;
-      shifted = false;
-      if (!m.linear && applied && m.solver.ok() && m.solver.backend() == kIndefinite) {
+      m.factor_shifted = false;
+      if (!m.linear && applied && (!m.solver.ok() || m.solver.backend() == kIndefinite)) {
         // Past a bifurcation (docs/model.md, "Solver"): the free diagonal raised by sigma of
-        // itself, sigma from 1e-6 up fourfold, until the factorisation is positive definite.
+        // itself, from a sixteenth of the last shift that worked (1e-6 at first) up fourfold,
+        // until the factorisation is positive definite.
         const Eigen::VectorXd diagonal_k = K.diagonal();
-        double sigma = 1e-6;
+        double sigma = std::max(1e-9, m.shift / 16.0);
         for (int attempt = 0; attempt < 20; ++attempt, sigma *= 4.0) {
           for (Eigen::Index i = 0; i < n; ++i)
             if (!is_constrained[i])
@@ -415,11 +415,12 @@ Equilibrium AxisymmetricModel::solve(const std::vector<std::uint32_t>& prescribe
           m.solver.factorize(K);
           ++m.factorizations;
           if (m.solver.ok() && m.solver.backend() != kIndefinite) {
-            shifted = true;
+            m.factor_shifted = true;
+            m.shift = sigma;
             break;
           }
         }
-        if (!shifted) {  // back to the indefinite tangent itself
+        if (!m.factor_shifted) {  // back to the indefinite tangent itself
           for (Eigen::Index i = 0; i < n; ++i) K.coeffRef(i, i) = diagonal_k[i];
           m.solver.factorize(K);
           ++m.factorizations;
@@ -443,12 +444,12 @@ Equilibrium AxisymmetricModel::solve(const std::vector<std::uint32_t>& prescribe
           double energy = 0.0;
           const Eigen::VectorXd trial_u = eq.displacement + alpha * step;
           Eigen::VectorXd r = internal_force(trial_u, &energy, nullptr);
-          const bool better = shifted ? potential(trial_u, energy) < start_potential
-                                      : free_norm(r, is_constrained) < residual;
+          const bool better = m.factor_shifted ? potential(trial_u, energy) < start_potential
+                                               : free_norm(r, is_constrained) < residual;
           if (better) {
             cached = std::move(r);
             cached_energy = energy;
-            m.bifurcated = m.bifurcated || shifted;
+            m.bifurcated = m.bifurcated || m.factor_shifted;
             break;
           }
         } catch (const OutOfMemoryError&) {

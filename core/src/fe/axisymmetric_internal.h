@@ -123,6 +123,8 @@ struct AxisymmetricModel::Impl {
   // A solve took a step along a shifted tangent (past a bifurcation): every later solve may take
   // NewtonOptions::max_descent_iterations, the path settling onto the stable branch.
   bool bifurcated = false;
+  bool factor_shifted = false;  // the factorisation held is of a shifted tangent
+  double shift = 1e-6;          // the last shift that made the tangent positive definite
   // Crack-face pairs {inner, outer} held by an augmented Lagrangian when closed
   // (AxisymmetricModel::set_face_pairs): penalty, state and multiplier per pair, and the value
   // slots of (inner_r, inner_r), (outer_r, outer_r), (inner_r, outer_r), (outer_r, inner_r).

@@ -112,8 +112,8 @@ struct NewtonOptions {
   bool modified_newton = true;
   /// Past a bifurcation the tangent is indefinite and Newton heads for the unstable branch: its
   /// diagonal is then shifted until it is positive definite and the step is taken where the
-  /// potential energy falls (docs/model.md, "Solver"). While such steps lower the energy the
-  /// solve may take up to this many iterations in all (the way to the stable branch is long).
+  /// potential energy falls (docs/model.md, "Solver"). Once a model has taken such a step, each of
+  /// its later solves may take up to this many iterations (the way to the stable branch is long).
   int max_descent_iterations = 400;
 };
 
