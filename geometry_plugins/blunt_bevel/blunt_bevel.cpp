@@ -47,13 +47,7 @@ BluntBevel read(const double* params) {
 
 // With no flat the rounded shape is the rounded sharp bevel, its tip at z = 0 as well.
 RoundedBevel rounded(const BluntBevel& bevel) {
-  return {.outer_radius_m = bevel.tube.radius_m,
-          .bore_radius_m = bevel.tube.bore_radius_m,
-          .tan_angle = bevel.tan_angle,
-          .edge_radius_m = bevel.tip_radius,
-          .length_m = bevel.tube.length_m,
-          .segments = bevel.tube.segments,
-          .flat_width_m = bevel.flat_width_m};
+  return rounded_bevel_of(bevel.tube, bevel.tan_angle, bevel.tip_radius, bevel.flat_width_m);
 }
 
 MeshBuilder make_mesh(const double* params) {

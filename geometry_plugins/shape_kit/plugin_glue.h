@@ -35,6 +35,19 @@ struct TubeParameters {
 };
 TubeParameters read_tube_parameters(const double* params);
 
+/// The bevelled tube of `tube`, its cut at atan(tan_angle) to the axis, every edge of the cut
+/// rounded to tip_radius; with flat_width > 0 the blunt bevel's flat (shape_kit's RoundedBevel).
+inline RoundedBevel rounded_bevel_of(const TubeParameters& tube, double tan_angle,
+                                     double tip_radius, double flat_width = 0.0) {
+  return {.outer_radius_m = tube.radius_m,
+          .bore_radius_m = tube.bore_radius_m,
+          .tan_angle = tan_angle,
+          .edge_radius_m = tip_radius,
+          .length_m = tube.length_m,
+          .segments = tube.segments,
+          .flat_width_m = flat_width};
+}
+
 void write_message(char* buffer, std::size_t size, const char* text) noexcept;
 
 /// Runs body() and turns every exception into a status and a message: nothing may unwind

@@ -400,9 +400,11 @@ MeshBuilder build_blunt(const RoundedBevel& b, const Frame& exact) {
     return sweep(e, n_flat, n_plane, rho);
   };
   const double top = f.top;
+  const Point3 up{0.0, 0.0, 1.0};
   auto lifted = [&](const Surfel& s) { return Surfel{{s.p.x, s.p.y, top}, s.n}; };
-  const Surfel up_normal{{0, 0, 0}, {0.0, 0.0, 1.0}};
-  auto top_of = [&](const Surfel& s) { return Surfel{{s.p.x, s.p.y, top}, up_normal.n}; };
+  auto top_of = [&](const Surfel& s) { return Surfel{{s.p.x, s.p.y, top}, up}; };
+  // A solid needle's crease ring through its midpoint, the hub of its faces' fans.
+  const std::vector<Surfel> middle = ri > 0 ? std::vector<Surfel>{} : crease_ring(0.0);
 
   MeshBuilder mesh(1e-9 * b.outer_radius_m);
   const std::size_t n = angles.size();
@@ -434,10 +436,9 @@ MeshBuilder build_blunt(const RoundedBevel& b, const Frame& exact) {
         add_facing(mesh, c0[out_side], c1[out_side], o1.front(), o0.front());
       }
     } else {
-      add_facing(mesh, {{0.0, 0.0, top}, up_normal.n}, top_of(o0.back()), top_of(o1.back()));
+      add_facing(mesh, {{0.0, 0.0, top}, up}, top_of(o0.back()), top_of(o1.back()));
       // The solid's faces are fans from the crease's midpoint (both faces are convex and it
       // lies on the edge of each).
-      const auto middle = crease_ring(0.0);
       const Surfel& hub = outer_flat ? middle.front() : middle.back();
       add_facing(mesh, hub, o0.front(), o1.front());
     }
@@ -445,8 +446,7 @@ MeshBuilder build_blunt(const RoundedBevel& b, const Frame& exact) {
   if (ri <= 0) {
     // The crease's pipe of a solid needle: from one outer corner through the midpoint to the
     // other, matching the fans' edges.
-    const auto low = crease_ring(corners[1].angle), middle = crease_ring(0.0),
-               high = crease_ring(corners[0].angle);
+    const auto low = crease_ring(corners[1].angle), high = crease_ring(corners[0].angle);
     add_strip(mesh, low, middle);
     add_strip(mesh, middle, high);
   }

@@ -38,12 +38,7 @@ Bevel read(const double* params) {
 }
 
 RoundedBevel rounded(const Bevel& bevel) {
-  return {.outer_radius_m = bevel.tube.radius_m,
-          .bore_radius_m = bevel.tube.bore_radius_m,
-          .tan_angle = bevel.tan_angle,
-          .edge_radius_m = bevel.tip_radius,
-          .length_m = bevel.tube.length_m,
-          .segments = bevel.tube.segments};
+  return rounded_bevel_of(bevel.tube, bevel.tan_angle, bevel.tip_radius);
 }
 
 MeshBuilder make_mesh(const double* params) {
