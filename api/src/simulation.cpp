@@ -79,6 +79,7 @@ nlohmann::json seconds_by_stage_json(const RunSeconds& t) {
           {"contact_s", t.contact_s},
           {"stress_s", t.stress_s},
           {"factorizations", t.factorizations},
+          {"shifted_factorizations", t.shifted_factorizations},
           {"fe_runs", t.fe_runs}};
 }
 

@@ -74,6 +74,10 @@ constexpr double kCaptureGroup = 1e-2;
 constexpr double kCaptureGroupPerSpacing = 0.02;
 constexpr double kCaptureGroupBisections = 4.0;
 constexpr int kMaxNewtonIterations = 40;
+// Past a bifurcation (Impl::shift_tangent): Newton iterations per solve while the path settles
+// onto the stable branch, and the fourfold shifts tried per factorisation.
+constexpr int kMaxDescentIterations = 200;
+constexpr int kMaxShifts = 20;
 constexpr int kMaxLineSearchHalvings = 6;
 constexpr int kMaxStepCuts = 12;
 // Frictionless contact: Uzawa updates of the multipliers until no nodal contact force changes by
@@ -165,6 +169,12 @@ struct Indentation3d::Impl {
   double step = 0.0;
   Eigen::SparseMatrix<double> tangent;   // last factorised tangent before the Dirichlet rows
   std::vector<char> factor_constraints;  // prescribed dofs of the current factorisation
+  // Past a bifurcation (shift_tangent): the factorisation held is of a shifted tangent; a step
+  // has descended along one (from then on Newton may take kMaxDescentIterations); the last
+  // shift that made the tangent positive definite.
+  bool factor_shifted = false;
+  bool bifurcated = false;
+  double shift = 1e-6;
   // Frictionless path: quadrature-point contact; on linear layers the tissue is condensed onto
   // the contact-face nodes (rows) through K⁻¹ columns at the loaded ("involved") nodes.
   std::optional<FrictionlessContact> contact;
@@ -284,6 +294,13 @@ struct Indentation3d::Impl {
         kCaptureGroupBisections * kCaptureBisection * capture_radius);
   }
 
+  // Where a node that entered needle n is held: on the face that swept over it, or where it
+  // entered a wall sideways (NeedleShape::sticking_anchor).
+  Eigen::Vector3d anchor_of(int n, const Eigen::Vector3d& local,
+                            const Eigen::Vector3d& entered) const {
+    return shapes[static_cast<std::size_t>(n)].sticking_anchor(local, entered, group_length());
+  }
+
   // Rows of the sticking path's compliance: the candidates, then the ring.
   Eigen::Index surface_rows() const {
     return 3 * static_cast<Eigen::Index>(candidates.size() + ring.size());
@@ -300,7 +317,7 @@ struct Indentation3d::Impl {
       for (std::size_t n = 0; n < needles.size(); ++n) {
         const Eigen::Vector3d local = x - tip(static_cast<int>(n), at_depth);
         if (local.head<2>().norm() > reach[n] || !shapes[n].touches(local)) continue;
-        found.push_back({node, static_cast<int>(n), shapes[n].lower_surface_below(local)});
+        found.push_back({node, static_cast<int>(n), anchor_of(static_cast<int>(n), local, local)});
         break;
       }
     }
@@ -711,8 +728,7 @@ struct Indentation3d::Impl {
         const int needle = found[i].needle;
         const Eigen::Vector3d local =
             position(found[i].node, first) - tip(needle, from + first * span);
-        now.push_back({found[i].node, needle,
-                       shapes[static_cast<std::size_t>(needle)].lower_surface_below(local)});
+        now.push_back({found[i].node, needle, anchor_of(needle, local, local)});
       }
       from += first * span;
       append_compliance_columns(now);
@@ -801,25 +817,60 @@ struct Indentation3d::Impl {
 
   // Factorises the assembled tangent in `stiffness` for this set of prescribed dofs; keeps the
   // unconstrained copy for the predictor's coupling term.
-  void factorize_tangent(const std::vector<char>& constrained) {
+  // With `may_shift` (the sticking path's Newton), a tangent that is not positive definite is
+  // shifted instead (shift_tangent).
+  void factorize_tangent(const std::vector<char>& constrained, bool may_shift = false) {
     tangent = stiffness;
     apply_dirichlet(&stiffness, constrained);
     const auto start = Clock::now();
+    solver.set_indefinite_fallback(!may_shift);
     solver.factorize(stiffness);
     ++timing.factorizations;
+    factor_shifted = false;
+    if (may_shift && !solver.ok()) shift_tangent(constrained);
     timing.factorization_s += seconds_since(start);
     if (!solver.ok()) throw SolverError("singular tangent stiffness");
     factor_constraints = constrained;
+  }
+
+  // Past a bifurcation (docs/model.md, "Solver"): the free diagonal raised by sigma of itself,
+  // from a sixteenth of the last shift that worked (1e-6 at first) up fourfold, until the
+  // Cholesky factorisation succeeds; the step it gives descends the strain energy (descend).
+  // When no shift up to 4^19 of the first works, the LDLᵀ of the tangent itself, as before.
+  void shift_tangent(const std::vector<char>& constrained) {
+    const Eigen::VectorXd diagonal = stiffness.diagonal();
+    const auto set_diagonal = [&](double sigma) {
+      for (Eigen::Index i = 0; i < diagonal.size(); ++i)
+        if (!constrained[static_cast<std::size_t>(i)])
+          stiffness.coeffRef(i, i) = diagonal[i] + sigma * std::abs(diagonal[i]);
+    };
+    double sigma = std::max(1e-9, shift / 16.0);
+    for (int attempt = 0; attempt < kMaxShifts; ++attempt, sigma *= 4.0) {
+      set_diagonal(sigma);
+      solver.factorize(stiffness);
+      ++timing.factorizations;
+      if (solver.ok()) {
+        factor_shifted = true;
+        shift = sigma;
+        ++timing.shifted_factorizations;
+        return;
+      }
+    }
+    set_diagonal(0.0);
+    solver.set_indefinite_fallback(true);
+    solver.factorize(stiffness);
+    ++timing.factorizations;
   }
 
   bool factor_fits(const std::vector<char>& constrained) const {
     return factor_constraints == constrained;
   }
 
-  Eigen::VectorXd assemble_force(bool with_tangent) {
+  Eigen::VectorXd assemble_force(bool with_tangent, double* energy = nullptr) {
     const auto start = Clock::now();
     Eigen::VectorXd force;
-    model.assemble(u, with_tangent ? &stiffness : nullptr, &force);
+    const double e = model.assemble(u, with_tangent ? &stiffness : nullptr, &force);
+    if (energy != nullptr) *energy = e;
     timing.assembly_s += seconds_since(start);
     return force;
   }
@@ -830,7 +881,7 @@ struct Indentation3d::Impl {
   int predict(const Eigen::VectorXd& jump, const std::vector<char>& constrained) {
     const bool reuse = factor_fits(constrained);
     const Eigen::VectorXd force = assemble_force(!reuse);
-    if (!reuse) factorize_tangent(constrained);
+    if (!reuse) factorize_tangent(constrained, true);
     const Eigen::VectorXd coupled = tangent.selfadjointView<Eigen::Lower>() * jump;
     u += jump + solver.solve(Eigen::VectorXd(free_part(-(force + coupled), constrained)));
     return 1;
@@ -846,19 +897,50 @@ struct Indentation3d::Impl {
     // Modified Newton: a factorisation is kept while it still shrinks the residual at least
     // fourfold per iteration.
     bool refactor = !factor_fits(constrained);
-    for (int iteration = 1 + predicted; iteration <= kMaxNewtonIterations; ++iteration) {
-      const Eigen::VectorXd force = assemble_force(refactor);
+    int iteration = 1 + predicted;
+    for (; iteration <= (bifurcated ? kMaxDescentIterations : kMaxNewtonIterations); ++iteration) {
+      double energy = 0.0;
+      const Eigen::VectorXd force = assemble_force(refactor, &energy);
       const Eigen::VectorXd residual = free_part(force, constrained);
       const double residual_norm = residual.norm();
       if (residual_norm <= options.tolerance * reaction_norm(force)) return iteration - 1;
-      if (refactor) factorize_tangent(constrained);
+      if (refactor) factorize_tangent(constrained, true);
       const Eigen::VectorXd delta = solver.solve(Eigen::VectorXd(-residual));
-      const double accepted = line_search(delta, residual_norm, constrained);
+      const double accepted = factor_shifted ? descend(delta, energy, constrained)
+                                             : line_search(delta, residual_norm, constrained);
       if (delta.lpNorm<Eigen::Infinity>() < 1e-13 * length_scale) return iteration;
       refactor = !(accepted < 0.25 * residual_norm);
     }
-    throw SolverError("Newton-Raphson did not converge in " + std::to_string(kMaxNewtonIterations) +
+    throw SolverError("Newton-Raphson did not converge in " + std::to_string(iteration - 1) +
                       " iterations");
+  }
+
+  // Backtracking on the strain energy after a shifted factorisation: a step toward the stable
+  // branch raises the residual before it lowers it, so the residual cannot judge it. With the
+  // captured nodes prescribed, the strain energy is the whole potential. No trial lowers it:
+  // the shortest one is taken, as on the residual. Returns the residual norm at the new point.
+  double descend(const Eigen::VectorXd& delta, double start_energy,
+                 const std::vector<char>& constrained) {
+    double alpha = 1.0;
+    for (int halving = 0; halving <= kMaxLineSearchHalvings; ++halving, alpha *= 0.5) {
+      const Eigen::VectorXd trial = u + alpha * delta;
+      try {
+        const auto start = Clock::now();
+        Eigen::VectorXd force;
+        const double energy = model.assemble(trial, nullptr, &force);
+        timing.assembly_s += seconds_since(start);
+        if (energy < start_energy || halving == kMaxLineSearchHalvings) {
+          u = trial;
+          bifurcated = true;
+          return free_part(force, constrained).norm();
+        }
+      } catch (const OutOfMemoryError&) {
+        throw;
+      } catch (const SolverError&) {
+        if (halving == kMaxLineSearchHalvings) throw;
+      }
+    }
+    throw SolverError("no descent along the shifted tangent");  // not reached
   }
 
   // Backtracking on the residual norm; an inverted element at a trial point counts as a failure.
@@ -911,6 +993,15 @@ struct Indentation3d::Impl {
     return hi;
   }
 
+  // The node of capture c in its needle's frame at the fraction t of that step.
+  Eigen::Vector3d local_at(const CapturedNode& c, double from_depth, const Eigen::VectorXd& from_u,
+                           double at_depth, double t) const {
+    const auto node = static_cast<std::size_t>(c.node);
+    const Eigen::Vector3d x0 = mesh.nodes[node] + from_u.segment<3>(3 * c.node);
+    const Eigen::Vector3d x1 = mesh.nodes[node] + u.segment<3>(3 * c.node);
+    return x0 + t * (x1 - x0) - tip(c.needle, from_depth + t * (at_depth - from_depth));
+  }
+
   // Nonlinear sticking: the nodes that enter a needle within the step are captured in depth order
   // (docs/model.md, "Contact with the rigid needle (sticking)"): those inside at the step's start
   // at once; when the first of the others enters more than the group length (group_length(), as
@@ -936,12 +1027,17 @@ struct Indentation3d::Impl {
           timing.contact_s += seconds_since(start);
           throw CaptureEvent{end};
         }
-        if (first <= step_start) {
-          std::vector<CapturedNode> at_start;
-          for (std::size_t i = 0; i < found.size(); ++i)
-            if (t[i] <= step_start) at_start.push_back(found[i]);
-          found = std::move(at_start);
+        // Each node held where it entered (anchor_of), which matters only for a wall entered
+        // sideways.
+        std::vector<CapturedNode> kept;
+        for (std::size_t i = 0; i < found.size(); ++i) {
+          if (first <= step_start && t[i] > step_start) continue;
+          CapturedNode c = found[i];
+          c.anchor = anchor_of(c.needle, local_at(c, from_depth, from_u, at_depth, 1.0),
+                               local_at(c, from_depth, from_u, at_depth, t[i]));
+          kept.push_back(c);
         }
+        found = std::move(kept);
       }
       timing.contact_s += seconds_since(start);
       if (found.empty()) return total;

@@ -98,6 +98,17 @@ Eigen::Vector3d NeedleShape::lower_surface_below(const Eigen::Vector3d& point) c
   return closest_point(point);
 }
 
+Eigen::Vector3d NeedleShape::sticking_anchor(const Eigen::Vector3d& point,
+                                             const Eigen::Vector3d& entered,
+                                             double tolerance) const {
+  // A node pressed sideways into the shaft above a bevel has the bevel face far below it:
+  // holding it there would pull it down the whole height.
+  const Eigen::Vector3d below = lower_surface_below(point);
+  const double nearest = (closest_point(point) - point).norm();
+  if ((below - point).norm() <= nearest + tolerance) return below;
+  return closest_point(entered);
+}
+
 Eigen::Vector3d NeedleShape::closest_point(const Eigen::Vector3d& point) const {
   const CgalPoint q = impl_->tree->closest_point(to_cgal(point));
   return {q.x(), q.y(), q.z()};

@@ -31,6 +31,13 @@ class NeedleShape {
   /// the face that reached the point as the needle moved along -z. Falls back to the closest
   /// surface point when that face is vertical or the ray grazes an edge.
   Eigen::Vector3d lower_surface_below(const Eigen::Vector3d& point) const;
+  /// Where sticking contact holds a tissue node found inside the needle at `point` that crossed
+  /// the surface at `entered` (both in the needle frame; docs/model.md, "Contact with the rigid
+  /// needle (sticking)"): lower_surface_below(point), the face that swept over it, unless that
+  /// lies more than `tolerance` (m) farther than the nearest face, as for a node that entered a
+  /// wall sideways; then the surface point nearest to `entered`.
+  Eigen::Vector3d sticking_anchor(const Eigen::Vector3d& point, const Eigen::Vector3d& entered,
+                                  double tolerance) const;
   /// First crossing of the vertical ray from `point` (down or up) with the surface: the point
   /// and the outward normal of its face. False when the ray misses the needle.
   bool vertical_hit(const Eigen::Vector3d& point, bool downward, Eigen::Vector3d* hit,

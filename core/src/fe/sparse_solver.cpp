@@ -221,6 +221,7 @@ struct SparseSolver::Impl {
   Cholesky cholesky;
   Indefinite indefinite;
   bool indefinite_analyzed = false;
+  bool indefinite_fallback = true;  // set_indefinite_fallback
   Eigen::Index rows = -1;
   Eigen::Index nonzeros = -1;
   int analyses = 0;
@@ -432,6 +433,10 @@ void SparseSolver::factorize(const Eigen::SparseMatrix<double>& input) {
 #endif
     return;
   }
+  if (!impl_->indefinite_fallback) {
+    impl_->active = Active::None;
+    return;
+  }
   // Not positive definite (e.g. a hyperelastic tangent past a limit point): LDLT still
   // factorises symmetric indefinite matrices with a nonsingular leading-minor sequence. It gets
   // P K Pᵀ, the Cholesky's fill-reducing order.
@@ -524,6 +529,10 @@ double SparseSolver::factor_nonzeros() const {
   if (impl_->active == Active::Cholesky) return impl_->cholesky.common().lnz;
 #endif
   return 0.0;
+}
+
+void SparseSolver::set_indefinite_fallback(bool on) {
+  impl_->indefinite_fallback = on;
 }
 
 void SparseSolver::set_trailing_nodes(std::vector<int> nodes) {

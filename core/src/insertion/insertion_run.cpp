@@ -258,6 +258,7 @@ PreResult run_3d(const RunPlan& plan, const std::vector<PreparedNeedle>& needles
     plan.seconds->contact_s += r.timing.contact_s;
     plan.seconds->stress_s += r.timing.stress_s;
     plan.seconds->factorizations += r.timing.factorizations;
+    plan.seconds->shifted_factorizations += r.timing.shifted_factorizations;
   }
   PreResult out;
   out.needles.resize(needles.size());

@@ -69,3 +69,37 @@ TEST(NeedleShape, OnlyAFlatEndHasAFaceAtItsFirstContact) {
 }
 
 }  // namespace
+
+// Sticking contact holds a node on the face that swept over it (docs/model.md, "Contact with
+// the rigid needle (sticking)"): under a bevel that is the face right below it. A node pressed
+// sideways into the shaft, 88 um above the bevel face (paper A's sharp bevel in neo-Hookean
+// silicone at 195.8 um), is held where it entered the wall instead of 88 um lower; the node at
+// the tip, on the wall, is held at the tip in both readings.
+TEST(NeedleShape, ANodeEnteringTheShaftSidewaysIsHeldWhereItEnteredNotOnTheBevelBelow) {
+  const double radius = 115e-6;
+  const double slope = 1.0 / std::tan(std::numbers::pi / 6.0);
+  const NeedleShape bevel(mneedle::test::bevel_needle(radius, std::numbers::pi / 6.0, 1e-3));
+  const double tolerance = 1.15e-6;  // the group length of paper A's needles
+  // Just above the bevel face: the face below, 0.1 um down (its vertical projection).
+  const Eigen::Vector3d over_face(-50e-6, 0.0, 65e-6 * slope + 0.1e-6);
+  const Eigen::Vector3d swept = bevel.sticking_anchor(over_face, over_face, tolerance);
+  EXPECT_NEAR(swept.x(), over_face.x(), 1e-12);
+  EXPECT_NEAR(swept.z(), 65e-6 * slope, 1e-12);  // round-off of the ray and the face (1e-12 m)
+  // Inside the wall on a generator (where the 48-gon has the full radius), 88 um above the face.
+  const double angle = 2.0 * std::numbers::pi * 3.0 / 48.0;
+  const Eigen::Vector3d side(std::cos(angle), std::sin(angle), 0.0);
+  const double face = (radius * side.x() + radius) * slope;
+  const Eigen::Vector3d pressed = (radius - 0.2e-6) * side + Eigen::Vector3d(0, 0, face + 88e-6);
+  const Eigen::Vector3d entered = (radius - 0.01e-6) * side + Eigen::Vector3d(0, 0, face + 87.9e-6);
+  const Eigen::Vector3d held = bevel.sticking_anchor(pressed, entered, tolerance);
+  EXPECT_NEAR(held.z(), entered.z(), 1e-9);  // on the wall beside where it entered
+  EXPECT_LT((held - entered).norm(), 0.02e-6);
+  // The old anchor, the bevel face below: the fan of facets lies up to
+  // R (1 - cos(pi/48)) slope = 0.43 um off the plane near the rim.
+  EXPECT_NEAR(bevel.lower_surface_below(pressed).z(), face, 0.5e-6);
+  // The tip's node on the wall, 10 um up after the first step, entered at the tip.
+  const Eigen::Vector3d at_tip(-radius, 0.0, 10e-6);
+  const Eigen::Vector3d tip_hold =
+      bevel.sticking_anchor(at_tip, Eigen::Vector3d(-radius, 0.0, 0.0), tolerance);
+  EXPECT_LT((tip_hold - Eigen::Vector3d(-radius, 0.0, 0.0)).norm(), 1e-12);
+}

@@ -92,6 +92,27 @@ TEST(SparseSolver, FallsBackToLdltForIndefiniteMatrix) {
   EXPECT_LT((matrix * solver.solve(rhs) - rhs).norm(), 1e-8);
 }
 
+// Without the fallback an indefinite matrix is reported at once (a caller that shifts it does
+// not pay for a factorisation it would discard); the next positive definite one factorises, and
+// turning the fallback back on brings LDLT back.
+TEST(SparseSolver, WithoutTheFallbackAnIndefiniteMatrixIsReportedNotFactorised) {
+  const SpMat indefinite = shifted_laplacian(40, -0.5);
+  mneedle::fe::SparseSolver solver;
+  solver.set_indefinite_fallback(false);
+  solver.factorize(indefinite);
+  EXPECT_FALSE(solver.ok());
+  EXPECT_EQ(solver.backend(), "none");
+  EXPECT_THROW(solver.solve(Eigen::VectorXd::Ones(40)), mneedle::SolverError);
+  const SpMat definite = shifted_laplacian(40, 0.5);
+  solver.factorize(definite);
+  ASSERT_TRUE(solver.ok());
+  EXPECT_NE(solver.backend(), "eigen-simplicial-ldlt");
+  solver.set_indefinite_fallback(true);
+  solver.factorize(indefinite);
+  ASSERT_TRUE(solver.ok());
+  EXPECT_EQ(solver.backend(), "eigen-simplicial-ldlt");
+}
+
 // The LDLT fallback needs about as much again as the factor that failed: when that does not fit
 // it is refused before Eigen allocates it (docs/performance.md, "Memory").
 TEST(SparseSolver, AnLdltFallbackThatCannotFitIsRefusedBeforeItIsAllocated) {

@@ -73,6 +73,8 @@ struct Timing3d {
   double stress_s = 0.0;   ///< simulate_3d: the stress criterion's probe (PeakStressProbe)
   double total_s = 0.0;
   int factorizations = 0;
+  /// Factorisations of a shifted tangent (past a bifurcation, docs/model.md "Solver").
+  int shifted_factorizations = 0;
 };
 
 /// Solver choices of one Indentation3d.

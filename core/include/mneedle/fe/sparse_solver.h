@@ -46,6 +46,10 @@ class SparseSolver {
   bool ordered_by_node() const;
   /// Nonzeros of the last CHOLMOD Cholesky factor (its fill); 0 for the other factorisations.
   double factor_nonzeros() const;
+  /// Whether a failed Cholesky falls back to LDLᵀ (on, the default). Off, a matrix that is not
+  /// positive definite leaves ok() false at once: a caller that shifts the matrix and tries again
+  /// (docs/model.md, "Solver") does not pay for a simplicial factorisation it would discard.
+  void set_indefinite_fallback(bool on);
 
   /// Nodes whose dofs the factorisation eliminates last, in this order (docs/performance.md,
   /// "The contact block"): the factor's trailing block is then the dense Cholesky factor of K's

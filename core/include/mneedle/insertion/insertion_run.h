@@ -157,6 +157,7 @@ struct RunSeconds {
   double contact_s = 0.0;          ///< of the 3-D runs: capture, compliance columns, contact
   double stress_s = 0.0;           ///< of the 3-D runs: the stress criterion's probe
   int factorizations = 0;          ///< of the 3-D runs
+  int shifted_factorizations = 0;  ///< of the 3-D runs: past a bifurcation (docs/model.md)
   int fe_runs = 0;                 ///< FE runs (3-D and axisymmetric) started
 };
 
