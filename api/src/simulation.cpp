@@ -216,8 +216,8 @@ std::vector<std::string> energy_warnings(const InsertionRun& run, const Scene& s
                     "through each other by up to " + format_quantity(overlap, Dimension::Length) +
                     (scene.model.crack_faces == CrackFaces::Free
                          ? std::string(" ([model] crack_faces = \"free\" leaves them free), ")
-                         : std::string(" (their contact is modelled with sticking needle contact, "
-                                       "in 3-D for linear tissue only), ")) +
+                         : std::string(" (their contact is modelled with sticking needle contact "
+                                       "only), ")) +
                     "so G is too high (docs/model.md, \"Crack faces in contact\")");
   }
   return out;

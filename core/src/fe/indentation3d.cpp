@@ -111,6 +111,10 @@ constexpr double kContactBlockBudget = 256.0 * 1024 * 1024;
 // than kCrackGapTolerance x the current depth (round-off of the condensed solve is ~1e-16 of it).
 constexpr int kMaxCrackRounds = 100;   // plus four per pair
 constexpr int kCrackBlockRounds = 20;  // rounds that open every pulling pair at once
+// Nonlinear path (augmented Lagrangian): the penalty per pair, kFacePenalty x the pair's mean
+// normal stiffness at u = 0, leaves about a thousandth of an overlap per multiplier update; a
+// closed pair's gap must fall below Newton's tolerance x the depth.
+constexpr double kNonlinearFacePenalty = 1e3;
 constexpr double kCrackGapTolerance = 1e-10;
 // A pair force below -kCrackForceFloor x the largest force of the solve pulls (round-off of a
 // dense solve is ~1e-15 of it).
@@ -201,6 +205,118 @@ struct Indentation3d::Impl {
 
   bool crack_contact() const {
     return pair_contact && !pairs.empty() && model.is_linear() && !frictionless();
+  }
+  // Crack faces held on the nonlinear sticking path: an augmented Lagrangian inside Newton
+  // (docs/model.md, "Crack faces in contact"), as in the axisymmetric model. Per pair: held or
+  // not, its multiplier (N, < 0 pressing), its penalty (N/m); within one depth, the pairs opened
+  // for pulling and those latched closed after overlapping again.
+  std::vector<char> pair_closed;
+  Eigen::VectorXd pair_multiplier;
+  Eigen::VectorXd pair_penalty;
+  std::vector<char> pair_pulled_open, pair_latched;
+  bool nonlinear_pairs() const {
+    return pair_contact && !pairs.empty() && !model.is_linear() && !frictionless();
+  }
+
+  // The held pairs' term of the potential, sum of lambda g + k g^2 / 2 (J), its gradient added to
+  // `force` and its Hessian to `tangent` (either may be null).
+  double add_pair_terms(const Eigen::VectorXd& at, Eigen::SparseMatrix<double>* tangent,
+                        Eigen::VectorXd* force) const {
+    if (!nonlinear_pairs()) return 0.0;
+    double total = 0.0;
+    for (std::size_t p = 0; p < pairs.size(); ++p) {
+      if (!pair_closed[p]) continue;
+      const auto i = static_cast<Eigen::Index>(p);
+      const CrackFacePair& pair = pairs[p];
+      const double g = gap_of(p, at);
+      const double t = pair_multiplier[i] + pair_penalty[i] * g;
+      total += pair_multiplier[i] * g + 0.5 * pair_penalty[i] * g * g;
+      if (force) {
+        force->segment<3>(3 * pair.positive_node) += t * pair.normal;
+        force->segment<3>(3 * pair.negative_node) -= t * pair.normal;
+      }
+      if (tangent) {
+        const Eigen::Matrix3d block = pair_penalty[i] * pair.normal * pair.normal.transpose();
+        model.add_block(pair.positive_node, pair.positive_node, block, tangent);
+        model.add_block(pair.negative_node, pair.negative_node, block, tangent);
+        model.add_block(std::max(pair.positive_node, pair.negative_node),
+                        std::min(pair.positive_node, pair.negative_node), -block, tangent);
+      }
+    }
+    return total;
+  }
+
+  // Penalties from the tangent at u = 0 (`stiffness` holds the coupled pattern).
+  void set_pair_penalties() {
+    Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.dof_count());
+    Eigen::VectorXd force;
+    model.assemble(zero, &stiffness, &force);
+    const auto normal_stiffness = [&](int node, const Eigen::Vector3d& n) {
+      double sum = 0.0;
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          sum +=
+              n[a] * n[b] * stiffness.coeff(3 * node + std::max(a, b), 3 * node + std::min(a, b));
+      return sum;
+    };
+    pair_penalty.resize(static_cast<Eigen::Index>(pairs.size()));
+    for (std::size_t p = 0; p < pairs.size(); ++p)
+      pair_penalty[static_cast<Eigen::Index>(p)] =
+          kNonlinearFacePenalty * 0.5 *
+          (normal_stiffness(pairs[p].positive_node, pairs[p].normal) +
+           normal_stiffness(pairs[p].negative_node, pairs[p].normal));
+  }
+
+  enum class PairUpdate { Settled, Multipliers, Set };
+  // One update of the held pairs after a converged solve at `at_depth` (as the axisymmetric
+  // stepper's): closed pairs that pull open, all at once for the first kCrackBlockRounds rounds
+  // and then the one pulled hardest; when none pulls, each closed pair's multiplier takes its
+  // force (Uzawa) and open pairs that overlap close. Set: a pair opened or closed; Multipliers:
+  // only multipliers moved, because a closed pair still overlaps or gapes by more than the
+  // tolerance; Settled: neither.
+  PairUpdate update_pairs(double at_depth, int round) {
+    const double tolerance = options.tolerance * std::max(at_depth, 1e-12);
+    const auto count = static_cast<Eigen::Index>(pairs.size());
+    Eigen::VectorXd t = Eigen::VectorXd::Zero(count), gaps(count);
+    for (Eigen::Index i = 0; i < count; ++i) {
+      gaps[i] = gap_of(static_cast<std::size_t>(i), u);
+      if (pair_closed[static_cast<std::size_t>(i)])
+        t[i] = pair_multiplier[i] + pair_penalty[i] * gaps[i];
+    }
+    const double floor = options.tolerance * t.lpNorm<Eigen::Infinity>();
+    Eigen::Index worst = -1;
+    for (Eigen::Index i = 0; i < count; ++i) {
+      const auto p = static_cast<std::size_t>(i);
+      if (pair_closed[p] && !pair_latched[p] && t[i] > floor && (worst < 0 || t[i] > t[worst]))
+        worst = i;
+    }
+    if (worst >= 0) {
+      for (Eigen::Index i = 0; i < count; ++i) {
+        const auto p = static_cast<std::size_t>(i);
+        if (pair_closed[p] && !pair_latched[p] && t[i] > floor &&
+            (round < kCrackBlockRounds || i == worst)) {
+          pair_closed[p] = 0;
+          pair_multiplier[i] = 0.0;
+          pair_pulled_open[p] = 1;
+        }
+      }
+      return PairUpdate::Set;
+    }
+    bool moved = false, changed = false;
+    for (Eigen::Index i = 0; i < count; ++i) {
+      const auto p = static_cast<std::size_t>(i);
+      if (pair_closed[p]) {
+        pair_multiplier[i] = t[i];
+        moved = moved || std::abs(gaps[i]) > tolerance;
+      } else if (gaps[i] < -tolerance) {
+        pair_closed[p] = 1;
+        pair_multiplier[i] = 0.0;
+        // Pulls when closed, overlaps when open: it stays closed, pulling a little.
+        if (pair_pulled_open[p]) pair_latched[p] = 1;
+        changed = true;
+      }
+    }
+    return changed ? PairUpdate::Set : moved ? PairUpdate::Multipliers : PairUpdate::Settled;
   }
   // Gap of pair p in the displacement field `field` (full length, or any vector indexed by dof).
   double gap_of(std::size_t p, Eigen::Ref<const Eigen::VectorXd> field) const {
@@ -811,6 +927,7 @@ struct Indentation3d::Impl {
     const auto start = Clock::now();
     Eigen::VectorXd force;
     model.assemble(at, nullptr, &force);
+    add_pair_terms(at, nullptr, &force);
     timing.assembly_s += seconds_since(start);
     return force;
   }
@@ -869,7 +986,8 @@ struct Indentation3d::Impl {
   Eigen::VectorXd assemble_force(bool with_tangent, double* energy = nullptr) {
     const auto start = Clock::now();
     Eigen::VectorXd force;
-    const double e = model.assemble(u, with_tangent ? &stiffness : nullptr, &force);
+    const double e = model.assemble(u, with_tangent ? &stiffness : nullptr, &force) +
+                     add_pair_terms(u, with_tangent ? &stiffness : nullptr, &force);
     if (energy != nullptr) *energy = e;
     timing.assembly_s += seconds_since(start);
     return force;
@@ -927,7 +1045,8 @@ struct Indentation3d::Impl {
       try {
         const auto start = Clock::now();
         Eigen::VectorXd force;
-        const double energy = model.assemble(trial, nullptr, &force);
+        const double energy =
+            model.assemble(trial, nullptr, &force) + add_pair_terms(trial, nullptr, &force);
         timing.assembly_s += seconds_since(start);
         if (energy < start_energy || halving == kMaxLineSearchHalvings) {
           u = trial;
@@ -1010,8 +1129,13 @@ struct Indentation3d::Impl {
   // takes them as they come.
   int solve_nonlinear_at(double at_depth, double from_depth, const Eigen::VectorXd& from_u) {
     int total = 0;
+    pair_pulled_open.assign(pairs.size(), 0);
+    pair_latched.assign(pairs.size(), 0);
+    int pair_round = 0;
+    const int pair_rounds = kMaxCrackRounds + 4 * static_cast<int>(pairs.size());
     for (int round = 0; round < kMaxCaptureRounds; ++round) {
-      total += newton(at_depth);
+      const int used = newton(at_depth);
+      total += used;
       const auto start = Clock::now();
       auto found = find_new_captures(
           at_depth, [&](int node) -> Eigen::Vector3d { return u.segment<3>(3 * node); });
@@ -1040,7 +1164,20 @@ struct Indentation3d::Impl {
         found = std::move(kept);
       }
       timing.contact_s += seconds_since(start);
-      if (found.empty()) return total;
+      if (found.empty()) {
+        if (!nonlinear_pairs()) return total;
+        // The crack's faces once the captures settled; multipliers that Newton absorbed
+        // without an iteration are within its tolerance.
+        const PairUpdate update = update_pairs(at_depth, pair_round);
+        if (update == PairUpdate::Settled ||
+            (update == PairUpdate::Multipliers && used == 0 && pair_round > 0))
+          return total;
+        if (++pair_round > pair_rounds)
+          throw SolverError("crack-face contact did not settle at depth " + micrometres(at_depth));
+        if (update == PairUpdate::Set) factor_constraints.clear();  // another tangent
+        --round;  // a pair round is not a capture round
+        continue;
+      }
       add_captures(found);
     }
     throw SolverError("contact set did not settle");
@@ -1049,7 +1186,18 @@ struct Indentation3d::Impl {
   int advance_nonlinear(double target) {
     if (u.size() == 0) {
       u = Eigen::VectorXd::Zero(model.dof_count());
+      if (nonlinear_pairs()) {
+        std::vector<std::array<int, 2>> coupled;
+        for (const CrackFacePair& pair : pairs)
+          coupled.push_back({pair.positive_node, pair.negative_node});
+        model.couple_nodes(coupled);
+      }
       stiffness = model.empty_stiffness();
+      if (nonlinear_pairs()) {
+        set_pair_penalties();
+        pair_closed.assign(pairs.size(), 0);
+        pair_multiplier = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(pairs.size()));
+      }
       solver.analyze(stiffness);
     }
     if (step <= 0.0) step = target - depth;
@@ -1061,6 +1209,15 @@ struct Indentation3d::Impl {
       const std::size_t saved_captured = captured.size();
       const std::vector<double> saved_multipliers =
           frictionless() ? multipliers_of() : std::vector<double>{};
+      const std::vector<char> saved_closed = pair_closed;
+      const Eigen::VectorXd saved_pair_multiplier = pair_multiplier;
+      // Undoes the held crack faces with the step; a factor with other held pairs is not kept.
+      const auto restore_pairs = [&]() {
+        if (!nonlinear_pairs()) return;
+        if (pair_closed != saved_closed) factor_constraints.clear();
+        pair_closed = saved_closed;
+        pair_multiplier = saved_pair_multiplier;
+      };
       try {
         const int used = frictionless() ? solve_frictionless_nonlinear_at(depth + h)
                                         : solve_nonlinear_at(depth + h, depth, saved_u);
@@ -1073,12 +1230,14 @@ struct Indentation3d::Impl {
       } catch (const CaptureEvent& event) {
         // The step ends where its first capture enters: not a failure, no cut counted.
         u = saved_u;
+        restore_pairs();
         for (std::size_t i = saved_captured; i < captured.size(); ++i)
           captured_by[static_cast<std::size_t>(captured[i].node)] = -1;
         captured.resize(saved_captured);
         step = event.depth - depth;
       } catch (const SolverError& error) {
         u = saved_u;
+        restore_pairs();
         if (frictionless()) contact->set_multipliers(saved_multipliers);
         for (std::size_t i = saved_captured; i < captured.size(); ++i)
           captured_by[static_cast<std::size_t>(captured[i].node)] = -1;
@@ -1479,7 +1638,9 @@ struct Indentation3d::Impl {
         gaps(static_cast<Eigen::Index>(p)) = gap_of(p, u_now);
     }
     step->crack_face_overlap_m = std::max(0.0, -gaps.minCoeff());
-    step->crack_face_contacts = static_cast<int>(active_pairs.size());
+    step->crack_face_contacts =
+        nonlinear_pairs() ? static_cast<int>(std::count(pair_closed.begin(), pair_closed.end(), 1))
+                          : static_cast<int>(active_pairs.size());
   }
 
   Step3d report(double at_depth, int solves) {

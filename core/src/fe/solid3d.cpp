@@ -229,15 +229,34 @@ SolidModel::SolidModel(const TetMesh& mesh) : mesh_(&mesh) {
                   nb = element[static_cast<std::size_t>(b)];
         if (na >= nb) lower[static_cast<std::size_t>(nb)].push_back(na);
       }
-  adjacency_start_.assign(static_cast<std::size_t>(node_count) + 1, 0);
-  for (int node = 0; node < node_count; ++node) {
-    auto& list = lower[static_cast<std::size_t>(node)];
+  set_adjacency(lower);
+}
+
+void SolidModel::set_adjacency(std::vector<std::vector<int>>& lower) {
+  adjacency_start_.assign(lower.size() + 1, 0);
+  adjacency_.clear();
+  for (std::size_t node = 0; node < lower.size(); ++node) {
+    auto& list = lower[node];
     std::sort(list.begin(), list.end());
     list.erase(std::unique(list.begin(), list.end()), list.end());
-    adjacency_start_[static_cast<std::size_t>(node) + 1] =
-        adjacency_start_[static_cast<std::size_t>(node)] + static_cast<int>(list.size());
+    adjacency_start_[node + 1] = adjacency_start_[node] + static_cast<int>(list.size());
     adjacency_.insert(adjacency_.end(), list.begin(), list.end());
   }
+}
+
+void SolidModel::couple_nodes(const std::vector<std::array<int, 2>>& pairs) {
+  const int node_count = static_cast<int>(mesh_->nodes.size());
+  std::vector<std::vector<int>> lower(static_cast<std::size_t>(node_count));
+  for (int node = 0; node < node_count; ++node)
+    lower[static_cast<std::size_t>(node)].assign(
+        adjacency_.begin() + adjacency_start_[static_cast<std::size_t>(node)],
+        adjacency_.begin() + adjacency_start_[static_cast<std::size_t>(node) + 1]);
+  for (const auto& [a, b] : pairs) {
+    if (a < 0 || b < 0 || a >= node_count || b >= node_count)
+      throw InputError("3-D solid: coupled node out of range");
+    lower[static_cast<std::size_t>(std::min(a, b))].push_back(std::max(a, b));
+  }
+  set_adjacency(lower);
 }
 
 Eigen::SparseMatrix<double> SolidModel::empty_stiffness() const {

@@ -837,6 +837,42 @@ TEST(Indentation3d, TheLookAheadOfThePunchsTipStressChangesNoStepAndHonoursTheSt
   EXPECT_EQ(stopped.steps[1].needles[0].tip_stress_Pa, ahead.steps[1].needles[0].tip_stress_Pa);
 }
 
+// Paper A's silicone (E 0.2 MPa, nu 0.49) under a 30 deg bevel of radius 115 um, with a crack
+// 100 um deep under its tip (11 node pairs on the faces): both meshes, the pairs (normal x) and
+// each cracked node's node in the intact mesh.
+struct CrackUnderBevel {
+  TetMesh mesh, cracked;
+  std::vector<int> original;
+  std::vector<CrackFacePair> pairs;
+};
+CrackUnderBevel crack_under_bevel(MaterialModel material, double depth) {
+  const double R = 115e-6;
+  TissueBlockSpec spec = homogeneous_block(material, 0.2e6, 0.49, 450e-6, 450e-6);
+  spec.sites = {{0.0, 0.0, R, Eigen::Vector2d(-R, 0.0)}};
+  spec.fidelity = Fidelity::Fast;
+  spec.overrides.tip_size_m = 60e-6;
+  spec.insertion_depth = depth;
+  spec.half_y = true;
+  CrackUnderBevel c;
+  c.mesh = generate_tissue_mesh(spec);
+  PlanarCrack crack;
+  crack.origin_m = crack_origin_under(c.mesh, {0.0, 0.0}, {-R, 0.0});
+  crack.depth_m = 100e-6;
+  c.cracked = crack_mesh(c.mesh, crack, nullptr, &c.original);
+  for (std::size_t n = c.mesh.nodes.size(); n < c.cracked.nodes.size(); ++n)
+    c.pairs.push_back({c.original[n], static_cast<int>(n), Eigen::Vector3d::UnitX()});
+  return c;
+}
+
+// The largest internal force at a face node below the surface (there, the contact force on it).
+double largest_face_force(const CrackUnderBevel& c, const Eigen::VectorXd& force) {
+  double largest = 0.0;
+  for (const CrackFacePair& p : c.pairs)
+    if (c.cracked.nodes[static_cast<std::size_t>(p.positive_node)].z() < 0.0)
+      largest = std::max(largest, force.segment<3>(3 * p.positive_node).norm());
+  return largest;
+}
+
 // Crack faces in contact (docs/model.md, "Crack faces in contact"). A bevel pushes the tissue
 // beside its tip sideways, so the crack under the tip closes on one side: with free faces the
 // two faces pass through each other by micrometres. In contact they must not, at any node pair
@@ -845,22 +881,12 @@ TEST(Indentation3d, TheLookAheadOfThePunchsTipStressChangesNoStepAndHonoursTheSt
 // only stiffen the cracked block, so U_free <= U_contact <= U_intact.
 TEST(Indentation3d, CrackFacesUnderABevelDoNotPassThroughEachOther) {
   const double R = 115e-6, depth = 150e-6, tolerance = 1e-13;  // m; see below for the tolerance
-  TissueBlockSpec spec = homogeneous_block(MaterialModel::Linear, 0.2e6, 0.49, 450e-6, 450e-6);
-  spec.sites = {{0.0, 0.0, R, Eigen::Vector2d(-R, 0.0)}};
-  spec.fidelity = Fidelity::Fast;
-  spec.overrides.tip_size_m = 60e-6;  // 11 node pairs on the crack's faces
-  spec.insertion_depth = depth;
-  spec.half_y = true;
-  const TetMesh mesh = generate_tissue_mesh(spec);
-  PlanarCrack crack;
-  crack.origin_m = crack_origin_under(mesh, {0.0, 0.0}, {-R, 0.0});
-  ASSERT_EQ(crack.origin_m.x(), -R);  // under the tip, not through the axis
-  crack.depth_m = 100e-6;
-  std::vector<int> original;
-  const TetMesh cracked = crack_mesh(mesh, crack, nullptr, &original);
-  std::vector<CrackFacePair> pairs;
-  for (std::size_t n = mesh.nodes.size(); n < cracked.nodes.size(); ++n)
-    pairs.push_back({original[n], static_cast<int>(n), Eigen::Vector3d::UnitX()});
+  const CrackUnderBevel c = crack_under_bevel(MaterialModel::Linear, depth);
+  const TetMesh& mesh = c.mesh;
+  const TetMesh& cracked = c.cracked;
+  const std::vector<int>& original = c.original;
+  const std::vector<CrackFacePair>& pairs = c.pairs;
+  ASSERT_EQ(crack_origin_under(mesh, {0.0, 0.0}, {-R, 0.0}).x(), -R);  // under the tip
   ASSERT_GT(pairs.size(), 8U);
   const std::vector<Needle3d> bevel = {
       {"bevel", bevel_needle(R, std::numbers::pi / 6, 1e-3), 0.0, 0.0}};
@@ -902,10 +928,7 @@ TEST(Indentation3d, CrackFacesUnderABevelDoNotPassThroughEachOther) {
     // surface is the contact force on it (mouth nodes on z = 0 may also carry the needle's).
     Eigen::VectorXd force;
     model.assemble(u, nullptr, &force);
-    double largest = 0.0;
-    for (const CrackFacePair& p : pairs)
-      if (cracked.nodes[static_cast<std::size_t>(p.positive_node)].z() < 0.0)
-        largest = std::max(largest, force.segment<3>(3 * p.positive_node).norm());
+    const double largest = largest_face_force(c, force);
     ASSERT_GT(largest, 0.0);
     // Round-off of an assembled force: 1e-9 of the largest contact force.
     const double floor = 1e-9 * largest;
@@ -925,6 +948,62 @@ TEST(Indentation3d, CrackFacesUnderABevelDoNotPassThroughEachOther) {
       if (gaps[k] > tolerance) {
         EXPECT_NEAR(plus.x(), 0.0, floor) << "open pair " << k;
       }
+      pressed += plus.x() > floor;
+    }
+    EXPECT_GT(pressed, 0) << "at " << at;
+    EXPECT_LT(free_step.strain_energy_J, step.strain_energy_J) << "at " << at;
+    EXPECT_LT(step.strain_energy_J, intact_energy) << "at " << at;
+  }
+}
+
+// The same on neo-Hookean tissue (paper A's silicone as neo-Hookean), where the faces are held
+// by an augmented Lagrangian inside Newton (docs/model.md, "Crack faces in contact"): free faces
+// overlap by micrometres, held ones by no more than the multiplier update's tolerance (Newton's
+// 1e-8 x the depth, 1.5e-12 m at 150 um); the held pairs press (a pair latched closed may pull by
+// up to that tolerance x the largest pair force, so the floor is 1e-6 of the largest); and the
+// held faces stiffen the cracked block, U_free < U_held < U_intact, so G_held < G_free.
+// (Measured: three pairs below the surface pressed, 15-39 uN; free faces overlap by > 1 um.)
+TEST(Indentation3d, NeoHookeanCrackFacesUnderABevelDoNotPassThroughEachOther) {
+  const double R = 115e-6, depth = 150e-6;
+  const CrackUnderBevel c = crack_under_bevel(MaterialModel::NeoHookean, depth);
+  const TetMesh& cracked = c.cracked;
+  const std::vector<CrackFacePair>& pairs = c.pairs;
+  const std::vector<Needle3d> bevel = {
+      {"bevel", bevel_needle(R, std::numbers::pi / 6, 1e-3), 0.0, 0.0}};
+  Indentation3d intact(c.mesh, bevel, depth);
+  Indentation3d free_twin(cracked, bevel, depth), twin(cracked, bevel, depth);
+  free_twin.hold_contact_of(intact, c.original);
+  free_twin.set_crack_faces(pairs, false);
+  twin.hold_contact_of(intact, c.original);
+  twin.set_crack_faces(pairs, true);
+  const SolidModel model(cracked);
+  const double tolerance = 1e-8 * depth;
+  // At the full depth only: at half of it only the crack's mouth is held (measured).
+  for (double at : {depth}) {
+    const double intact_energy = intact.advance_to(at).strain_energy_J;
+    const Step3d free_step = free_twin.advance_to(at);
+    EXPECT_GT(free_step.crack_face_overlap_m, 1e-6) << "at " << at;
+    const Step3d step = twin.advance_to(at);
+    const Eigen::VectorXd u = twin.displacement();
+    double smallest = 0.0;
+    for (const CrackFacePair& p : pairs)
+      smallest = std::min(smallest, u(3 * p.positive_node) - u(3 * p.negative_node));
+    EXPECT_GE(smallest, -tolerance) << "at " << at;
+    EXPECT_LE(step.crack_face_overlap_m, tolerance);
+    EXPECT_GT(step.crack_face_contacts, 0);
+    // The held pairs' forces from the field: the internal force at a face node below the
+    // surface is the contact force on it.
+    Eigen::VectorXd force;
+    model.assemble(u, nullptr, &force);
+    const double largest = largest_face_force(c, force);
+    ASSERT_GT(largest, 0.0);
+    const double floor = 1e-6 * largest;
+    int pressed = 0;
+    for (const CrackFacePair& p : pairs) {
+      if (cracked.nodes[static_cast<std::size_t>(p.positive_node)].z() == 0.0) continue;
+      const Eigen::Vector3d plus = force.segment<3>(3 * p.positive_node);
+      EXPECT_GE(plus.x(), -floor) << "the contact pulls";
+      EXPECT_NEAR(plus.x() + force(3 * p.negative_node), 0.0, floor);
       pressed += plus.x() > floor;
     }
     EXPECT_GT(pressed, 0) << "at " << at;

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Sparse>
+#include <array>
 #include <vector>
 
 #include "mneedle/fe/material.h"
@@ -44,13 +45,18 @@ class SolidModel {
 
   /// Lower-triangle sparse matrix with the model's fixed pattern and zero values.
   Eigen::SparseMatrix<double> empty_stiffness() const;
+  /// Adds the blocks coupling each pair of nodes to the pattern (two nodes that share no
+  /// element: a crack's opposite faces held in contact), so that add_block() may write them.
+  /// Matrices from empty_stiffness() before the call do not have them.
+  void couple_nodes(const std::vector<std::array<int, 2>>& pairs);
   /// Fills `stiffness` (from empty_stiffness()) and the internal force; returns strain energy.
   /// Throws SolverError for an inverted element.
   double assemble(const Eigen::VectorXd& u, Eigen::SparseMatrix<double>* stiffness,
                   Eigen::VectorXd* internal_force) const;
   double strain_energy(const Eigen::VectorXd& u) const;
   /// Adds `block` at rows of node `row`, columns of node `column` (row >= column, both in one
-  /// element) of a matrix from empty_stiffness(): for contact terms on top of the tangent.
+  /// element, or coupled by couple_nodes) of a matrix from empty_stiffness(): for contact terms
+  /// on top of the tangent.
   void add_block(int row, int column, const Eigen::Matrix3d& block,
                  Eigen::SparseMatrix<double>* stiffness) const;
   std::vector<double> von_mises(const Eigen::VectorXd& u) const;
@@ -60,6 +66,8 @@ class SolidModel {
   std::vector<double> energy_density(const Eigen::VectorXd& u) const;
 
  private:
+  // Sorts and deduplicates each node's lower neighbours and stores them (adjacency_).
+  void set_adjacency(std::vector<std::vector<int>>& lower);
   std::vector<Eigen::Vector3d> element_nodes(int element) const;
   Eigen::VectorXd element_displacement(int element, const Eigen::VectorXd& u) const;
   template <typename ElementMatrix>
