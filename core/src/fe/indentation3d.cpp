@@ -78,6 +78,8 @@ constexpr int kMaxNewtonIterations = 40;
 // onto the stable branch, and the fourfold shifts tried per factorisation.
 constexpr int kMaxDescentIterations = 200;
 constexpr int kMaxShifts = 20;
+// Relative round-off of an assembled strain energy (a sum over elements): Impl::descend.
+constexpr double kEnergyRoundOff = 1e-12;
 constexpr int kMaxLineSearchHalvings = 6;
 constexpr int kMaxStepCuts = 12;
 // Frictionless contact: Uzawa updates of the multipliers until no nodal contact force changes by
@@ -433,7 +435,9 @@ struct Indentation3d::Impl {
       for (std::size_t n = 0; n < needles.size(); ++n) {
         const Eigen::Vector3d local = x - tip(static_cast<int>(n), at_depth);
         if (local.head<2>().norm() > reach[n] || !shapes[n].touches(local)) continue;
-        found.push_back({node, static_cast<int>(n), anchor_of(static_cast<int>(n), local, local)});
+        // Where it entered is not known here: the face below (the nonlinear path re-anchors
+        // its captures with their entry points, the linear path's capture event likewise).
+        found.push_back({node, static_cast<int>(n), shapes[n].lower_surface_below(local)});
         break;
       }
     }
@@ -1048,7 +1052,10 @@ struct Indentation3d::Impl {
         const double energy =
             model.assemble(trial, nullptr, &force) + add_pair_terms(trial, nullptr, &force);
         timing.assembly_s += seconds_since(start);
-        if (energy < start_energy || halving == kMaxLineSearchHalvings) {
+        // Near equilibrium a step lowers the energy by about the squared relative residual,
+        // below the round-off of summing element energies: within that it is no rise.
+        if (energy < start_energy + kEnergyRoundOff * std::abs(start_energy) ||
+            halving == kMaxLineSearchHalvings) {
           u = trial;
           bifurcated = true;
           return free_part(force, constrained).norm();
@@ -1210,6 +1217,7 @@ struct Indentation3d::Impl {
       const std::vector<double> saved_multipliers =
           frictionless() ? multipliers_of() : std::vector<double>{};
       const std::vector<char> saved_closed = pair_closed;
+      const bool saved_bifurcated = bifurcated;
       const Eigen::VectorXd saved_pair_multiplier = pair_multiplier;
       // Undoes the held crack faces with the step; a factor with other held pairs is not kept.
       const auto restore_pairs = [&]() {
@@ -1238,6 +1246,7 @@ struct Indentation3d::Impl {
       } catch (const SolverError& error) {
         u = saved_u;
         restore_pairs();
+        bifurcated = saved_bifurcated;  // the undone step's descent does not count
         if (frictionless()) contact->set_multipliers(saved_multipliers);
         for (std::size_t i = saved_captured; i < captured.size(); ++i)
           captured_by[static_cast<std::size_t>(captured[i].node)] = -1;
@@ -1762,7 +1771,8 @@ void Indentation3d::hold_contact_of(const Indentation3d& leader, std::vector<int
 }
 
 void Indentation3d::set_crack_faces(std::vector<CrackFacePair> pairs, bool contact) {
-  if (impl_->depth > 0.0 || impl_->compliance.cols() > 0 || !impl_->column_cache.empty())
+  if (impl_->depth > 0.0 || impl_->compliance.cols() > 0 || !impl_->column_cache.empty() ||
+      impl_->u.size() > 0)  // the nonlinear path's pattern and pair state are set at its start
     throw InputError("3-D indentation: crack-face contact must be set before the first depth");
   const auto nodes = static_cast<int>(impl_->mesh.nodes.size());
   for (const CrackFacePair& pair : pairs) {
@@ -1902,8 +1912,7 @@ InpExport Indentation3d::write_inp(const std::string& path,
   problem.mesh = &impl_->mesh;
   problem.comment_lines = comment;
   const Eigen::VectorXd u = displacement();
-  Eigen::VectorXd force;
-  impl_->model.assemble(u, nullptr, &force);
+  const Eigen::VectorXd force = impl_->internal_force(u);  // held crack faces' forces included
   InpExport result;
   for (const CapturedNode& c : impl_->captured) {
     problem.prescribed_nodes.push_back(c.node);
