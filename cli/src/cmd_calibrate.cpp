@@ -68,6 +68,7 @@ const char* unit_of(CalibratedConstant c) {
   switch (c) {
     case CalibratedConstant::scale:
     case CalibratedConstant::friction_coefficient:
+    case CalibratedConstant::modulus:
       return "";
     case CalibratedConstant::critical_pressure:
       return "Pa";
@@ -97,7 +98,8 @@ nlohmann::json to_json(const Calibration& c, const Scene& scene, const Calibrate
   nlohmann::json layers = nlohmann::json::array();
   for (std::size_t i = 0; i < c.layer_pressure_scale_Pa.size(); ++i) {
     layers.push_back({{"name", scene.tissue.layers[i].name},
-                      {"pressure_scale_Pa", c.layer_pressure_scale_Pa[i]}});
+                      {"pressure_scale_Pa", c.layer_pressure_scale_Pa[i]},
+                      {"youngs_modulus_Pa", c.layer_youngs_modulus_Pa[i]}});
   }
   nlohmann::json curve = nlohmann::json::array();
   for (std::size_t i = 0; i < c.depth_m.size(); ++i) {
@@ -152,9 +154,14 @@ void print_table(const Calibration& c, const Scene& scene) {
                   << to_string(c.parameters[j].constant) << " " << c.correlation[i][j];
     std::cout << "\n";
   }
-  for (std::size_t i = 0; i < c.layer_pressure_scale_Pa.size(); ++i)
+  for (std::size_t i = 0; i < c.layer_pressure_scale_Pa.size(); ++i) {
     std::cout << "  q " << scene.tissue.layers[i].name << " "
-              << format_quantity(c.layer_pressure_scale_Pa[i], Dimension::Pressure) << "\n";
+              << format_quantity(c.layer_pressure_scale_Pa[i], Dimension::Pressure);
+    if (c.modulus_factor != 1.0) {
+      std::cout << ", E " << format_quantity(c.layer_youngs_modulus_Pa[i], Dimension::Pressure);
+    }
+    std::cout << "\n";
+  }
   std::cout << "fit: " << c.fit.samples << " samples, RMSE " << c.fit.rmse_N * 1e3 << " mN, R^2 "
             << c.fit.r2 << "\n";
   if (c.held_out) {
@@ -248,6 +255,8 @@ void run(const CalibrateArgs& a) {
       }
       if (p.constant == CalibratedConstant::friction_coefficient)
         edits.friction_coefficient = c.friction_coefficient;
+      // A q derived from the modulus is derived again from the written one.
+      if (p.constant == CalibratedConstant::modulus) edits.modulus_factor = c.modulus_factor;
     }
     edits.critical_pressure_Pa = c.critical_pressure_Pa;
     edits.toughness_J_per_m2 = c.toughness_J_per_m2;
@@ -274,8 +283,8 @@ void add_calibrate_command(CLI::App& app) {
   auto a = std::make_shared<CalibrateArgs>();
   CLI::App* cmd = app.add_subcommand(
       "calibrate",
-      "Fit a scene's tissue constants (pressure scale, friction coefficient, P_c or toughness) to "
-      "one measured insertion curve of its needle");
+      "Fit a scene's tissue constants (pressure scale, friction coefficient, P_c or toughness, "
+      "modulus) to one measured insertion curve of its needle");
   cmd->footer(
       "Example:\n  mneedle calibrate my_scene.toml --curve measured.csv --fit "
       "scale,friction_coefficient "
@@ -284,7 +293,8 @@ void add_calibrate_command(CLI::App& app) {
       ->required();
   cmd->add_option("--curve", a->curve, "Measured force-depth curve (CSV)")->required();
   cmd->add_option("--fit", a->fit,
-                  "Constants to fit, comma-separated: scale, friction_coefficient, and "
+                  "Constants to fit, comma-separated: scale, friction_coefficient, modulus (a "
+                  "factor on every layer's stiffness, fitted before the puncture), and "
                   "critical_pressure or toughness")
       ->required();
   cmd->add_option("--out", a->out, "Write the scene with the fitted constants here (TOML)");
@@ -293,7 +303,8 @@ void add_calibrate_command(CLI::App& app) {
                   "Travel at contact, with unit (default: detected from the force)");
   cmd->add_option("--puncture-at", a->puncture_at,
                   "Travel at the measured puncture, with unit, or 'detect' (largest force drop): "
-                  "fit the post-puncture stage only, no finite elements");
+                  "fit the post-puncture stage only, no finite elements (unless modulus is "
+                  "fitted, on the samples before it)");
   cmd->add_option("--fit-range", a->fit_range,
                   "Travel interval to fit, FROM:TO with units (either may be empty); the rest is "
                   "held out and its error reported");

@@ -104,6 +104,44 @@ TEST(CmdCalibrate, RecoversTheConstantsOfACurveForceMadeAndWritesAFittedScene) {
             std::string::npos);
 }
 
+std::string punch_scene(const std::string& modulus) {
+  return "[tissue]\nsize = [\"3 mm\", \"3 mm\", \"3 mm\"]\n[[tissue.layers]]\nname = "
+         "\"silicone\"\nmaterial = { model = \"linear\", E = \"" +
+         modulus +
+         "\", nu = 0.45 }\n[tissue.fracture]\ntoughness = \"19 J/m^2\"\n"
+         "critical_pressure = \"10 GPa\"\n[[needles]]\nname = \"punch\"\n"
+         "geometry = { plugin = \"cylinder\", diameter = \"230 um\", length = \"2.5 mm\" }\n"
+         "[insertion]\ndepth = \"400 um\"\n[model]\nfidelity = \"fast\"\n"
+         "outputs = [\"puncture\", \"force_curve\"]\n";
+}
+
+// `simulate` makes a pre-puncture curve of a flat punch in silicone of 0.5 MPa (P_c so high
+// that nothing fires); calibrate starts from 0.2 MPa. The force scales with the modulus exactly
+// (docs/model.md, "Calibration"), so the factor comes back as 2.5 to the printed digits of the
+// curve (9), and the written scene carries E = 0.5 MPa and reproduces the curve.
+TEST(CmdCalibrate, FitsTheModulusOnTheCurveBeforeThePunctureAndWritesItIntoTheScene) {
+  const CommandRun made =
+      run_mneedle("simulate '" + write("punch_made.toml", punch_scene("0.5 MPa")) + "' --csv");
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  const std::string curve = write("punch_made.csv", made.out);
+  const auto out = kWork / "punch_fitted.toml";
+  const CommandRun run = run_mneedle(
+      "calibrate '" + write("punch.toml", punch_scene("0.2 MPa")) + "' --curve '" + curve +
+      "' --fit modulus --contact-at 0mm --json --out '" + out.string() + "'" + plugins());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  ASSERT_EQ(j["parameters"].size(), 1u);
+  EXPECT_EQ(j["parameters"][0]["name"], "modulus");
+  EXPECT_NEAR(j["parameters"][0]["value"].get<double>(), 2.5, 1e-8 * 2.5);
+  EXPECT_NEAR(j["layers"][0]["youngs_modulus_Pa"].get<double>(), 0.5e6, 1e-8 * 0.5e6);
+  EXPECT_TRUE(j["puncture_depth_m"].is_null());
+  EXPECT_LT(j["fit"]["rmse_N"].get<double>(), 1e-9);
+  const CommandRun again = run_mneedle("simulate '" + out.string() + "' --csv");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  // The same rows, the provenance line apart.
+  EXPECT_EQ(again.out.substr(again.out.find('\n')), made.out.substr(made.out.find('\n')));
+}
+
 TEST(CmdCalibrate, CriticalPressureAndToughnessTogetherAreRefused) {
   const CommandRun run =
       run_mneedle("calibrate '" + write("s.toml", silicone_scene("")) + "' --curve '" +

@@ -110,8 +110,9 @@ CalibratedConstant calibrated_constant(const std::string& name) {
   if (name == "friction_coefficient") return CalibratedConstant::friction_coefficient;
   if (name == "critical_pressure") return CalibratedConstant::critical_pressure;
   if (name == "toughness") return CalibratedConstant::toughness;
+  if (name == "modulus") return CalibratedConstant::modulus;
   fail("--fit " + name +
-       ": unknown constant (scale, friction_coefficient, critical_pressure, toughness)");
+       ": unknown constant (scale, friction_coefficient, critical_pressure, toughness, modulus)");
   return CalibratedConstant::scale;
 }
 
@@ -125,6 +126,8 @@ std::string to_string(CalibratedConstant c) {
       return "critical_pressure";
     case CalibratedConstant::toughness:
       return "toughness";
+    case CalibratedConstant::modulus:
+      return "modulus";
   }
   return "?";
 }
@@ -137,6 +140,7 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
   if (chosen.size() != options.fit.size()) fail("a constant is listed twice in --fit");
   const bool fits_pc = chosen.count(CalibratedConstant::critical_pressure) > 0;
   const bool fits_gamma = chosen.count(CalibratedConstant::toughness) > 0;
+  const bool fits_modulus = chosen.count(CalibratedConstant::modulus) > 0;
   if (fits_pc && fits_gamma) {
     fail(
         "critical_pressure and toughness together: one curve has one puncture, which fixes "
@@ -177,7 +181,8 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     given_puncture_depth = *options.puncture_travel_m - all.contact_travel_m;
   std::vector<std::size_t> used;  // samples the model covers
   for (std::size_t i = 0; i < all.depth_m.size(); ++i) {
-    if (given_puncture_depth && all.depth_m[i] < *given_puncture_depth) continue;
+    // Before a given puncture only the pre-puncture model, run for the modulus, covers them.
+    if (given_puncture_depth && all.depth_m[i] < *given_puncture_depth && !fits_modulus) continue;
     used.push_back(i);
   }
   if (used.size() < options.fit.size() + 2) {
@@ -203,20 +208,29 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
   // run_insertion climbs them: a threshold's puncture is read on the first rung that reaches it.
   std::vector<PreCurve> rungs;
   double scene_threshold = 0.0;
-  if (!given_puncture_depth) {
+  if (!given_puncture_depth || fits_modulus) {
     double deepest = 0.0;
     for (std::size_t i : used) deepest = std::max(deepest, all.depth_m[i]);
+    if (given_puncture_depth) deepest = *given_puncture_depth;
     for (double horizon = kFirstRung_m;; horizon *= 2.0) {
       rungs.push_back(pre_puncture_curve(scene, needle, horizon, options.run));
       if (horizon >= deepest * (1.0 - 1e-12)) break;
     }
-    if (!fits_pc && !fits_gamma) scene_threshold = puncture_threshold(scene, criterion).threshold;
+    if (!given_puncture_depth && !fits_pc && !fits_gamma)
+      scene_threshold = puncture_threshold(scene, criterion).threshold;
   }
   const PreCurve* last_rung = rungs.empty() ? nullptr : &rungs.back();
 
   struct Values {
-    double scale = 1.0, mu = 0.0;
+    double scale = 1.0, mu = 0.0, modulus = 1.0;
   };
+  // A layer's q follows its modulus when it is derived from it (docs/model.md, "Pressure
+  // scale"): S E / (1 - nu^2), or paper A's Fig. 17 K = E D / (4 H).
+  std::vector<bool> follows_modulus;
+  for (const LoadLayer& layer : base.layers) {
+    follows_modulus.push_back(base.mode == LoadModelMode::paper_a_fig17 ||
+                              (!layer.pressure_scale_Pa && !base.stiffness_Pa));
+  }
   // Where the model punctures and which pre-puncture curve it follows until then.
   struct Split {
     std::optional<double> depth;
@@ -225,6 +239,8 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     /// "Wall pressure cap") follows it in every layer that reads the same fracture data.
     std::optional<double> critical_pressure;
   };
+  // The criterion's quantity scales with the modulus factor m: it reaches a threshold T where the
+  // unscaled run's reaches T / m.
   const auto split_for_threshold = [&](double threshold) {
     Split split{given_puncture_depth, last_rung, std::nullopt};
     for (const PreCurve& rung : rungs) {
@@ -246,8 +262,10 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     LoadConstants c = base;
     c.friction_coefficient = v.mu;
     for (std::size_t j = 0; j < c.layers.size(); ++j) {
-      c.layers[j].pressure_scale_Pa = v.scale * base_q[j].pressure_scale_Pa;
+      c.layers[j].pressure_scale_Pa =
+          v.scale * base_q[j].pressure_scale_Pa * (follows_modulus[j] ? v.modulus : 1.0);
       c.layers[j].pressure_scale_source = "calibrate";
+      c.layers[j].youngs_modulus_Pa *= v.modulus;
     }
     if (c.layers.empty()) c.stiffness_Pa = *base.stiffness_Pa * v.scale;
     if (split.critical_pressure) {
@@ -265,7 +283,7 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
       const double z = all.depth_m[i];
       const bool after = split.depth && z >= *split.depth;
       out.push_back(after ? post.at(z).force_N
-                          : interpolate_at(split.pre->depth_m, split.pre->force_N, z));
+                          : v.modulus * interpolate_at(split.pre->depth_m, split.pre->force_N, z));
     }
     return out;
   };
@@ -288,8 +306,11 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
       x0.push_back(std::clamp(base.friction_coefficient, 0.01, 0.99));
     }
   }
+  // The modulus factor is fitted in closed form on the samples before the puncture (below), so
+  // it is not one of the least-squares unknowns: the split and the factor are settled first.
+  double modulus = 1.0;
   const auto values_of = [&](const std::vector<double>& x) {
-    Values v{1.0, base.friction_coefficient};
+    Values v{1.0, base.friction_coefficient, modulus};
     for (std::size_t k = 0; k < smooth.size(); ++k) {
       if (options.fit[smooth[k]] == CalibratedConstant::scale) v.scale = x[k];
       if (options.fit[smooth[k]] == CalibratedConstant::friction_coefficient) v.mu = x[k];
@@ -309,6 +330,59 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     for (double v : r) sum += v * v;
     return sum;
   };
+  // F = m g(d) on the fitted samples before the split, g the unscaled pre-puncture force: the
+  // least-squares m = sum g F / sum g^2, its standard error sqrt(s^2 / sum g^2) with
+  // s^2 = RSS / (n - 1).
+  struct ModulusFit {
+    double value = 1.0, standard_error = 0.0;
+    std::size_t samples = 0;
+    std::string problem;  ///< why the samples fix no modulus; empty when they do
+  };
+  const auto try_modulus = [&](const Split& split) {
+    ModulusFit m;
+    double gg = 0.0, gf = 0.0;
+    std::vector<std::pair<double, double>> pairs;
+    for (std::size_t i : fitted) {
+      const double z = all.depth_m[i];
+      if (split.depth && z >= *split.depth) continue;
+      const double g = interpolate_at(split.pre->depth_m, split.pre->force_N, z);
+      pairs.push_back({g, all.force_N[i]});
+      gg += g * g;
+      gf += g * all.force_N[i];
+    }
+    if (pairs.size() < 2) {
+      m.problem = std::to_string(pairs.size()) +
+                  " fitted samples before the puncture; the modulus needs at least 2";
+      return m;
+    }
+    if (!(gg > 0.0) || !(gf > 0.0)) {
+      m.problem = "the samples before the puncture do not fix a positive modulus";
+      return m;
+    }
+    m.value = gf / gg;
+    m.samples = pairs.size();
+    double rss = 0.0;
+    for (const auto& [g, f] : pairs) rss += (f - m.value * g) * (f - m.value * g);
+    m.standard_error = std::sqrt(rss / static_cast<double>(pairs.size() - 1) / gg);
+    return m;
+  };
+  const auto fit_modulus = [&](const Split& split) {
+    ModulusFit m = try_modulus(split);
+    if (!m.problem.empty()) fail(measured.source + ": " + m.problem);
+    return m;
+  };
+  std::vector<double> fitted_depths;  // sorted, each once
+  for (std::size_t i : fitted) fitted_depths.push_back(all.depth_m[i]);
+  std::sort(fitted_depths.begin(), fitted_depths.end());
+  fitted_depths.erase(std::unique(fitted_depths.begin(), fitted_depths.end()), fitted_depths.end());
+  // How many of those depths lie before the split.
+  const auto depths_before = [&](const Split& split) -> std::size_t {
+    if (!split.depth) return fitted_depths.size();
+    return static_cast<std::size_t>(
+        std::lower_bound(fitted_depths.begin(), fitted_depths.end(), *split.depth) -
+        fitted_depths.begin());
+  };
+  ModulusFit modulus_fit;
 
   // ---- solve
   // -------------------------------------------------------------------------------------
@@ -316,9 +390,39 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
   BoundedFit fit;
   std::optional<double> threshold, threshold_error;
   if (!fits_pc && !fits_gamma) {
-    best_split = given_puncture_depth ? Split{given_puncture_depth, nullptr, std::nullopt}
-                                      : split_for_threshold(scene_threshold);
-    fit = fit_bounded(residuals_for(best_split), x0, bounds, {});
+    best_split =
+        given_puncture_depth
+            ? Split{given_puncture_depth,
+                    fits_modulus ? rung_for_depth(*given_puncture_depth) : nullptr, std::nullopt}
+            : split_for_threshold(scene_threshold);
+    if (fits_modulus && given_puncture_depth) {
+      modulus_fit = fit_modulus(best_split);
+    } else if (fits_modulus) {
+      // With the scene's threshold the puncture moves with m, and m with the samples before
+      // the puncture. Start from the two shallowest samples and take in more while the puncture
+      // their m implies lies beyond them: the shallowest puncture consistent with its own
+      // modulus. (Samples after a puncture can fit a deeper one too: a post-puncture force
+      // below the pre-puncture curve lowers m and so deepens the crossing.)
+      std::size_t k = std::min<std::size_t>(2, fitted_depths.size());
+      for (;;) {
+        const std::optional<double> end =
+            k < fitted_depths.size()
+                ? std::optional<double>(0.5 * (fitted_depths[k - 1] + fitted_depths[k]))
+                : std::nullopt;
+        modulus_fit = fit_modulus({end, end ? rung_for_depth(*end) : last_rung, std::nullopt});
+        best_split = split_for_threshold(scene_threshold / modulus_fit.value);
+        const std::size_t before = depths_before(best_split);
+        if (before == k) break;
+        if (before < k) {
+          fail(measured.source +
+               ": the modulus and the puncture it implies do not settle; give the measured "
+               "puncture with --puncture-at, or fit the criterion's constant with it");
+        }
+        k = before;
+      }
+    }
+    modulus = modulus_fit.value;
+    if (!smooth.empty()) fit = fit_bounded(residuals_for(best_split), x0, bounds, {});
   } else {
     // Gaps between consecutive fitted depths that the pre-puncture run covers; the puncture in
     // the middle of a gap stands for the whole gap (the residuals are the same anywhere in it).
@@ -334,10 +438,16 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     const auto gap_cost = [&](std::size_t g, std::vector<double>& x, int starts) {
       const double d = 0.5 * (gaps[g].first + gaps[g].second);
       const PreCurve* rung = rung_for_depth(d);
-      const Split split{
-          d, rung,
-          fits_pc ? std::optional<double>(interpolate_at(rung->depth_m, rung->criterion, d))
-                  : std::nullopt};
+      Split split{d, rung, std::nullopt};
+      if (fits_modulus) {
+        // A puncture with too few samples before it to fix the modulus is no candidate.
+        const ModulusFit m = try_modulus(split);
+        if (!m.problem.empty()) return std::numeric_limits<double>::infinity();
+        modulus = m.value;
+      }
+      if (fits_pc) {
+        split.critical_pressure = modulus * interpolate_at(rung->depth_m, rung->criterion, d);
+      }
       if (smooth.empty()) return cost_of(residuals_for(split)(x));
       BoundedFitOptions o;
       o.starts = starts;
@@ -370,15 +480,19 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     }
     const double d = 0.5 * (gaps[best_gap].first + gaps[best_gap].second);
     best_split = {d, rung_for_depth(d), std::nullopt};
+    if (fits_modulus) {
+      modulus_fit = fit_modulus(best_split);
+      modulus = modulus_fit.value;
+    }
     if (fits_pc) {
       best_split.critical_pressure =
-          interpolate_at(best_split.pre->depth_m, best_split.pre->criterion, d);
+          modulus * interpolate_at(best_split.pre->depth_m, best_split.pre->criterion, d);
     }
     if (!smooth.empty()) fit = fit_bounded(residuals_for(best_split), x_start, bounds, {});
     const PreCurve& rung = *best_split.pre;
-    const double lo = interpolate_at(rung.depth_m, rung.criterion, gaps[best_gap].first);
-    const double hi = interpolate_at(rung.depth_m, rung.criterion, gaps[best_gap].second);
-    threshold = interpolate_at(rung.depth_m, rung.criterion, d);
+    const double lo = modulus * interpolate_at(rung.depth_m, rung.criterion, gaps[best_gap].first);
+    const double hi = modulus * interpolate_at(rung.depth_m, rung.criterion, gaps[best_gap].second);
+    threshold = modulus * interpolate_at(rung.depth_m, rung.criterion, d);
     // Anywhere in the gap fits as well: a uniform spread over it.
     threshold_error = std::abs(hi - lo) / std::sqrt(12.0);
   }
@@ -408,6 +522,10 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
       param.standard_error = fit.standard_error[n];
       param.at_bound = fit.at_bound[n];
       if (param.constant == CalibratedConstant::scale) param.initial = 1.0;
+    } else if (param.constant == CalibratedConstant::modulus) {
+      param.initial = 1.0;
+      param.value = modulus_fit.value;
+      param.standard_error = modulus_fit.standard_error;
     } else {
       const auto own = scene.tissue.layers.front().fracture;
       param.initial = own ? (fits_pc ? own->critical_pressure : own->toughness) : 0.0;
@@ -441,8 +559,14 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     for (double z : out_depth) line_model.push_back(line.intercept + line.slope * z);
     out.straight_line_held_out = compare_curves(out_measured, line_model);
   }
-  for (const LayerPressure& q : base_q)
-    out.layer_pressure_scale_Pa.push_back(best.scale * q.pressure_scale_Pa);
+  for (std::size_t j = 0; j < base_q.size(); ++j) {
+    const bool follows = j < follows_modulus.size() && follows_modulus[j];
+    out.layer_pressure_scale_Pa.push_back(best.scale * base_q[j].pressure_scale_Pa *
+                                          (follows ? best.modulus : 1.0));
+  }
+  out.modulus_factor = best.modulus;
+  for (const TissueLayer& layer : scene.tissue.layers)
+    out.layer_youngs_modulus_Pa.push_back(best.modulus * layer.material.youngs_modulus);
   out.friction_coefficient = best.mu;
   if (fits_pc) out.critical_pressure_Pa = threshold;
   if (fits_gamma) out.toughness_J_per_m2 = threshold;

@@ -7,6 +7,7 @@
 
 #include "mneedle/base/error.h"
 #include "mneedle/base/files.h"
+#include "mneedle/base/units.h"
 
 namespace mneedle {
 namespace {
@@ -60,6 +61,25 @@ std::string edited_scene_text(const std::filesystem::path& scene_file,
     if (!layer) throw InputError(where + "tissue.layers[" + std::to_string(i) + "]: not a table");
     layer->insert_or_assign("pressure_scale", quantity(*edits.layer_pressure_scale_Pa[i], "Pa"));
     layer->insert_or_assign("pressure_scale_source", edits.pressure_scale_source);
+  }
+  if (edits.modulus_factor) {
+    for (std::size_t i = 0; i < layers->size(); ++i) {
+      const std::string at = where + "tissue.layers[" + std::to_string(i) + "].material";
+      auto* layer = (*layers)[i].as_table();
+      auto* material = layer ? (*layer)["material"].as_table() : nullptr;
+      if (!material) throw InputError(at + ": not a table");
+      for (const char* key : {"E", "C10", "C01", "K"}) {
+        const auto* value = (*material)[key].as_string();
+        if (!value) continue;
+        double stiffness = 0.0;
+        try {
+          stiffness = parse_quantity(value->get(), Dimension::Pressure);
+        } catch (const InputError& e) {
+          throw InputError(at + "." + key + ": " + e.what());
+        }
+        material->insert_or_assign(key, quantity(*edits.modulus_factor * stiffness, "Pa"));
+      }
+    }
   }
   if (edits.friction_coefficient) {
     if (!root["loads"].as_table()) root.insert("loads", toml::table{});

@@ -95,44 +95,156 @@ TEST(Calibration, RecoversScaleAndFrictionFromANoisyModelCurveWithinTwoStandardE
   EXPECT_GT(c.fit.r2, 0.99);
 }
 
-// The two-stage curve of a flat punch (axisymmetric FE until P = F / A_sec reaches P_c, surface
-// loads after) is made by run_insertion with P_c = 0.3 MPa and q three times the derived one;
-// calibrate starts from P_c = 0.6 MPa and the derived q.
-TEST(Calibration, RecoversTheCriticalPressureAndScaleOfATwoStageCurve) {
-  const std::string made =
-      "[tissue.fracture]\ntoughness = \"19 J/m^2\"\ncritical_pressure = \"0.3 MPa\"\n";
-  Scene truth_scene = silicone_scene(made, "[\"puncture\", \"force_curve\"]");
-  const double q0 = layer_pressures(load_constants(truth_scene))[0].pressure_scale_Pa;
-  truth_scene.tissue.layers[0].pressure_scale = 3.0 * q0;
-  truth_scene.tissue.layers[0].pressure_scale_source = "truth";
-  truth_scene.insertion.depth = 0.6e-3;
+std::string fracture_with(const std::string& critical_pressure) {
+  return "[tissue.fracture]\ntoughness = \"19 J/m^2\"\ncritical_pressure = \"" + critical_pressure +
+         "\"\n";
+}
+
+// The silicone scene with a flat punch as its needle, 0.6 mm deep at fast, the given P_c, the
+// layer's E times `modulus` and q = `q_factor` times the q the unscaled E derives (given).
+Scene punch_scene(const std::string& critical_pressure, double modulus, double q_factor) {
+  Scene scene = silicone_scene(fracture_with(critical_pressure), "[\"puncture\", \"force_curve\"]");
+  const double q0 = layer_pressures(load_constants(scene))[0].pressure_scale_Pa;
+  scene.tissue.layers[0].material.youngs_modulus *= modulus;
+  scene.tissue.layers[0].pressure_scale = q_factor * q0;
+  scene.tissue.layers[0].pressure_scale_source = "test";
+  scene.insertion.depth = 0.6e-3;
+  return scene;
+}
+
+InsertionRunOptions fast_run() {
   InsertionRunOptions run;
   run.fidelity = fe::Fidelity::Fast;
-  const InsertionRun made_run = run_insertion(truth_scene, {punch_needle()}, run);
-  const NeedleRun& n = made_run.needles.front();
-  ASSERT_TRUE(n.puncture.has_value());
+  return run;
+}
+
+// A fitted constant within two of its own standard errors of the value the curve was made with.
+void expect_within_two_errors(const CalibratedParameter& p, double truth) {
+  EXPECT_LT(std::abs(p.value - truth), 2.0 * p.standard_error)
+      << to_string(p.constant) << " " << p.value << " +- " << p.standard_error << ", made with "
+      << truth;
+}
+
+// The two-stage curve run_insertion makes for `truth` (axisymmetric FE until P = F / A_sec
+// reaches P_c, surface loads after), one sample per depth.
+struct MadeCurve {
   std::vector<double> depth, force;
+  double puncture_depth_m = 0.0;
+};
+MadeCurve made_curve(const Scene& truth) {
+  const InsertionRun made_run = run_insertion(truth, {punch_needle()}, fast_run());
+  const NeedleRun& n = made_run.needles.front();
+  MadeCurve out;
+  if (n.puncture) out.puncture_depth_m = n.puncture->depth_m;
   for (const RunPoint& p : n.curve) {
-    if (p.depth_m <= 0.0 || (!depth.empty() && p.depth_m <= depth.back())) continue;
-    depth.push_back(p.depth_m);
-    force.push_back(p.force_N);
+    if (p.depth_m <= 0.0 || (!out.depth.empty() && p.depth_m <= out.depth.back())) continue;
+    out.depth.push_back(p.depth_m);
+    out.force.push_back(p.force_N);
   }
-  const std::string start =
-      "[tissue.fracture]\ntoughness = \"19 J/m^2\"\ncritical_pressure = \"0.6 MPa\"\n";
-  Scene scene = silicone_scene(start, "[\"puncture\", \"force_curve\"]");
-  scene.insertion.depth = 0.6e-3;
+  return out;
+}
+
+// The curve is made with P_c = 0.3 MPa and q three times the derived one; calibrate starts from
+// P_c = 0.6 MPa and the derived q.
+TEST(Calibration, RecoversTheCriticalPressureAndScaleOfATwoStageCurve) {
+  const MadeCurve made = made_curve(punch_scene("0.3 MPa", 1.0, 3.0));
+  ASSERT_GT(made.puncture_depth_m, 0.0);
   CalibrationOptions options;
   options.fit = {CalibratedConstant::scale, CalibratedConstant::critical_pressure};
   options.contact_travel_m = 0.0;
-  options.run = run;
-  const Calibration c = calibrate(scene, punch_needle(), noisy(depth, force), options);
+  options.run = fast_run();
+  const Calibration c = calibrate(punch_scene("0.6 MPa", 1.0, 1.0), punch_needle(),
+                                  noisy(made.depth, made.force), options);
   ASSERT_EQ(c.parameters.size(), 2u);
   ASSERT_TRUE(c.critical_pressure_Pa.has_value());
-  EXPECT_LT(std::abs(c.parameters[0].value - 3.0), 2.0 * c.parameters[0].standard_error)
-      << "scale " << c.parameters[0].value << " +- " << c.parameters[0].standard_error;
-  EXPECT_LT(std::abs(*c.critical_pressure_Pa - 0.3e6), 2.0 * c.parameters[1].standard_error)
-      << "P_c " << *c.critical_pressure_Pa << " +- " << c.parameters[1].standard_error;
+  expect_within_two_errors(c.parameters[0], 3.0);
+  EXPECT_DOUBLE_EQ(c.parameters[1].value, *c.critical_pressure_Pa);
+  expect_within_two_errors(c.parameters[1], 0.3e6);
   ASSERT_TRUE(c.puncture_depth_m.has_value());
+}
+
+// The tissue of the made curve is 2.5 times stiffer than the scene's: the forces before the
+// puncture, and the pressure that fires it, are 2.5 times the scene's at every depth (linear
+// tissue, sticking contact: the captured nodes do not depend on the modulus). With the scene's
+// own P_c the puncture moves with the fitted modulus; calibrate settles both and the scale.
+TEST(Calibration, RecoversTheModulusAndScaleOfATwoStageCurveWithTheScenesCriticalPressure) {
+  const MadeCurve made = made_curve(punch_scene("0.3 MPa", 2.5, 3.0));
+  ASSERT_GT(made.puncture_depth_m, 0.0);
+  CalibrationOptions options;
+  options.fit = {CalibratedConstant::modulus, CalibratedConstant::scale};
+  options.contact_travel_m = 0.0;
+  options.run = fast_run();
+  const Calibration c = calibrate(punch_scene("0.3 MPa", 1.0, 1.0), punch_needle(),
+                                  noisy(made.depth, made.force), options);
+  ASSERT_EQ(c.parameters.size(), 2u);
+  expect_within_two_errors(c.parameters[0], 2.5);
+  EXPECT_GT(c.parameters[0].standard_error, 0.0);
+  expect_within_two_errors(c.parameters[1], 3.0);
+  EXPECT_DOUBLE_EQ(c.modulus_factor, c.parameters[0].value);
+  EXPECT_NEAR(c.layer_youngs_modulus_Pa[0], c.parameters[0].value * 0.2e6, 1e-6);
+  // The puncture is where the made curve's was, within what the modulus's error moves it: a
+  // flat punch's section pressure grows in proportion to the depth, so d_p goes as 1 / k.
+  ASSERT_TRUE(c.puncture_depth_m.has_value());
+  const double relative = c.parameters[0].standard_error / c.parameters[0].value;
+  EXPECT_NEAR(*c.puncture_depth_m, made.puncture_depth_m, 2.0 * relative * made.puncture_depth_m);
+}
+
+// Fitting P_c too, each candidate puncture (a gap between samples) gets the modulus of the
+// samples before it and the P_c that modulus gives the criterion there.
+TEST(Calibration, RecoversTheModulusAndTheCriticalPressureOfATwoStageCurveTogether) {
+  const MadeCurve made = made_curve(punch_scene("0.3 MPa", 2.5, 3.0));
+  CalibrationOptions options;
+  options.fit = {CalibratedConstant::modulus, CalibratedConstant::critical_pressure,
+                 CalibratedConstant::scale};
+  options.contact_travel_m = 0.0;
+  options.run = fast_run();
+  const Calibration c = calibrate(punch_scene("0.6 MPa", 1.0, 1.0), punch_needle(),
+                                  noisy(made.depth, made.force), options);
+  ASSERT_EQ(c.parameters.size(), 3u);
+  ASSERT_TRUE(c.critical_pressure_Pa.has_value());
+  expect_within_two_errors(c.parameters[0], 2.5);
+  EXPECT_DOUBLE_EQ(c.parameters[1].value, *c.critical_pressure_Pa);
+  expect_within_two_errors(c.parameters[1], 0.3e6);
+  expect_within_two_errors(c.parameters[2], 3.0);
+}
+
+// Without noise the fitted factor is the made one to the solver's tolerance: the pre-puncture
+// force scales with the modulus exactly (the property the closed-form fit rests on).
+TEST(Calibration, ANoiseFreeCurveGivesTheModulusItWasMadeWithToRoundOff) {
+  const MadeCurve made = made_curve(punch_scene("0.3 MPa", 2.5, 1.0));
+  ForceCurve curve;
+  curve.source = "made.csv";
+  for (std::size_t i = 0; i < made.depth.size(); ++i) {
+    curve.depth_m.push_back(made.depth[i]);
+    curve.force_N.push_back(made.force[i]);
+    curve.line.push_back(i + 2);
+  }
+  CalibrationOptions options;
+  options.fit = {CalibratedConstant::modulus};
+  options.contact_travel_m = 0.0;
+  options.puncture_travel_m = made.puncture_depth_m;
+  options.run = fast_run();
+  const Calibration c = calibrate(punch_scene("0.3 MPa", 1.0, 1.0), punch_needle(), curve, options);
+  ASSERT_EQ(c.parameters.size(), 1u);
+  EXPECT_NEAR(c.parameters[0].value, 2.5, 1e-6 * 2.5);
+  EXPECT_LT(c.parameters[0].standard_error, 1e-6 * 2.5);
+}
+
+TEST(Calibration, AModulusWithFewerThanTwoSamplesBeforeTheGivenPunctureIsRefused) {
+  CalibrationOptions options;
+  options.fit = {CalibratedConstant::modulus};
+  options.contact_travel_m = 0.0;
+  options.puncture_travel_m = 0.15e-3;
+  options.run = fast_run();
+  const ForceCurve curve = noisy({1e-4, 2e-4, 3e-4, 4e-4}, {1e-3, 2e-3, 3e-3, 4e-3});
+  try {
+    calibrate(punch_scene("0.3 MPa", 1.0, 1.0), punch_needle(), curve, options);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("synthetic.csv: 1 fitted samples before the puncture"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Calibration, OneCurveCannotFixBothCriticalPressureAndToughness) {

@@ -21,9 +21,14 @@ enum class CalibratedConstant {
   friction_coefficient,  ///< mu of the Coulomb shaft friction
   critical_pressure,     ///< P_c of the pressure criterion (top layer)
   toughness,             ///< Gamma of the energy criterion (top layer)
+  /// a factor m on every layer's stiffness (E, or C10, C01 and K), fitted on the samples before
+  /// the puncture: the pre-puncture force and the criterion's quantity scale with it exactly
+  /// (docs/model.md, "Calibration")
+  modulus,
 };
 
-/// "scale", "friction_coefficient", "critical_pressure", "toughness"; InputError otherwise.
+/// "scale", "friction_coefficient", "critical_pressure", "toughness", "modulus"; InputError
+/// otherwise.
 CalibratedConstant calibrated_constant(const std::string& name);
 std::string to_string(CalibratedConstant c);
 
@@ -32,8 +37,9 @@ struct CalibrationOptions {
   /// Travel (the recording's depth column) at contact; empty: detected (force_curve.h).
   std::optional<double> contact_travel_m;
   /// Travel at the measured puncture. Given: the model is the post-puncture stage from there on
-  /// and the pre-puncture part of the recording is not used (no finite elements run). Empty:
-  /// the full two-stage model (one pre-puncture run, the crossing taken on its steps).
+  /// and the pre-puncture part of the recording is not used (no finite elements run), unless
+  /// `modulus` is fitted, which is fitted on that part. Empty: the full two-stage model (one
+  /// pre-puncture run, the crossing taken on its steps).
   std::optional<double> puncture_travel_m;
   /// Travel interval whose samples are fitted; the rest is held out and reported. Empty: all
   /// samples the model covers.
@@ -66,6 +72,10 @@ struct Calibration {
   std::vector<bool> fitted;  ///< the sample lies in the fit interval
   /// The layer pressure scales after the fit (Pa), one per scene layer.
   std::vector<double> layer_pressure_scale_Pa;
+  /// The factor on every layer's stiffness (1 unless `modulus` is fitted) and the layers' Young's
+  /// moduli after the fit (Pa, the small-strain value for Mooney-Rivlin), one per scene layer.
+  double modulus_factor = 1.0;
+  std::vector<double> layer_youngs_modulus_Pa;
   double friction_coefficient = 0.0;
   std::optional<double> critical_pressure_Pa, toughness_J_per_m2;
 };
@@ -74,7 +84,8 @@ struct Calibration {
 /// Throws InputError for an empty or repeated `fit` list, critical_pressure together with
 /// toughness (one curve fixes one), a constant the scene does not use (friction_coefficient
 /// without Coulomb friction, a criterion constant with a given puncture or with the other
-/// criterion), too few samples, and SolverError when the model cannot be evaluated.
+/// criterion), too few samples (`modulus`: fewer than two before the puncture), a modulus whose
+/// puncture does not settle, and SolverError when the model cannot be evaluated.
 Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const ForceCurve& measured,
                       const CalibrationOptions& options);
 

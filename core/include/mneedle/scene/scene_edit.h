@@ -18,6 +18,8 @@ struct SceneConstantEdits {
   std::optional<double> friction_coefficient;
   std::optional<double> critical_pressure_Pa;  ///< into the fracture data the top layer uses
   std::optional<double> toughness_J_per_m2;
+  /// A factor on every layer's stiffness constants (E; C10, C01 and K for Mooney-Rivlin).
+  std::optional<double> modulus_factor;
   std::vector<std::string> header_comment;  ///< lines, written as '# ' comments first
 };
 
