@@ -213,8 +213,9 @@ void run(const CalibrateArgs& a) {
   if (a.puncture_at == "detect") {
     // On the loading branch only: a hold or a retraction has larger drops than any puncture.
     const LoadingBranch branch = extract_loading_branch(measured);
-    options.puncture_travel_m =
-        largest_force_drop(branch.curve).bottom_depth_m + branch.contact_travel_m;
+    const ForceDrop drop = largest_force_drop(branch.curve);
+    options.puncture_travel_m = drop.bottom_depth_m + branch.contact_travel_m;
+    options.drop_start_travel_m = drop.peak_depth_m + branch.contact_travel_m;
   } else if (!a.puncture_at.empty()) {
     options.puncture_travel_m = length_option("--puncture-at", a.puncture_at);
   }

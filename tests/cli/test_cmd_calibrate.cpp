@@ -118,7 +118,7 @@ std::string punch_scene(const std::string& modulus) {
 // `simulate` makes a pre-puncture curve of a flat punch in silicone of 0.5 MPa (P_c so high
 // that nothing fires); calibrate starts from 0.2 MPa. The force scales with the modulus exactly
 // (docs/model.md, "Calibration"), so the factor comes back as 2.5 to the printed digits of the
-// curve (9), and the written scene carries E = 0.5 MPa and reproduces the curve.
+// curve (9: 1e-8 relative), and the written scene carries E = 0.5 MPa and reproduces the curve.
 TEST(CmdCalibrate, FitsTheModulusOnTheCurveBeforeThePunctureAndWritesItIntoTheScene) {
   const CommandRun made =
       run_mneedle("simulate '" + write("punch_made.toml", punch_scene("0.5 MPa")) + "' --csv");
@@ -136,10 +136,19 @@ TEST(CmdCalibrate, FitsTheModulusOnTheCurveBeforeThePunctureAndWritesItIntoTheSc
   EXPECT_NEAR(j["layers"][0]["youngs_modulus_Pa"].get<double>(), 0.5e6, 1e-8 * 0.5e6);
   EXPECT_TRUE(j["puncture_depth_m"].is_null());
   EXPECT_LT(j["fit"]["rmse_N"].get<double>(), 1e-9);
-  const CommandRun again = run_mneedle("simulate '" + out.string() + "' --csv");
+  // The written scene's curve is the made one (E written with 9 digits: 1e-8 relative).
+  const CommandRun again = run_mneedle("simulate '" + out.string() + "' --json");
+  const CommandRun made_json =
+      run_mneedle("simulate '" + kWork.string() + "/punch_made.toml' --json");
   ASSERT_EQ(again.exit_code, 0) << again.err;
-  // The same rows, the provenance line apart.
-  EXPECT_EQ(again.out.substr(again.out.find('\n')), made.out.substr(made.out.find('\n')));
+  ASSERT_EQ(made_json.exit_code, 0) << made_json.err;
+  const auto a = nlohmann::json::parse(again.out)["needles"][0]["curve"];
+  const auto b = nlohmann::json::parse(made_json.out)["needles"][0]["curve"];
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double f = b[i]["force_N"].get<double>();
+    EXPECT_NEAR(a[i]["force_N"].get<double>(), f, 1e-8 * f) << i;
+  }
 }
 
 TEST(CmdCalibrate, CriticalPressureAndToughnessTogetherAreRefused) {

@@ -181,8 +181,12 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     given_puncture_depth = *options.puncture_travel_m - all.contact_travel_m;
   std::vector<std::size_t> used;  // samples the model covers
   for (std::size_t i = 0; i < all.depth_m.size(); ++i) {
-    // Before a given puncture only the pre-puncture model, run for the modulus, covers them.
-    if (given_puncture_depth && all.depth_m[i] < *given_puncture_depth && !fits_modulus) continue;
+    // Before a given puncture only the pre-puncture model, run for the modulus, covers them;
+    // the drop itself (from where the force starts to fall) neither model does.
+    if (given_puncture_depth && all.depth_m[i] < *given_puncture_depth) {
+      if (!fits_modulus) continue;
+      if (options.drop_start_travel_m && all.travel_m[i] >= *options.drop_start_travel_m) continue;
+    }
     used.push_back(i);
   }
   if (used.size() < options.fit.size() + 2) {
@@ -239,8 +243,8 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     /// "Wall pressure cap") follows it in every layer that reads the same fracture data.
     std::optional<double> critical_pressure;
   };
-  // The criterion's quantity scales with the modulus factor m: it reaches a threshold T where the
-  // unscaled run's reaches T / m.
+  // The criterion's quantity scales with the modulus factor k: it reaches a threshold T where the
+  // unscaled run's reaches T / k.
   const auto split_for_threshold = [&](double threshold) {
     Split split{given_puncture_depth, last_rung, std::nullopt};
     for (const PreCurve& rung : rungs) {
@@ -317,11 +321,25 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     }
     return v;
   };
+  // The samples the least-squares constants are fitted on: all fitted ones, or with the modulus
+  // (fitted in closed form before the split) those from the split on, so that the misfit
+  // before it does not enter their errors.
+  const auto smooth_samples = [&](const Split& split) {
+    if (!fits_modulus) return fitted;
+    std::vector<std::size_t> after;
+    for (std::size_t i : fitted) {
+      if (split.depth && all.depth_m[i] >= *split.depth) after.push_back(i);
+    }
+    return after;
+  };
+  const auto enough_after = [&](const Split& split) {
+    return smooth.empty() || smooth_samples(split).size() > smooth.size();
+  };
   const auto residuals_for = [&](const Split& split) -> ResidualVector {
-    return [&, split](const std::vector<double>& x) {
-      const std::vector<double> model = model_at(values_of(x), split, fitted);
+    return [&, split, which = smooth_samples(split)](const std::vector<double>& x) {
+      const std::vector<double> model = model_at(values_of(x), split, which);
       std::vector<double> r(model.size());
-      for (std::size_t k = 0; k < fitted.size(); ++k) r[k] = all.force_N[fitted[k]] - model[k];
+      for (std::size_t k = 0; k < which.size(); ++k) r[k] = all.force_N[which[k]] - model[k];
       return r;
     };
   };
@@ -330,11 +348,11 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     for (double v : r) sum += v * v;
     return sum;
   };
-  // F = m g(d) on the fitted samples before the split, g the unscaled pre-puncture force: the
-  // least-squares m = sum g F / sum g^2, its standard error sqrt(s^2 / sum g^2) with
+  // F = k g(d) on the fitted samples before the split, g the unscaled pre-puncture force: the
+  // least-squares k = sum g F / sum g^2, its standard error sqrt(s^2 / sum g^2) with
   // s^2 = RSS / (n - 1).
   struct ModulusFit {
-    double value = 1.0, standard_error = 0.0;
+    double value = 1.0, standard_error = 0.0, rss = 0.0;
     std::size_t samples = 0;
     std::string problem;  ///< why the samples fix no modulus; empty when they do
   };
@@ -363,6 +381,7 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     m.samples = pairs.size();
     double rss = 0.0;
     for (const auto& [g, f] : pairs) rss += (f - m.value * g) * (f - m.value * g);
+    m.rss = rss;
     m.standard_error = std::sqrt(rss / static_cast<double>(pairs.size() - 1) / gg);
     return m;
   };
@@ -398,30 +417,44 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     if (fits_modulus && given_puncture_depth) {
       modulus_fit = fit_modulus(best_split);
     } else if (fits_modulus) {
-      // With the scene's threshold the puncture moves with m, and m with the samples before
-      // the puncture. Start from the two shallowest samples and take in more while the puncture
-      // their m implies lies beyond them: the shallowest puncture consistent with its own
+      // With the scene's threshold the puncture moves with k, and k with the samples before
+      // the puncture. The first n fitted depths, n = 2, 3, ..., each give a k; the first n whose
+      // k puts the puncture right after them is the shallowest puncture consistent with its own
       // modulus. (Samples after a puncture can fit a deeper one too: a post-puncture force
-      // below the pre-puncture curve lowers m and so deepens the crossing.)
-      std::size_t k = std::min<std::size_t>(2, fitted_depths.size());
-      for (;;) {
+      // below the pre-puncture curve lowers k and so deepens the crossing.) Each try is a
+      // closed-form fit on the runs already made.
+      bool settled = false;
+      for (std::size_t n = 2; n <= fitted_depths.size() && !settled; ++n) {
         const std::optional<double> end =
-            k < fitted_depths.size()
-                ? std::optional<double>(0.5 * (fitted_depths[k - 1] + fitted_depths[k]))
+            n < fitted_depths.size()
+                ? std::optional<double>(0.5 * (fitted_depths[n - 1] + fitted_depths[n]))
                 : std::nullopt;
-        modulus_fit = fit_modulus({end, end ? rung_for_depth(*end) : last_rung, std::nullopt});
+        const ModulusFit first =
+            try_modulus({end, end ? rung_for_depth(*end) : last_rung, std::nullopt});
+        if (!first.problem.empty()) continue;
+        const Split split = split_for_threshold(scene_threshold / first.value);
+        if (depths_before(split) != n) continue;
+        // Refitted on the rung the crossing lies on (the same samples; a rung boundary between
+        // the gap's middle and the crossing changes the curve, not the samples).
+        modulus_fit = fit_modulus(split);
         best_split = split_for_threshold(scene_threshold / modulus_fit.value);
-        const std::size_t before = depths_before(best_split);
-        if (before == k) break;
-        if (before < k) {
-          fail(measured.source +
-               ": the modulus and the puncture it implies do not settle; give the measured "
-               "puncture with --puncture-at, or fit the criterion's constant with it");
+        if (depths_before(best_split) != n) {
+          best_split = split;
+          modulus_fit = first;
         }
-        k = before;
+        settled = true;
+      }
+      if (!settled) {
+        fail(measured.source +
+             ": no puncture is consistent with the modulus of the samples before it; give the "
+             "measured puncture with --puncture-at, or fit the criterion's constant with it");
       }
     }
     modulus = modulus_fit.value;
+    if (!enough_after(best_split)) {
+      fail(measured.source + ": " + std::to_string(smooth_samples(best_split).size()) +
+           " fitted samples after the puncture for the post-puncture constants");
+    }
     if (!smooth.empty()) fit = fit_bounded(residuals_for(best_split), x0, bounds, {});
   } else {
     // Gaps between consecutive fitted depths that the pre-puncture run covers; the puncture in
@@ -439,22 +472,25 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
       const double d = 0.5 * (gaps[g].first + gaps[g].second);
       const PreCurve* rung = rung_for_depth(d);
       Split split{d, rung, std::nullopt};
+      double pre_cost = 0.0;  // the misfit before the split, which the modulus alone fits
       if (fits_modulus) {
         // A puncture with too few samples before it to fix the modulus is no candidate.
         const ModulusFit m = try_modulus(split);
         if (!m.problem.empty()) return std::numeric_limits<double>::infinity();
         modulus = m.value;
+        pre_cost = m.rss;
+        if (!enough_after(split)) return std::numeric_limits<double>::infinity();
       }
       if (fits_pc) {
         split.critical_pressure = modulus * interpolate_at(rung->depth_m, rung->criterion, d);
       }
-      if (smooth.empty()) return cost_of(residuals_for(split)(x));
+      if (smooth.empty()) return pre_cost + cost_of(residuals_for(split)(x));
       BoundedFitOptions o;
       o.starts = starts;
       o.max_iterations = 60;
       const BoundedFit f = fit_bounded(residuals_for(split), x, bounds, o);
       x = f.x;
-      return f.cost;
+      return pre_cost + f.cost;
     };
     // Every gap when there are few, else every k-th and then the neighbours of the best.
     const std::size_t stride = std::max<std::size_t>(1, (gaps.size() + 39) / 40);
@@ -495,6 +531,11 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     threshold = modulus * interpolate_at(rung.depth_m, rung.criterion, d);
     // Anywhere in the gap fits as well: a uniform spread over it.
     threshold_error = std::abs(hi - lo) / std::sqrt(12.0);
+    if (fits_modulus) {
+      // threshold = k P(d): k's own error adds (P(d) and k independent).
+      const double unscaled = *threshold / modulus;
+      threshold_error = std::hypot(*threshold_error, unscaled * modulus_fit.standard_error);
+    }
   }
 
   // ---- output
@@ -533,6 +574,41 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
       param.standard_error = *threshold_error;
     }
     out.parameters.push_back(param);
+  }
+  // The modulus's error in the constants that depend on it. A threshold is k times the
+  // criterion's value (above). Where every layer's q is derived from its modulus the samples
+  // after the puncture fix only the product of the scale and k: the scale's error given k
+  // gains k's relative error, and the two are anticorrelated. (mu's error stays the one given
+  // k: mu q also enters as a product, with the scale's own error already in it.)
+  if (fits_modulus) {
+    const auto index_of = [&](CalibratedConstant c) -> std::optional<std::size_t> {
+      for (std::size_t j = 0; j < p; ++j) {
+        if (options.fit[j] == c) return j;
+      }
+      return std::nullopt;
+    };
+    const std::size_t km = *index_of(CalibratedConstant::modulus);
+    const CalibratedParameter& mod = out.parameters[km];
+    const double relative_k = mod.standard_error / mod.value;
+    const auto couple = [&](std::size_t j, double covariance) {
+      const double sd = out.parameters[j].standard_error;
+      if (!(sd > 0.0) || !std::isfinite(sd) || !(mod.standard_error > 0.0)) return;
+      out.correlation[j][km] = out.correlation[km][j] = covariance / (sd * mod.standard_error);
+    };
+    for (CalibratedConstant c :
+         {CalibratedConstant::critical_pressure, CalibratedConstant::toughness}) {
+      if (const auto j = index_of(c)) {
+        couple(*j, out.parameters[*j].value / mod.value * mod.standard_error * mod.standard_error);
+      }
+    }
+    const bool all_follow =
+        !follows_modulus.empty() &&
+        std::all_of(follows_modulus.begin(), follows_modulus.end(), [](bool f) { return f; });
+    if (const auto j = index_of(CalibratedConstant::scale); j && all_follow) {
+      CalibratedParameter& scale = out.parameters[*j];
+      scale.standard_error = std::hypot(scale.standard_error, scale.value * relative_k);
+      couple(*j, -scale.value * relative_k * mod.standard_error);
+    }
   }
   const Values best = values_of(smooth.empty() ? std::vector<double>{} : fit.x);
   out.puncture_depth_m = best_split.depth;

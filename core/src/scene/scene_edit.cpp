@@ -69,13 +69,19 @@ std::string edited_scene_text(const std::filesystem::path& scene_file,
       auto* material = layer ? (*layer)["material"].as_table() : nullptr;
       if (!material) throw InputError(at + ": not a table");
       for (const char* key : {"E", "C10", "C01", "K"}) {
-        const auto* value = (*material)[key].as_string();
+        const toml::node* value = material->get(key);
         if (!value) continue;
         double stiffness = 0.0;
-        try {
-          stiffness = parse_quantity(value->get(), Dimension::Pressure);
-        } catch (const InputError& e) {
-          throw InputError(at + "." + key + ": " + e.what());
+        if (const auto* text = value->as_string()) {
+          try {
+            stiffness = parse_quantity(text->get(), Dimension::Pressure);
+          } catch (const InputError& e) {
+            throw InputError(at + "." + key + ": " + e.what());
+          }
+        } else if (const auto number = value->value<double>()) {
+          stiffness = *number;  // a plain number is SI, Pa, as the scene parser reads it
+        } else {
+          throw InputError(at + "." + key + ": not a pressure");
         }
         material->insert_or_assign(key, quantity(*edits.modulus_factor * stiffness, "Pa"));
       }

@@ -4,6 +4,7 @@
 #include "mneedle/scene/scene_edit.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -25,8 +26,9 @@ TEST(SceneEdit, ValuesJsonKeepsValuesAsWrittenAndMakesStlPathsAbsolute) {
   EXPECT_TRUE(j["tissue"]["layers"][0]["material"]["E"].is_string());
 }
 
-// calibrate's modulus factor: every stiffness constant of every layer, E of a linear layer and
-// C10, C01 and K of a Mooney-Rivlin one, written times the factor (nu is a ratio: kept).
+// calibrate's modulus factor: every stiffness constant of every layer, E of a linear layer (here
+// a plain number, which the scene reads as Pa) and C10, C01 and K of a Mooney-Rivlin one (with
+// units), written times the factor (nu is a ratio: kept).
 TEST(SceneEdit, AModulusFactorScalesEveryLayersStiffnessConstants) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("scene_edit_" + std::to_string(::getpid()));
@@ -35,7 +37,7 @@ TEST(SceneEdit, AModulusFactorScalesEveryLayersStiffnessConstants) {
   std::ofstream(file)
       << "[tissue]\nsize = [\"5 mm\", \"5 mm\", \"4 mm\"]\n"
          "[[tissue.layers]]\nname = \"gel\"\nthickness = \"1 mm\"\n"
-         "material = { model = \"linear\", E = \"0.2 MPa\", nu = 0.45 }\n"
+         "material = { model = \"linear\", E = 200000.0, nu = 0.45 }\n"
          "[[tissue.layers]]\nname = \"liver\"\n"
          "material = { model = \"mooney_rivlin\", C10 = \"1 kPa\", C01 = \"0.5 kPa\", "
          "K = \"100 kPa\" }\n"

@@ -21,7 +21,7 @@ enum class CalibratedConstant {
   friction_coefficient,  ///< mu of the Coulomb shaft friction
   critical_pressure,     ///< P_c of the pressure criterion (top layer)
   toughness,             ///< Gamma of the energy criterion (top layer)
-  /// a factor m on every layer's stiffness (E, or C10, C01 and K), fitted on the samples before
+  /// a factor k on every layer's stiffness (E, or C10, C01 and K), fitted on the samples before
   /// the puncture: the pre-puncture force and the criterion's quantity scale with it exactly
   /// (docs/model.md, "Calibration")
   modulus,
@@ -41,6 +41,10 @@ struct CalibrationOptions {
   /// `modulus` is fitted, which is fitted on that part. Empty: the full two-stage model (one
   /// pre-puncture run, the crossing taken on its steps).
   std::optional<double> puncture_travel_m;
+  /// With a given puncture and `modulus`: travel where the force starts to fall at the puncture
+  /// (the drop's peak; `--puncture-at detect` gives it). The samples from there to the puncture,
+  /// the drop itself, are left out: neither stage models them.
+  std::optional<double> drop_start_travel_m;
   /// Travel interval whose samples are fitted; the rest is held out and reported. Empty: all
   /// samples the model covers.
   std::optional<double> fit_from_travel_m, fit_to_travel_m;
