@@ -59,7 +59,8 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
   // both bevels by -0.2 to -0.4 % when the stress probe began cutting each element in an order its
   // mirror image keeps, docs/model.md "Tip stress and cracked meshes": 65.4 -> 65.16 and 85.81
   // -> 85.64 um; the blunt bevel 85.64 -> 85.68 um when fast graded the column under its flat,
-  // docs/model.md "Tissue block and mesh").
+  // docs/model.md "Tissue block and mesh"; 85.68 -> 85.39 um when a node entering the needle's
+  // side was held where it entered, docs/model.md "Contact with the rigid needle (sticking)").
   std::map<std::string, nlohmann::json> by_name;
   for (const auto& d : j["designs"]) {
     EXPECT_TRUE(d["ok"].get<bool>()) << d.dump();
@@ -70,7 +71,7 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
   }
   const std::vector<std::pair<std::string, double>> readme = {{"cone", 62.8e-6},
                                                               {"sharp_bevel", 65.16e-6},
-                                                              {"blunt_bevel", 85.68e-6},
+                                                              {"blunt_bevel", 85.39e-6},
                                                               {"cylinder", 148.0e-6}};
   for (std::size_t i = 0; i < readme.size(); ++i) {
     const auto& [name, depth] = readme[i];
@@ -109,13 +110,15 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
 // (2026-12-07, docs/model.md "Tissue block and mesh") moved its bevels to 63.06 / 84.55 um
 // (+0.6 % / -1.4 %), both inside their converged bands (63.4-63.8 um and 84.0-85.8 um,
 // docs/validation.md, "The stress criterion in skin"). Fast's blunt bevel reads 85.68 um since
-// its column under the flat was graded (2026-12-07; 85.64 um before).
+// its column under the flat was graded (2026-12-07; 85.64 um before), 85.39 um since a node
+// entering the needle's side is held where it entered (docs/model.md, "Contact with the rigid
+// needle (sticking)").
 // Each level is also pinned to 1 % of its own reading, so that a move inside the 6 % is seen and
 // explained.
 TEST(ScreenCommand, ReadmeMainJobReadsWithinSixPercentOfFastAtStandardAndFine) {
   const std::map<std::string, double> fast = {{"cone", 62.8e-6},
                                               {"sharp_bevel", 65.16e-6},
-                                              {"blunt_bevel", 85.68e-6},
+                                              {"blunt_bevel", 85.39e-6},
                                               {"cylinder", 148.0e-6}};
   const std::map<std::string, std::map<std::string, double>> level = {{"standard",
                                                                        {{"cone", 65.44e-6},
@@ -153,7 +156,9 @@ TEST(ScreenCommand, ReadmeMainJobReadsWithinSixPercentOfFastAtStandardAndFine) {
 // The puncture depth is a continuous function of every design parameter (docs/model.md,
 // "Contact with the rigid needle (sticking)"): blunt bevels of 32 and 33 deg in skin read
 // 85.67 and 85.67 um at fast (2026-12-07, with fast's column under the flat graded; 85.64 and
-// 85.63 um before it, 85.81 both before the probe's mirror-invariant cut), 45 deg 85.39 um. Until
+// 85.63 um before it, 85.81 both before the probe's mirror-invariant cut), 45 deg 85.39 um; since
+// a node entering the needle's side is held where it entered (docs/model.md, "Contact with the
+// rigid needle (sticking)") 85.39, 85.39 and 85.13 um. Until
 // captures were grouped over a fiftieth of the surface spacing instead of a quarter, the 33 deg
 // bevel's first capture event took a row of nodes 0.4 um beside its flat, whose face was 0.62 um
 // above them against the group's 0.625 um, pulled them onto the needle, and read 79.80 um: a 7 %
@@ -178,9 +183,9 @@ TEST(ScreenCommand, ABluntBevelsPunctureDepthDoesNotJumpWithItsBevelAngle) {
     depth[d["design"].get<std::string>()] = d["puncture_depth_m"].get<double>();
   }
   ASSERT_EQ(depth.size(), 3u);
-  EXPECT_NEAR(depth["blunt_32"], 85.67e-6, 0.01 * 85.67e-6);
-  EXPECT_NEAR(depth["blunt_33"], 85.67e-6, 0.01 * 85.67e-6);
-  EXPECT_NEAR(depth["blunt_45"], 85.39e-6, 0.01 * 85.39e-6);
+  EXPECT_NEAR(depth["blunt_32"], 85.39e-6, 0.01 * 85.39e-6);
+  EXPECT_NEAR(depth["blunt_33"], 85.39e-6, 0.01 * 85.39e-6);
+  EXPECT_NEAR(depth["blunt_45"], 85.13e-6, 0.01 * 85.13e-6);
   EXPECT_NEAR(depth["blunt_33"], depth["blunt_32"], 1e-3 * depth["blunt_32"]);
 }
 

@@ -346,23 +346,25 @@ TEST(CmdSimulate, ASharpBevelWithItsTipResolvedPuncturesSkinShallowerThanTheShip
 // (which read what 5 um cells read, docs/validation.md "How fine the flat must be"; 85.64 and
 // 82.64 um before fast graded the column under the flat, docs/model.md "Tissue block and mesh";
 // 85.81 and 82.59 um before the stress probe's mirror-invariant cut, docs/model.md "Tip stress and
-// cracked meshes"); before the zone the level read 100.03 um. Pinned to 1 % (deterministic runs: a
-// move is a change to explain); the 2 L zone's remaining error against L asked to stay below 5 %
-// (3.6 % measured at fast, 2.0 % at fine).
+// cracked meshes"); before the zone the level read 100.03 um; 85.39 and 82.94 um since a node
+// entering the needle's side is held where it entered (docs/model.md, "Contact with the rigid
+// needle (sticking)"). Pinned to 1 % (deterministic runs: a move is a change to explain); the
+// 2 L zone's remaining error against L asked to stay below 5 % (3.0 % measured at fast, 2.0 % at
+// fine).
 TEST(CmdSimulate, ABluntBevelsFlatIsMeshedWithCellsOfTwiceTheCriterionLength) {
   const auto [twice, shipped] = punctures_with_zone("paper_a_skin_blunt_bevel.toml",
                                                     "contact_zone = \"20 um\"", "--fidelity fast");
   ASSERT_TRUE(twice.is_object() && shipped.is_object());
   EXPECT_FALSE(shipped["at_first_contact"].get<bool>());
   const double d = shipped["depth_m"].get<double>();
-  EXPECT_NEAR(d, 85.68e-6, 0.01 * 85.68e-6);
+  EXPECT_NEAR(d, 85.39e-6, 0.01 * 85.39e-6);
   EXPECT_NEAR(twice["depth_m"].get<double>(), d, 1e-12 * d);
   const nlohmann::json once = simulate_with_zone("paper_a_skin_blunt_bevel.toml",
                                                  "contact_zone = \"10 um\"", "--fidelity fast");
   ASSERT_TRUE(once.is_object());
   EXPECT_DOUBLE_EQ(once["mesh"]["contact_zone_m"].get<double>(), 10e-6);
   const double finer = once["needles"][0]["puncture"]["depth_m"].get<double>();
-  EXPECT_NEAR(finer, 82.68e-6, 0.01 * 82.68e-6);
+  EXPECT_NEAR(finer, 82.94e-6, 0.01 * 82.94e-6);
   EXPECT_LT(d / finer, 1.05);
   EXPECT_GT(d / finer, 1.0);
 }
@@ -570,10 +572,10 @@ TEST(CmdSimulate, ARoundedBevelTipIsAPointContactAndPuncturesWhereTheSharpOneDoe
 // The blunt bevel with every edge of its cut rounded (tip_radius; docs/model.md, "Blunt bevel with
 // rounded edges"): its flat stays a flat at z = 0, narrower by 1.577 rho, so it keeps the level's
 // 2 L zone over its outline. In that zone's 20 um cells the rim's move shows: 81.02 um at rho = 5
-// um against 85.68 um sharp-edged (fast, 2026-12-07), as flat widths of 40-54 um scatter by 3-4 %
+// um against 85.39 um sharp-edged (fast, 2026-12-07), as flat widths of 40-54 um scatter by 3-4 %
 // at standard (docs/validation.md, "The blunt bevel with rounded edges"). With cells of L
 // (contact_zone = "10 um") the rounding moves it by 0.3 % at most: 82.74 / 82.91 um at 5 / 10 um
-// against 82.68 um (ABluntBevelsFlatIsMeshedWithCellsOfTwiceTheCriterionLength). Pinned to 1 %
+// against 82.94 um (ABluntBevelsFlatIsMeshedWithCellsOfTwiceTheCriterionLength). Pinned to 1 %
 // (deterministic runs).
 TEST(CmdSimulate, ARoundedBluntBevelKeepsItsFlatZoneAndWithCellsOfLPuncturesAsTheSharpEdgedOne) {
   std::string text = mneedle::test::file_text(std::string(MNEEDLE_SOURCE_ROOT) +
