@@ -217,8 +217,12 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     for (std::size_t i : used) deepest = std::max(deepest, all.depth_m[i]);
     if (given_puncture_depth) deepest = *given_puncture_depth;
     for (double horizon = kFirstRung_m;; horizon *= 2.0) {
-      rungs.push_back(pre_puncture_curve(scene, needle, horizon, options.run));
-      if (horizon >= deepest * (1.0 - 1e-12)) break;
+      const bool covers = horizon >= deepest * (1.0 - 1e-12);
+      // A given puncture is read on the rung that covers it, as run_insertion would stop there;
+      // the shallower rungs could only hold a crossing, and none is sought.
+      if (covers || !given_puncture_depth)
+        rungs.push_back(pre_puncture_curve(scene, needle, horizon, options.run));
+      if (covers) break;
     }
     if (!given_puncture_depth && !fits_pc && !fits_gamma)
       scene_threshold = puncture_threshold(scene, criterion).threshold;
