@@ -51,8 +51,11 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
   EXPECT_EQ(j["fidelity"], "fast");
   // What the README says of this table: with the scene's stress criterion every design punctures
   // at a resolved depth (none at first contact), cone < sharp bevel < blunt bevel < cylinder,
-  // each at the depth the README quotes (fast; standard and fine within 6 %). Pinned to 1 %: the
-  // run is deterministic, so any move is a change of the model or the mesh to explain
+  // each at the depth the README quotes (fast; standard and fine within 6 %). Pinned to 0.1 %
+  // (1 % until 2026-12-07, which let the sticking anchor's 0.34 % move of the blunt bevel pass
+  // unseen for a session; the runs read the same to the printed digits on Intel and AMD VMs,
+  // docs/speed-accuracy.md): the run is deterministic, so any move is a change of the model or
+  // the mesh to explain
   // (docs/validation.md, "The stress criterion in skin"; the cone moved 62.3 -> 62.8 um with the
   // pointed-tip mesh rule of the axisymmetric model, docs/model.md "Mesh"; the blunt bevel
   // 100.0 -> 85.8 um with its flat meshed in cells of 2 L, docs/model.md "Tissue block and mesh";
@@ -69,7 +72,7 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
     EXPECT_DOUBLE_EQ(d["target_depth_m"].get<double>(), 200e-6);
     by_name[d["design"].get<std::string>()] = d;
   }
-  const std::vector<std::pair<std::string, double>> readme = {{"cone", 62.8e-6},
+  const std::vector<std::pair<std::string, double>> readme = {{"cone", 62.82e-6},
                                                               {"sharp_bevel", 65.16e-6},
                                                               {"blunt_bevel", 85.39e-6},
                                                               {"cylinder", 148.0e-6}};
@@ -78,7 +81,7 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
     const auto& d = by_name[name];
     ASSERT_TRUE(d["punctured"].get<bool>()) << name;
     EXPECT_FALSE(d["puncture_at_first_contact"].get<bool>()) << name;
-    EXPECT_NEAR(d["puncture_depth_m"].get<double>(), depth, 0.01 * depth) << name;
+    EXPECT_NEAR(d["puncture_depth_m"].get<double>(), depth, 1e-3 * depth) << name;
     EXPECT_TRUE(d["passes"].get<bool>()) << name;
     EXPECT_EQ(j["designs"][i]["design"], name) << "rank " << i + 1;
   }
@@ -109,12 +112,13 @@ TEST(ScreenCommand, ReadmeMainJobRanksEveryShippedDesignByPunctureDepth) {
 // um; the sharp bevel's gap to fast at fine is now -3.8 %. Fine's growth 1.35 -> 1.6
 // (2026-12-07, docs/model.md "Tissue block and mesh") moved its bevels to 63.06 / 84.55 um
 // (+0.6 % / -1.4 %), both inside their converged bands (63.4-63.8 um and 84.0-85.8 um,
-// docs/validation.md, "The stress criterion in skin"). Fast's blunt bevel reads 85.68 um since
+// docs/validation.md, "The stress criterion in skin"); fine's sharp bevel 63.14 um since a node
+// entering the needle's side is held where it entered. Fast's blunt bevel reads 85.68 um since
 // its column under the flat was graded (2026-12-07; 85.64 um before), 85.39 um since a node
 // entering the needle's side is held where it entered (docs/model.md, "Contact with the rigid
 // needle (sticking)").
-// Each level is also pinned to 1 % of its own reading, so that a move inside the 6 % is seen and
-// explained.
+// Each level is also pinned to 0.1 % of its own reading (1 % until 2026-12-07, which hid the
+// sticking anchor's moves for a session), so that a move inside the 6 % is seen and explained.
 TEST(ScreenCommand, ReadmeMainJobReadsWithinSixPercentOfFastAtStandardAndFine) {
   const std::map<std::string, double> fast = {{"cone", 62.8e-6},
                                               {"sharp_bevel", 65.16e-6},
@@ -127,7 +131,7 @@ TEST(ScreenCommand, ReadmeMainJobReadsWithinSixPercentOfFastAtStandardAndFine) {
                                                                         {"cylinder", 141.43e-6}}},
                                                                       {"fine",
                                                                        {{"cone", 65.79e-6},
-                                                                        {"sharp_bevel", 63.06e-6},
+                                                                        {"sharp_bevel", 63.14e-6},
                                                                         {"blunt_bevel", 84.55e-6},
                                                                         {"cylinder", 140.52e-6}}}};
   for (const auto& [fidelity, depths] : level) {
@@ -145,7 +149,7 @@ TEST(ScreenCommand, ReadmeMainJobReadsWithinSixPercentOfFastAtStandardAndFine) {
       EXPECT_FALSE(d["puncture_at_first_contact"].get<bool>());
       const double depth = d["puncture_depth_m"].get<double>();
       EXPECT_NEAR(depth, fast.at(name), 0.06 * fast.at(name));
-      EXPECT_NEAR(depth, depths.at(name), 0.01 * depths.at(name));
+      EXPECT_NEAR(depth, depths.at(name), 1e-3 * depths.at(name));
     }
     // Paper A's order at every level: sharp tips first, the flat end last.
     EXPECT_EQ(order.back(), "cylinder") << fidelity;
