@@ -327,7 +327,9 @@ std::pair<nlohmann::json, nlohmann::json> punctures_with_zone(const std::string&
 // while a capture event took every node entering within 1.15 um of depth with it (110 nodes at the
 // first contact; with groups of at most a quarter of the surface's finest spacing 85 nodes were
 // captured over 74 events; with a fiftieth, since 2026-12-06, it read 61.470 um, and 61.44 um with
-// the stress probe's mirror-invariant cut, docs/model.md "Tip stress and cracked meshes"). Pinned
+// the stress probe's mirror-invariant cut, docs/model.md "Tip stress and cracked meshes"; 61.47 um
+// since a node entering the needle's side is held where it entered, docs/model.md "Contact with
+// the rigid needle (sticking)"). Pinned
 // to 1 % (a mesh-converged FE number: a move is a change to explain); the gap to the plain level is
 // asked to stay at least 5 % (7 % measured). 8 s, release only.
 TEST(CmdSimulate, ASharpBevelWithItsTipResolvedPuncturesSkinShallowerThanTheShippedLevelReadsIt) {
