@@ -157,7 +157,10 @@ void print_table(const Calibration& c, const Scene& scene) {
   for (std::size_t i = 0; i < c.layer_pressure_scale_Pa.size(); ++i) {
     std::cout << "  q " << scene.tissue.layers[i].name << " "
               << format_quantity(c.layer_pressure_scale_Pa[i], Dimension::Pressure);
-    if (c.modulus_factor != 1.0) {
+    const bool modulus_fitted = std::any_of(
+        c.parameters.begin(), c.parameters.end(),
+        [](const CalibratedParameter& p) { return p.constant == CalibratedConstant::modulus; });
+    if (modulus_fitted) {
       std::cout << ", E " << format_quantity(c.layer_youngs_modulus_Pa[i], Dimension::Pressure);
     }
     std::cout << "\n";

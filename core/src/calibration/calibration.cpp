@@ -523,6 +523,11 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     if (fits_modulus) {
       modulus_fit = fit_modulus(best_split);
       modulus = modulus_fit.value;
+      if (!enough_after(best_split)) {
+        fail(measured.source +
+             ": no candidate puncture leaves the modulus two samples before it "
+             "and the post-puncture constants enough after it");
+      }
     }
     if (fits_pc) {
       best_split.critical_pressure =
