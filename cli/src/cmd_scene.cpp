@@ -177,11 +177,19 @@ std::string q(double v, Dimension d) {
   return format_quantity(v, d);
 }
 
+// A layer's depth range; a zero top in the unit of its bottom ("0 um to 20 um", not "0 m").
+std::string depth_range(double top, double bottom) {
+  const std::string end = q(bottom, Dimension::Length);
+  const auto space = end.find(' ');
+  const std::string start = top == 0.0 && space != std::string::npos ? "0" + end.substr(space)
+                                                                     : q(top, Dimension::Length);
+  return start + " to " + end;
+}
+
 std::string layer_line(std::size_t i, const TissueLayer& l) {
   std::ostringstream s;
-  s << "  [" << i << "] " << l.name << ": " << q(l.top, Dimension::Length) << " to "
-    << q(l.top + l.thickness, Dimension::Length) << " (" << q(l.thickness, Dimension::Length)
-    << "), " << to_string(l.material.model) << " E "
+  s << "  [" << i << "] " << l.name << ": " << depth_range(l.top, l.top + l.thickness) << " ("
+    << q(l.thickness, Dimension::Length) << "), " << to_string(l.material.model) << " E "
     << q(l.material.youngs_modulus, Dimension::Pressure) << ", nu " << l.material.poisson_ratio;
   if (l.material.model == MaterialModel::MooneyRivlin) {
     s << " (C10 " << q(l.material.c10, Dimension::Pressure) << ", C01 "

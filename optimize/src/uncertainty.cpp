@@ -498,8 +498,16 @@ std::optional<UncertaintyResult> uncertainty_core(
       s.low = done[n + 2 * k];
       s.high = done[n + 2 * k + 1];
       if (s.low.ok && s.high.ok) {
-        s.depth_effect_m = std::abs(s.high.puncture_objective_m - s.low.puncture_objective_m);
-        s.peak_effect_n = std::abs(s.high.peak_force_n - s.low.peak_force_n);
+        // Two runs that agree to round-off (a value the input cannot move, reached along other
+        // paths: 3e-12 relative measured on a skin cylinder's peak force with the strength
+        // varied) are no effect, and printed they read as one. 1e-9 lies far above that and far
+        // below any effect worth a line.
+        const auto effect = [](double a, double b) {
+          const double d = std::abs(a - b);
+          return d <= 1e-9 * std::max(std::abs(a), std::abs(b)) ? 0.0 : d;
+        };
+        s.depth_effect_m = effect(s.high.puncture_objective_m, s.low.puncture_objective_m);
+        s.peak_effect_n = effect(s.high.peak_force_n, s.low.peak_force_n);
         const auto resolved = [](const UncertaintySample& x) {
           return x.puncture_depth_m.has_value() && !x.puncture_at_first_contact;
         };

@@ -831,6 +831,16 @@ TEST(SceneCheck, RefusesNeedlesThatDoNotFitOrShareTissueAsEveryRunDoes) {
   fs::remove_all(dir);
 }
 
+// The summary's layer depths: the top layer starts at zero, written in its bottom's unit (it read
+// "0 m to 20 um", docs/cli.md shows "0 um to 20 um").
+TEST(SceneCheck, ATopLayerStartsAtZeroInTheUnitOfItsBottom) {
+  const auto run = run_mneedle("scene check '" + kRoot + "/designs/scenes/human_skin.toml'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("[0] stratum_corneum: 0 um to 20 um (20 um)"), std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("[1] epidermis: 20 um to 120 um (100 um)"), std::string::npos) << run.out;
+}
+
 // The convergence study's contact zone is a scene's [model] keys (docs/scene.md): lengths with
 // their unit, shown back in SI; a tip size without its zone is one line naming file, line and key.
 TEST(SceneCheck, AContactZoneIsReadWithItsUnitsAndATipSizeAloneIsRefused) {
