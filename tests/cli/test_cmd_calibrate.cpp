@@ -199,14 +199,14 @@ std::filesystem::path liver_curve() {
 // In the shipped scene the liver block is 60 mm deep and the needle never leaves it. The curve
 // cannot separate q from mu (correlation -1): mu goes to its bound and the model becomes a line
 // through the origin, which extrapolates 30 % better than a free line but misses the plateau
-// after 36.7 mm: held-out error 1.78x the fit's (455 against 256 mN), a miss of the issue's
-// 1.5x, pinned to 0.02 so that it stays in view (docs/validation.md).
+// after 36.7 mm: held-out error 1.774x the fit's (455 against 256 mN), a miss of the issue's
+// 1.5x, pinned to 0.001 so that it stays in view and a move shows (docs/validation.md).
 TEST(CmdCalibrate, LiverCurveInADeepBlockBeatsAStraightLineButNotItsOwnFitError) {
   MNEEDLE_NEED_REFDATA(liver_curve());
   const LiverFit f = liver_fit(kLiverScene, liver_curve());
   EXPECT_TRUE(f.friction_at_bound);
   EXPECT_LE(f.held_out_rmse, 0.7 * f.line_rmse);
-  EXPECT_NEAR(f.held_out_rmse / f.fit_rmse, 1.78, 0.02);
+  EXPECT_NEAR(f.held_out_rmse / f.fit_rmse, 1.774, 0.001);
 }
 
 // The recording's force peaks at 36.7 mm and falls to a flat 1.4-1.5 N: the tip leaving the far

@@ -161,11 +161,14 @@ TEST_F(ForceCommand, PaperAFig20SharpBevelAndCylinderInTheFig17ModeArePinnedWith
 // The shipped silicone scenes carry q = 570 kPa, fitted so that paper A's sharp bevel carries its
 // measured 14 mN at 0.23 mm (docs/validation.md). The blunt bevel at its measured puncture
 // (1.226 mm, 217 mN in paper A) and the cylinder at 2 mm are predictions: pinned here, misses
-// reported there.
+// reported there. The fit point to 0.1 mN (q is fitted to two digits); the predictions to 1 uN
+// (closed form: any move is a change to explain). The blunt bevel was pinned at 107.68 mN
+// within 0.5 mN from the day it was fitted, where the model read 107.392 mN (checked on that
+// commit): the loose bound hid the pin's own error.
 TEST_F(ForceCommand, SiliconePressureScaleReproducesItsFitPointAndPinsThePredictions) {
   EXPECT_NEAR(force_at(design("paper_a_silicone_sharp_bevel.toml"), 230.0), 0.014, 0.0001);
-  EXPECT_NEAR(force_at(design("paper_a_silicone_blunt_bevel.toml"), 1230.0), 0.10768, 0.0005);
-  EXPECT_NEAR(force_at(design("paper_a_silicone_cylinder.toml"), 2000.0), 0.1847, 0.0005);
+  EXPECT_NEAR(force_at(design("paper_a_silicone_blunt_bevel.toml"), 1230.0), 0.107392, 1e-6);
+  EXPECT_NEAR(force_at(design("paper_a_silicone_cylinder.toml"), 2000.0), 0.184703, 1e-6);
 }
 
 TEST_F(ForceCommand, ForceJsonNamesEachLayersPressureScaleAndItsSource) {
