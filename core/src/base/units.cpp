@@ -182,6 +182,10 @@ Parsed split_number_and_unit(std::string_view text) {
 
 }  // namespace
 
+std::string unit_names(Dimension d) {
+  return unit_list(d);
+}
+
 std::string_view dimension_name(Dimension d) {
   switch (d) {
     case Dimension::Dimensionless:

@@ -93,7 +93,9 @@ class Table {
     fail(key_path(key), line_, "required key is missing (expected " + std::string(expected) + ")");
   }
 
-  // A quantity: a string with a unit or a plain number in SI.
+  // A quantity: a string with a unit; a plain number only where there is no unit to forget (a
+  // dimensionless key) or none is needed (0). `thickness = 20` is 20 what? (docs/scene.md,
+  // "General rules").
   double quantity_of(const toml::node& node, const std::string& where, Dimension d) const {
     if (const auto* s = node.as_string()) {
       try {
@@ -105,6 +107,9 @@ class Table {
     if (node.is_number()) {
       const double v = node.value<double>().value_or(NAN);
       if (!std::isfinite(v)) fail(where, line_of(node), "not a finite number");
+      if (d != Dimension::Dimensionless && v != 0.0)
+        fail(where, line_of(node),
+             "a number needs its unit here: " + expectation(d) + " (" + unit_names(d) + ")");
       return v;
     }
     fail(where, line_of(node), "expected " + expectation(d));

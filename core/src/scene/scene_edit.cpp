@@ -79,7 +79,7 @@ std::string edited_scene_text(const std::filesystem::path& scene_file,
             throw InputError(at + "." + key + ": " + e.what());
           }
         } else if (const auto number = value->value<double>()) {
-          stiffness = *number;  // a plain number is SI, Pa, as the scene parser reads it
+          stiffness = *number;  // 0, the one plain number the parser takes for a pressure
         } else {
           throw InputError(at + "." + key + ": not a pressure");
         }

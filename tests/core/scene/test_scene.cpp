@@ -162,10 +162,27 @@ TEST(Scene, AContactZoneAndItsTipSizeAreLengths) {
   EXPECT_DOUBLE_EQ(*none.model.contact_zone, 0.0);
 }
 
-TEST(Scene, PlainNumbersAreSi) {
-  const Scene s =
-      parse(with(R"(size = ["3000 um", "3000 um", "1150 um"])", "size = [0.003, 0.003, 1.15e-3]"));
-  EXPECT_DOUBLE_EQ(s.tissue.size[2], 1.15e-3);
+// A dimensional value needs its unit (docs/scene.md, "General rules"): `thickness = 20` was read
+// as 20 m and failed only when the layers overfilled the block; 2e-5 passed as 20 um. A plain
+// number is taken where no unit can be forgotten (a dimensionless key) and as 0.
+TEST(Scene, APlainNumberForADimensionalKeyIsAnErrorThatListsItsUnits) {
+  const std::string sized = R"(size = ["3000 um", "3000 um", "1150 um"])";
+  for (const std::string& plain :
+       {std::string("size = [0.003, 0.003, 1.15e-3]"), std::string("size = [3000, 3000, 1150]")}) {
+    try {
+      parse(with(sized, plain));
+      FAIL() << plain;
+    } catch (const mneedle::InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("tissue.size[0]: a number needs its unit here: a length such as "
+                          "\"230 um\" (nm, um, mm, cm, m)"),
+                std::string::npos)
+          << what;
+    }
+  }
+  const Scene s = parse(with(R"(at = ["0 um", "0 um"])", "at = [0, 0]"));
+  EXPECT_DOUBLE_EQ(s.needles[0].at[0], 0.0);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[0].material.poisson_ratio, 0.4);
 }
 
 TEST(Scene, LastLayerWithoutThicknessFillsTheBlock) {

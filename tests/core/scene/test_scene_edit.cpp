@@ -34,17 +34,16 @@ TEST(SceneEdit, AModulusFactorScalesEveryLayersStiffnessConstants) {
       std::filesystem::temp_directory_path() / ("scene_edit_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::filesystem::path file = dir / "two_layers.toml";
-  std::ofstream(file)
-      << "[tissue]\nsize = [\"5 mm\", \"5 mm\", \"4 mm\"]\n"
-         "[[tissue.layers]]\nname = \"gel\"\nthickness = \"1 mm\"\n"
-         "material = { model = \"linear\", E = 200000.0, nu = 0.45 }\n"
-         "[[tissue.layers]]\nname = \"liver\"\n"
-         "material = { model = \"mooney_rivlin\", C10 = \"1 kPa\", C01 = \"0.5 kPa\", "
-         "K = \"100 kPa\" }\n"
-         "[[needles]]\nname = \"n\"\n"
-         "geometry = { plugin = \"cone\", diameter = \"200 um\", tip_angle = "
-         "\"30 deg\" }\n"
-         "[insertion]\ndepth = \"1 mm\"\n";
+  std::ofstream(file) << "[tissue]\nsize = [\"5 mm\", \"5 mm\", \"4 mm\"]\n"
+                         "[[tissue.layers]]\nname = \"gel\"\nthickness = \"1 mm\"\n"
+                         "material = { model = \"linear\", E = \"200 kPa\", nu = 0.45 }\n"
+                         "[[tissue.layers]]\nname = \"liver\"\n"
+                         "material = { model = \"mooney_rivlin\", C10 = \"1 kPa\", C01 = 0, "
+                         "K = \"100 kPa\" }\n"
+                         "[[needles]]\nname = \"n\"\n"
+                         "geometry = { plugin = \"cone\", diameter = \"200 um\", tip_angle = "
+                         "\"30 deg\" }\n"
+                         "[insertion]\ndepth = \"1 mm\"\n";
   const Scene before = load_scene(file);
   SceneConstantEdits edits;
   edits.modulus_factor = 2.5;

@@ -28,6 +28,9 @@ enum class Dimension {
 /// "density", "viscosity", "stiffness", "energy".
 std::string_view dimension_name(Dimension d);
 
+/// The units a value of dimension `d` may be written in, ASCII spellings: "nm, um, mm, cm, m".
+std::string unit_names(Dimension d);
+
 /// The SI unit of a dimension as written in output ("m", "rad", "Pa", "N/m", ...; "" if none).
 std::string_view si_unit(Dimension d);
 
