@@ -193,6 +193,7 @@ void run_uncertainty_command(const UncertaintyArgs& args) {
                     {"punctured_fraction", r.punctured_fraction},
                     {"first_contact_fraction", r.first_contact_fraction},
                     {"pass_probability", r.pass_probability},
+                    {"pass_probability_standard_error", r.pass_probability_standard_error},
                     {"failed_samples", r.failed}};
   out["sensitivity"] = nlohmann::json::array();
   for (const auto& s : r.sensitivity)
@@ -228,8 +229,9 @@ void run_uncertainty_command(const UncertaintyArgs& args) {
     print_row("margin", r.margin, Dimension::Dimensionless);
     std::printf(
         "\n  punctured before the target depth: %.1f %% of samples (first-contact "
-        "crossings not counted)\n  passes: %.1f %%\n",
-        100.0 * r.punctured_fraction, 100.0 * r.pass_probability);
+        "crossings not counted)\n  passes: %.1f %% (standard error %.1f %%)\n",
+        100.0 * r.punctured_fraction, 100.0 * r.pass_probability,
+        100.0 * r.pass_probability_standard_error);
     if (r.first_contact_fraction > 0.0)
       std::printf(
           "  fired at the first depth step (depth unresolved, not in the spread): %.1f %%\n",

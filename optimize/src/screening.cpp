@@ -265,6 +265,7 @@ json design_uncertainty(const ScreenedNeedle& needle, const std::string& scene_t
           {"method", u.latin_hypercube ? "lhs" : "mc"},
           {"vary", inputs},
           {"pass_probability", r.pass_probability},
+          {"pass_probability_standard_error", r.pass_probability_standard_error},
           {"punctured_fraction", r.punctured_fraction},
           {"first_contact_fraction", r.first_contact_fraction},
           {"failed_samples", r.failed},

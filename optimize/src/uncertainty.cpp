@@ -491,6 +491,8 @@ std::optional<UncertaintyResult> uncertainty_core(
   result.punctured_fraction = share(punctured);
   result.first_contact_fraction = share(first_contact);
   result.pass_probability = share(passed);
+  result.pass_probability_standard_error = std::sqrt(
+      result.pass_probability * (1.0 - result.pass_probability) / static_cast<double>(ran));
   if (options.sensitivity) {
     for (std::size_t k = 0; k < K; ++k) {
       Sensitivity s;

@@ -1,6 +1,7 @@
 // `mneedle uncertainty` end to end: the JSON a notebook reads, the table, and bad --vary values.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -45,6 +46,9 @@ TEST(UncertaintyCommand, JsonGivesInputsSummarySensitivityAndEverySample) {
   const double pass = j["summary"]["pass_probability"].get<double>();
   EXPECT_GE(pass, 0.0);
   EXPECT_LE(pass, 1.0);
+  // Binomial, over the 8 samples that ran (docs/model.md, "Uncertainty from tissue variability").
+  EXPECT_DOUBLE_EQ(j["summary"]["pass_probability_standard_error"].get<double>(),
+                   std::sqrt(pass * (1.0 - pass) / 8.0));
   ASSERT_EQ(j["sensitivity"].size(), 2u);
   EXPECT_GE(j["sensitivity"][0]["depth_effect_m"].get<double>(),
             j["sensitivity"][1]["depth_effect_m"].get<double>());

@@ -6,6 +6,7 @@
 #include <map>
 #include <stdexcept>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -153,6 +154,9 @@ TEST_F(Screening, UncertaintyRanksByTheProbabilityOfPassingAndIsPartOfTheResumeH
     const auto j = nlohmann::json::parse(r.json);
     EXPECT_EQ(j["uncertainty"]["samples"], 6);
     EXPECT_EQ(j["uncertainty"]["pass_probability"].get<double>(), *r.pass_probability);
+    const double ran = 6.0 - j["uncertainty"]["failed_samples"].get<double>();
+    EXPECT_DOUBLE_EQ(j["uncertainty"]["pass_probability_standard_error"].get<double>(),
+                     std::sqrt(*r.pass_probability * (1.0 - *r.pass_probability) / ran));
     EXPECT_EQ(j["uncertainty"]["peak_force_N"]["count"].get<int>() +
                   j["uncertainty"]["failed_samples"].get<int>(),
               6);

@@ -106,9 +106,11 @@ struct UncertaintyResult {
   UncertaintySample nominal;  ///< the scene as written
   std::vector<UncertaintySample> samples;
   Percentiles puncture_depth_m, puncture_force_n, peak_force_n, margin;
-  double punctured_fraction = 0.0;       ///< of the samples that ran; resolved punctures only
-  double first_contact_fraction = 0.0;   ///< of the samples that ran: fired at the first step
-  double pass_probability = 0.0;         ///< of the samples that ran
+  double punctured_fraction = 0.0;      ///< of the samples that ran; resolved punctures only
+  double first_contact_fraction = 0.0;  ///< of the samples that ran: fired at the first step
+  double pass_probability = 0.0;        ///< of the samples that ran
+  /// Binomial standard error of pass_probability, sqrt(P (1 - P) / n), n the samples that ran.
+  double pass_probability_standard_error = 0.0;
   std::size_t failed = 0;                ///< samples that could not be evaluated (error rows)
   std::vector<Sensitivity> sensitivity;  ///< largest depth effect first, then peak force
 };
