@@ -1,6 +1,7 @@
 // `mneedle screen` and `mneedle strength` end to end: the README's main job ranked by puncture
 // depth, bad designs among good ones, results kept on disk, JSON with units in its keys.
 #include <gtest/gtest.h>
+#include <cstdio>
 
 #include <fcntl.h>
 #include <signal.h>
@@ -528,6 +529,27 @@ TEST(ScreenCommand, KilledAndResumedAgainAndAgainListsEveryDesignOnceWithUninter
   EXPECT_EQ(csv_seen.size(), 48u);
   for (const auto& [design, count] : csv_seen) EXPECT_EQ(count, 1) << design;
   fs::remove_all(dir);
+}
+
+// Under each row of a screen with --uncertainty: P(pass) with its binomial standard error over
+// the samples that ran (docs/model.md, "Uncertainty from tissue variability").
+TEST(ScreenCommand, UncertaintyLineGivesThePassProbabilityWithItsStandardError) {
+  const auto run = run_mneedle("screen '" + kRoot + "/designs' --scene '" + kSkinPressure +
+                               "' --model analytic --uncertainty 4 --seed 2 --vary "
+                               "'fracture.critical_pressure=uniform(0.5MPa,6MPa)'");
+  std::istringstream lines(run.out);
+  int seen = 0;
+  for (std::string line; std::getline(lines, line);) {
+    double p = 0.0, error = 0.0;
+    int samples = 0;
+    if (std::sscanf(line.c_str(), " P(pass) %lf %% (standard error %lf %%) of %d samples", &p,
+                    &error, &samples) != 3)
+      continue;
+    ++seen;
+    EXPECT_EQ(samples, 4) << line;
+    EXPECT_NEAR(error, 100.0 * std::sqrt(p / 100.0 * (1.0 - p / 100.0) / 4.0), 0.05) << line;
+  }
+  EXPECT_GE(seen, 1) << run.out << run.err;
 }
 
 TEST(ScreenCommand, UncertaintyAndVaryNeedEachOtherAndABadPathFailsBeforeAnyDesign) {
