@@ -3,6 +3,9 @@
 // named by MNEEDLE_PIN_AUDIT, so that a pinned value the code no longer reads exactly is seen
 // before it drifts out of its tolerance (docs/validation.md, "Pins and what the code reads").
 #pragma once
+// A system header to the compiler, so that #include_next (a GCC extension) is not warned about
+// in every test file.
+#pragma GCC system_header
 #include_next <gtest/gtest.h>
 
 #include <cstdio>
