@@ -1,7 +1,6 @@
 // mneedle screen: rank a folder of needle designs on one scene (docs/cli.md).
 #include <CLI/CLI.hpp>
 
-#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -104,14 +103,12 @@ void print_table(const std::vector<ScreeningRow>& ranked, const Scene& scene,
     if (row.pass_probability) {
       const auto& u = j["uncertainty"];
       const auto& d = u["puncture_depth_m"];
-      // From the row's own counts, so that rows resumed from an older results.jsonl print too.
       const double p = *row.pass_probability;
-      const double ran = u["samples"].get<double>() - u["failed_samples"].get<double>();
-      const double standard_error = ran > 0.0 ? std::sqrt(p * (1.0 - p) / ran) : 0.0;
       std::printf(
           "     P(pass) %.1f %% (standard error %.1f %%) of %d samples; puncture depth 5/50/95 "
           "%%: %s\n",
-          100.0 * p, 100.0 * standard_error, u["samples"].get<int>(),
+          100.0 * p, 100.0 * u["pass_probability_standard_error"].get<double>(),
+          u["samples"].get<int>(),
           d["p50"].is_null() ? "no resolved puncture"
                              : (cell(d["p5"].get<double>(), Dimension::Length) + " / " +
                                 cell(d["p50"].get<double>(), Dimension::Length) + " / " +

@@ -369,6 +369,13 @@ ScreeningRow row_from_json(const std::string& line) {
     if (j.contains("uncertainty")) {
       const auto& u = j.at("uncertainty");
       row.pass_probability = u.at("pass_probability").get<double>();
+      if (!u.contains("pass_probability_standard_error")) {
+        // A row written before the key existed: the same from its own counts.
+        json with = j;
+        with["uncertainty"]["pass_probability_standard_error"] = binomial_standard_error(
+            *row.pass_probability, u.at("samples").get<double>() - u.value("failed_samples", 0.0));
+        row.json = with.dump();
+      }
       if (!u.at("puncture_depth_m").at("p50").is_null())
         row.median_puncture_depth_m = u.at("puncture_depth_m").at("p50").get<double>();
     }

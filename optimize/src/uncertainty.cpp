@@ -491,8 +491,8 @@ std::optional<UncertaintyResult> uncertainty_core(
   result.punctured_fraction = share(punctured);
   result.first_contact_fraction = share(first_contact);
   result.pass_probability = share(passed);
-  result.pass_probability_standard_error = std::sqrt(
-      result.pass_probability * (1.0 - result.pass_probability) / static_cast<double>(ran));
+  result.pass_probability_standard_error =
+      binomial_standard_error(result.pass_probability, static_cast<double>(ran));
   if (options.sensitivity) {
     for (std::size_t k = 0; k < K; ++k) {
       Sensitivity s;
@@ -667,6 +667,10 @@ std::optional<UncertaintyResult> run_uncertainty_mpi(
   return uncertainty_core(text, source, inputs, options,
                           scene_needle_evaluator(registry, options, source), on_sample, over_ranks,
                           settle);
+}
+
+double binomial_standard_error(double p, double n) {
+  return n > 0.0 ? std::sqrt(p * (1.0 - p) / n) : 0.0;
 }
 
 }  // namespace mneedle

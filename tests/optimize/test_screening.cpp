@@ -163,15 +163,37 @@ TEST_F(Screening, UncertaintyRanksByTheProbabilityOfPassingAndIsPartOfTheResumeH
     ++sampled;
   }
   EXPECT_EQ(sampled, 4u);  // every design but the open box
+  // The standard error is checked on a share strictly between 0 and 1 (where it is not 0).
+  EXPECT_TRUE(std::any_of(rows.begin(), rows.end(), [](const mneedle::ScreeningRow& r) {
+    return r.ok && *r.pass_probability > 0.0 && *r.pass_probability < 1.0;
+  }));
   const auto ranked = mneedle::rank_rows(rows);
   for (std::size_t i = 1; i < ranked.size(); ++i)
     if (ranked[i].ok) {
       EXPECT_GE(*ranked[i - 1].pass_probability, *ranked[i].pass_probability) << i;
     }
-  // The same settings resume; another seed is another run.
+  // The same settings resume; another seed is another run. Rows written before the standard
+  // error was reported (the key taken out here) get it from their own counts.
+  const std::vector<std::string> written = jsonl_lines();
+  {
+    std::ofstream out(dir_ / "out" / "results.jsonl", std::ios::trunc);
+    for (const std::string& line : written) {
+      nlohmann::json j = nlohmann::json::parse(line);
+      if (j.contains("uncertainty")) j["uncertainty"].erase("pass_probability_standard_error");
+      out << j.dump() << "\n";
+    }
+  }
   options.resume = true;
-  for (const auto& r : mneedle::screen_designs(designs, scene_, scene_file_, registry_, options))
+  for (const auto& r : mneedle::screen_designs(designs, scene_, scene_file_, registry_, options)) {
     EXPECT_TRUE(r.resumed || !r.ok) << r.design;
+    if (!r.ok) continue;
+    const auto j = nlohmann::json::parse(r.json);
+    const auto& u = j["uncertainty"];
+    EXPECT_DOUBLE_EQ(u["pass_probability_standard_error"].get<double>(),
+                     std::sqrt(*r.pass_probability * (1.0 - *r.pass_probability) /
+                               (6.0 - u["failed_samples"].get<double>())))
+        << r.design;
+  }
   options.uncertainty.seed = 4;
   for (const auto& r : mneedle::screen_designs(designs, scene_, scene_file_, registry_, options))
     EXPECT_FALSE(r.resumed) << r.design;

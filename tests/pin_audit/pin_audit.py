@@ -6,6 +6,9 @@ computed reference): a measured value of our own code, held within a tolerance. 
 passes while the code reads it 0.2 % away with a 1 % tolerance hides a move; this lists every
 such pin, largest share of its tolerance first. Comparisons against closed forms and ratios to 1
 are listed apart with --all (their distance is a discretisation error, stated in each test).
+A pin is recognised by the number written in the EXPECT_NEAR itself: a pin written through a
+variable (a table of values looped over) is listed only with --all; a comparison made in a loop
+is listed once, at its worst.
 
 usage: pin_audit.py LOG [--min-deviation 5e-4] [--all]
 """

@@ -109,11 +109,14 @@ struct UncertaintyResult {
   double punctured_fraction = 0.0;      ///< of the samples that ran; resolved punctures only
   double first_contact_fraction = 0.0;  ///< of the samples that ran: fired at the first step
   double pass_probability = 0.0;        ///< of the samples that ran
-  /// Binomial standard error of pass_probability, sqrt(P (1 - P) / n), n the samples that ran.
+  /// binomial_standard_error(pass_probability, the samples that ran).
   double pass_probability_standard_error = 0.0;
   std::size_t failed = 0;                ///< samples that could not be evaluated (error rows)
   std::vector<Sensitivity> sensitivity;  ///< largest depth effect first, then peak force
 };
+
+/// Standard error of a share p of n independent samples: sqrt(p (1 - p) / n); 0 for n = 0.
+double binomial_standard_error(double p, double n);
 
 /// Runs the scene at its own values first (if that fails, its exception: InputError or
 /// SolverError), then every sample (drawn in a fixed order from a 64-bit
