@@ -415,7 +415,13 @@ void run_optimize(const OptimizeArgs& a) {
       if (n.material && problem.material.empty()) problem.material = *n.material;
   if (problem.material.empty()) problem.material = "silicon";
   // Checked once here: an unknown name would otherwise fail every evaluation of the search.
-  find_needle_material(problem.material, scene_needle_materials(scene));
+  try {
+    find_needle_material(problem.material, scene_needle_materials(scene));
+  } catch (const InputError& e) {
+    throw InputError(std::string(a.material.empty() ? "optimize: the scene's needle material: "
+                                                    : "optimize: --material: ") +
+                     e.what());
+  }
   problem.evaluation.fidelity = parse_fidelity(a.fidelity);
   problem.evaluation.model = parse_pre_model(a.model);
   const std::vector<double> start = start_values(shape, vars, problem.fixed);

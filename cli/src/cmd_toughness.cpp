@@ -74,7 +74,11 @@ CrackAreaChoice crack_area(const ToughnessArgs& a, double end_depth_m) {
   if (given != 1) throw InputError("toughness: give exactly one of --area, --needle or --plugin");
   CrackAreaChoice out;
   if (!a.area.empty()) {
-    out.area_m2 = parse_area_m2(a.area);
+    try {
+      out.area_m2 = parse_area_m2(a.area);
+    } catch (const InputError& e) {
+      throw InputError(std::string("toughness: --area: ") + e.what());
+    }
     out.source = "given";
     return out;
   }

@@ -120,18 +120,29 @@ NeedleSource needle_from_plugin(const PluginRegistry& registry, const std::strin
   return n;
 }
 
-NeedleSource needle_from_scene(const PluginRegistry& registry, const NeedleSpec& spec) {
-  if (const auto* stl = std::get_if<StlGeometry>(&spec.geometry)) {
-    NeedleSource n = needle_from_file(stl->path, stl->unit_scale, parse_axis_choice(stl->axis));
+NeedleSource needle_from_scene(const PluginRegistry& registry, const NeedleSpec& spec,
+                               const std::string& where) {
+  // The scene parser cannot check a plugin's parameters or read a mesh (it knows no registry),
+  // so their errors are raised here and carry the scene's file and line like the parser's.
+  try {
+    if (const auto* stl = std::get_if<StlGeometry>(&spec.geometry)) {
+      NeedleSource n = needle_from_file(stl->path, stl->unit_scale, parse_axis_choice(stl->axis));
+      n.name = spec.name;
+      return n;
+    }
+    const auto& plugin = std::get<PluginGeometry>(spec.geometry);
+    const auto& info = registry.shape(plugin.plugin);
+    NeedleSource n = needle_from_plugin(registry, plugin.plugin,
+                                        scene_parameters(info, plugin.parameters, "geometry"));
     n.name = spec.name;
     return n;
+  } catch (const InputError& e) {
+    throw InputError(where + ": " + e.what());
   }
-  const auto& plugin = std::get<PluginGeometry>(spec.geometry);
-  const auto& info = registry.shape(plugin.plugin);
-  NeedleSource n = needle_from_plugin(
-      registry, plugin.plugin, scene_parameters(info, plugin.parameters, "needles." + spec.name));
-  n.name = spec.name;
-  return n;
+}
+
+std::string scene_needle_where(const Scene& scene, const NeedleSpec& spec) {
+  return scene.source_name + ":" + std::to_string(spec.line) + ": needle '" + spec.name + "'";
 }
 
 std::optional<fe::AxisymmetricNeedle> axisymmetric_profile(const PluginRegistry& registry,
@@ -450,9 +461,8 @@ std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, cons
                      " (raise it with --max-needles)");
   std::vector<PreparedNeedle> prepared;
   for (const NeedleSpec& spec : scene.needles) {
-    const std::string where =
-        scene.source_name + ":" + std::to_string(spec.line) + ": needle '" + spec.name + "'";
-    NeedleSource source = needle_from_scene(registry, spec);
+    const std::string where = scene_needle_where(scene, spec);
+    NeedleSource source = needle_from_scene(registry, spec, where);
     PreparedNeedle n;
     n.name = spec.name;
     n.x = spec.at[0];

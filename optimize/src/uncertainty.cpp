@@ -258,7 +258,8 @@ SceneEvaluator scene_needle_evaluator(const PluginRegistry& registry,
   const PreModel model = parse_pre_model(options.model);
   return [&registry, fidelity, model, source, material = options.material](const Scene& scene) {
     if (scene.needles.empty()) throw InputError(source + ": the scene has no needle to evaluate");
-    const NeedleSource needle = needle_from_scene(registry, scene.needles.front());
+    const NeedleSource needle = needle_from_scene(registry, scene.needles.front(),
+                                                  scene_needle_where(scene, scene.needles.front()));
     EvaluationOptions o;
     o.fidelity = fidelity;
     o.model = model;

@@ -189,7 +189,7 @@ CrackArea needle_crack_area(const TriangleMesh& needle_frame_mesh, double depth_
 double parse_area_m2(std::string_view text) {
   const auto fail = [&](const std::string& why) {
     return InputError("area '" + std::string(text) + "': " + why +
-                      " (expected e.g. 1.27mm^2, 0.04 mm2, 4e-7 m^2, 4e-7)");
+                      " (expected a length unit squared, e.g. 1.27mm^2, 0.04 mm2, 4e-7 m^2)");
   };
   std::string t(text);
   bool squared = false;
@@ -211,7 +211,15 @@ double parse_area_m2(std::string_view text) {
       const double metres = parse_quantity("1 " + std::string(unit_start), Dimension::Length);
       value = number * metres * metres;
     } else {
-      value = parse_quantity(t, Dimension::Dimensionless);
+      // A bare number would be read in m^2, a million times the mm^2 a user usually means: the
+      // unit is required, as for every dimensional value (docs/cli.md).
+      char* end = nullptr;
+      std::strtod(t.c_str(), &end);
+      const char* rest = end;
+      const bool plain = end != t.c_str() && std::all_of(rest, t.c_str() + t.size(), [](char c) {
+                           return std::isspace(static_cast<unsigned char>(c));
+                         });
+      throw fail(plain ? "needs its unit" : "not an area");
     }
   } catch (const InputError& e) {
     if (std::string(e.what()).rfind("area '", 0) == 0) throw;

@@ -56,7 +56,12 @@ NeedleSource needle_from_file(const std::filesystem::path& file, double metres_p
 NeedleSource needle_from_plugin(const PluginRegistry& registry, const std::string& shape,
                                 const std::map<std::string, double>& params_si);
 
-NeedleSource needle_from_scene(const PluginRegistry& registry, const NeedleSpec& spec);
+/// The scene's needle built from its plugin or mesh file; InputError messages start with `where`
+/// (scene_needle_where: the scene's file and the entry's line).
+NeedleSource needle_from_scene(const PluginRegistry& registry, const NeedleSpec& spec,
+                               const std::string& where);
+/// "FILE:LINE: needle 'NAME'" for the scene's [[needles]] entry `spec`.
+std::string scene_needle_where(const Scene& scene, const NeedleSpec& spec);
 
 /// The outer profile of a body-of-revolution plugin needle (the cylinder and cone plugins),
 /// sampled from the plugin's section area A(h) = pi (r_out^2 - r_bore^2); nullopt for any other

@@ -238,12 +238,21 @@ TEST(Toughness, CrackAreaOfAHollowNeedleExcludesTheBore) {
 TEST(Toughness, AreaTextTakesASquaredLengthUnit) {
   EXPECT_NEAR(mneedle::parse_area_m2("0.0415mm^2"), 0.0415e-6, 1e-15);
   EXPECT_NEAR(mneedle::parse_area_m2("41500 um2"), 0.0415e-6, 1e-15);
-  EXPECT_NEAR(mneedle::parse_area_m2("4e-8"), 4e-8, 1e-20);
+  EXPECT_NEAR(mneedle::parse_area_m2("4e-8 m^2"), 4e-8, 1e-20);
   EXPECT_NEAR(mneedle::parse_area_m2("1 cm^2"), 1e-4, 1e-16);
-  for (const char* bad : {"3 mm", "1 N^2", "-1mm^2", "0", "mm^2", "abc"}) {
+  for (const char* bad : {"3 mm", "1 N^2", "-1mm^2", "0", "mm^2", "abc", "4e-8", "0.0415"}) {
     const auto msg = error_of([bad] { mneedle::parse_area_m2(bad); });
     EXPECT_NE(msg.find("area '" + std::string(bad) + "'"), std::string::npos) << msg;
   }
+}
+
+// A bare number would be m^2 (0.0415 read so is 10^6 times the 0.0415 mm^2 meant, and J 10^6
+// too small): it is refused and the message asks for the unit.
+TEST(Toughness, AnAreaWithoutItsUnitIsAnErrorThatAsksForIt) {
+  const auto msg = error_of([] { mneedle::parse_area_m2("0.0415"); });
+  EXPECT_NE(msg.find("area '0.0415': needs its unit (expected a length unit squared"),
+            std::string::npos)
+      << msg;
 }
 
 TEST(Toughness, MissingColumnTextInANumberAndNoLoadingBranchNameFileAndLine) {

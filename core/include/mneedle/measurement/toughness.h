@@ -95,8 +95,8 @@ struct CrackArea {
 };
 CrackArea needle_crack_area(const TriangleMesh& needle_frame_mesh, double depth_m);
 
-/// "1.27 mm^2", "1.27mm2", "4e-7 m^2", "4e-7" (m^2): a length unit squared. Throws InputError
-/// naming the text for anything else, a non-positive or non-finite value.
+/// "1.27 mm^2", "1.27mm2", "4e-7 m^2": a length unit squared. Throws InputError naming the text
+/// for anything else (a bare number included), a non-positive or non-finite value.
 double parse_area_m2(std::string_view text);
 
 /// The largest drop of the force below its running maximum: the first puncture of a recording.
