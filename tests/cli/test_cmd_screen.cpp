@@ -325,6 +325,55 @@ TEST(ScreenCommand, ResumeWithoutOutIsAnError) {
   EXPECT_NE(run.err.find("--resume needs --out"), std::string::npos) << run.err;
 }
 
+// docs/scene.md: every command that takes a scene checks it as `scene check` does. screen
+// replaces the scene's needles by the designs, but a scene whose own needle is wrong (a misspelled
+// plugin parameter, one without its unit) is refused with its file and line before any design
+// runs (it was accepted, exit 0); so is an unknown --material (every FE model ran first, then each
+// row failed) and a folder with no designs (the message now names it).
+TEST(ScreenCommand, ASceneWhoseNeedleSceneCheckRefusesAndAnUnknownMaterialStopItBeforeAnyDesign) {
+  const fs::path dir = fs::temp_directory_path() / ("screen_refuses_" + std::to_string(::getpid()));
+  fs::create_directories(dir / "empty");
+  const std::string text = mneedle::test::file_text(kSkin);
+  const std::string angle = "bevel_angle = \"30 deg\"";
+  ASSERT_NE(text.find(angle), std::string::npos);
+  int line = 1;
+  for (std::size_t i = 0; i < text.rfind("[[needles]]", text.find(angle)); ++i)
+    line += text[i] == '\n' ? 1 : 0;
+  for (const auto& [with, problem] :
+       {std::pair<std::string, std::string>{"bevel_angel = \"30 deg\"",
+                                            "has no parameter 'bevel_angel'"},
+        std::pair<std::string, std::string>{"bevel_angle = 30",
+                                            "geometry.bevel_angle needs a unit"}}) {
+    std::string scene = text;
+    scene.replace(scene.find(angle), angle.size(), with);
+    const fs::path file = dir / "scene.toml";
+    std::ofstream(file) << scene;
+    const auto check = run_mneedle("scene check '" + file.string() + "'");
+    const auto run = run_mneedle("screen '" + kRoot + "/designs' --scene '" + file.string() + "'");
+    const std::string where =
+        file.string() + ":" + std::to_string(line) + ": needle 'sharp_bevel': ";
+    for (const auto* r : {&check, &run}) {
+      EXPECT_EQ(r->exit_code, 1) << with;
+      EXPECT_NE(r->err.find(where), std::string::npos) << r->err;
+      EXPECT_NE(r->err.find(problem), std::string::npos) << r->err;
+    }
+    EXPECT_EQ(run.err.find("done"), std::string::npos) << run.err;
+  }
+  const auto material =
+      run_mneedle("screen '" + kRoot + "/designs' --scene '" + kSkin + "' --material plaa");
+  EXPECT_EQ(material.exit_code, 1);
+  EXPECT_NE(material.err.find("screen: --material: unknown needle material 'plaa'"),
+            std::string::npos)
+      << material.err;
+  EXPECT_EQ(material.err.find("done"), std::string::npos) << material.err;
+  EXPECT_EQ(material.out, "");
+  const auto empty =
+      run_mneedle("screen '" + (dir / "empty").string() + "' --scene '" + kSkin + "'");
+  EXPECT_EQ(empty.exit_code, 1);
+  EXPECT_NE(empty.err.find("found in " + (dir / "empty").string()), std::string::npos) << empty.err;
+  fs::remove_all(dir);
+}
+
 TEST(ScreenCommand, TablePrintsTheMarginToFourSignificantDigitsWhateverItsSize) {
   // A 1 Pa gel: the cone's margin is about 7e10; the table printed its first six characters,
   // "732099", as if it were 7e5.
