@@ -160,6 +160,25 @@ TEST(CmdCalibrate, CriticalPressureAndToughnessTogetherAreRefused) {
   EXPECT_NE(run.err.find("not both"), std::string::npos) << run.err;
 }
 
+// A puncture given at or above where the curve meets the surface (0.5 mm of travel here) was taken
+// for one at a negative depth and every sample fitted as post-puncture (exit 0); now it is one
+// line naming the option.
+TEST(CmdCalibrate, APunctureGivenAtOrAboveTheSurfaceIsRefused) {
+  std::string rows = "depth_mm,force_N\n";  // flat to 0.5 mm, then rising: contact at 0.5 mm
+  for (int i = 0; i <= 40; ++i)
+    rows += std::to_string(0.05 * i) + "," + std::to_string(i <= 10 ? 0.0 : 0.01 * (i - 10)) + "\n";
+  const std::string curve = write("c3.csv", rows);
+  for (const std::string at : {"-618um", "0um", "400um"}) {
+    const CommandRun run =
+        run_mneedle("calibrate '" + write("s3.toml", silicone_scene("")) + "' --curve '" + curve +
+                    "' --fit scale --puncture-at " + at + plugins());
+    EXPECT_EQ(run.exit_code, 1) << at;
+    EXPECT_NE(run.err.find("calibrate: --puncture-at "), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find(": not below the surface; " + curve + " meets it at"), std::string::npos)
+        << run.err;
+  }
+}
+
 TEST(CmdCalibrate, UnknownConstantNamesTheAcceptedOnes) {
   const CommandRun run =
       run_mneedle("calibrate '" + write("s2.toml", silicone_scene("")) + "' --curve '" +

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "mneedle/base/error.h"
+#include "mneedle/base/units.h"
 #include "mneedle/insertion/puncture.h"
 #include "mneedle/insertion/surface_loads.h"
 #include "mneedle/measurement/bounded_least_squares.h"
@@ -177,8 +178,16 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
 
   const Samples all = samples_from(measured, options.contact_travel_m);
   std::optional<double> given_puncture_depth;
-  if (options.puncture_travel_m)
+  if (options.puncture_travel_m) {
     given_puncture_depth = *options.puncture_travel_m - all.contact_travel_m;
+    // A puncture at or above the surface is no puncture: the pre-puncture model has nothing to
+    // cover and every sample would be fitted as post-puncture.
+    if (!(*given_puncture_depth > 0.0)) {
+      fail("--puncture-at " + format_quantity(*options.puncture_travel_m, Dimension::Length) +
+           ": not below the surface; " + measured.source + " meets it at " +
+           format_quantity(all.contact_travel_m, Dimension::Length) + " of travel");
+    }
+  }
   std::vector<std::size_t> used;  // samples the model covers
   for (std::size_t i = 0; i < all.depth_m.size(); ++i) {
     // Before a given puncture only the pre-puncture model, run for the modulus, covers them;
