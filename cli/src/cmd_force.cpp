@@ -15,6 +15,7 @@
 #include "json_output.h"
 #include "mneedle/api/loads_json.h"
 #include "mneedle/base/error.h"
+#include "mneedle/base/text.h"
 #include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
 #include "mneedle/insertion/insertion_run.h"
@@ -78,8 +79,7 @@ std::vector<double> depth_grid(double max_depth, double step, double max_points)
   if (!(max_depth / step <= max_points))
     throw InputError("--step " + format_quantity(step, Dimension::Length) + " over " +
                      format_quantity(max_depth, Dimension::Length) + " is " +
-                     std::to_string(static_cast<long double>(max_depth / step)).substr(0, 12) +
-                     " points, above the limit of " +
+                     count_text(max_depth / step) + " points, above the limit of " +
                      std::to_string(static_cast<long>(max_points)) +
                      " (raise it with --max-points)");
   std::vector<double> depths;

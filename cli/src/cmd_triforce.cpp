@@ -147,7 +147,7 @@ struct PredictArgs {
   std::string step = "0.05s";
   std::string amplitude = "0m";
   double frequency_Hz = 1000.0;
-  std::size_t max_samples = 20'000'000;
+  std::size_t max_samples = 1'000'000;
   std::string compare;
   CurveSettings curve;
   bool csv = false;

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "mneedle/base/error.h"
+#include "mneedle/base/text.h"
 #include "mneedle/base/units.h"
 
 namespace mneedle {
@@ -201,9 +202,8 @@ std::vector<ProtocolSample> TriforceModel::simulate(const InsertionProtocol& p) 
   if (!(needed <= static_cast<double>(p.max_samples)))
     throw InputError("insertion protocol: " + format_quantity(duration, Dimension::Time) +
                      " in steps of " + format_quantity(p.time_step_s, Dimension::Time) + " is " +
-                     std::to_string(static_cast<long double>(needed)).substr(0, 12) +
-                     " samples, above the limit of " + std::to_string(p.max_samples) +
-                     " (raise it with --max-samples)");
+                     count_text(needed) + " samples, above the limit of " +
+                     std::to_string(p.max_samples) + " (raise it with --max-samples)");
   std::vector<ProtocolSample> out;
   const double t_in = p.max_depth_m / c.speed_m_per_s;
   for (double t = 0.0;; t += p.time_step_s) {

@@ -18,5 +18,16 @@ TEST(Text, TrimKeepsQuotes) {
   EXPECT_EQ(trim(" \"x\" "), "\"x\"");
 }
 
+// `force --step 1e-30m` said "199999999999 points" for 2e27 (its 12 characters of the number)
+// and `--step 1nm` "2000000.0000 points".
+TEST(Text, CountTextIsWholeBelowTenMillionAndThreeDigitsAbove) {
+  EXPECT_EQ(count_text(2000000.0), "2000000");
+  EXPECT_EQ(count_text(1999999.2), "2000000");
+  EXPECT_EQ(count_text(0.0), "0");
+  EXPECT_EQ(count_text(2e27), "2e+27");
+  EXPECT_EQ(count_text(40000000.0), "4e+07");
+  EXPECT_EQ(count_text(12345678.0), "1.23e+07");
+}
+
 }  // namespace
 }  // namespace mneedle
