@@ -14,6 +14,43 @@
 #include "mneedle/fe/sparse_solver.h"
 #include "run_provenance.h"
 
+namespace {
+
+// CLI11 answers a misspelt command with "A subcommand is required", which does not say which
+// word it did not know. Follows the words from the left through the known commands; at the first
+// one that is neither a command nor an option where a command is required, names it, the closest
+// known command and the list (docs/cli.md, "Exit status": unknown command).
+std::string unknown_command(CLI::App& app, int argc, char** argv) {
+  CLI::App* level = &app;
+  std::string path = "mneedle";
+  for (int i = 1; i < argc; ++i) {
+    const std::string word(argv[i]);
+    if (word.empty() || word[0] == '-') return "";
+    CLI::App* next = nullptr;
+    for (CLI::App* sub : level->get_subcommands({}))
+      if (sub->get_name() == word) next = sub;
+    if (next) {
+      level = next;
+      path += " " + word;
+      continue;
+    }
+    if (level->get_require_subcommand_min() == 0) return "";
+    std::string known, best;
+    std::size_t best_distance = 3;
+    for (CLI::App* sub : level->get_subcommands({})) {
+      known += (known.empty() ? "" : ", ") + sub->get_name();
+      const std::size_t d = mneedle::edit_distance(word, sub->get_name());
+      if (d < best_distance) best_distance = d, best = sub->get_name();
+    }
+    return "unknown command '" + path + " " + word + "'" +
+           (best.empty() ? "" : " (did you mean '" + path + " " + best + "'?)") +
+           "; known: " + known;
+  }
+  return "";
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"mneedle: evaluate microneedle designs before fabrication"};
   app.require_subcommand(1);
@@ -89,7 +126,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --help, --version
   } catch (const CLI::ParseError& e) {
-    std::cerr << "mneedle: error: " << e.what() << " (see mneedle --help)\n";
+    const std::string unknown = unknown_command(app, argc, argv);
+    std::cerr << "mneedle: error: " << (unknown.empty() ? std::string(e.what()) : unknown)
+              << " (see mneedle --help)\n";
     return 2;
   } catch (const mneedle::InputError& e) {
     std::cerr << "mneedle: error: " << e.what() << "\n";

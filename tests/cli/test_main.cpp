@@ -42,6 +42,28 @@ TEST(ExitStatus, BadCommandLineIsTwoWithTheErrorPrefix) {
   }
 }
 
+// CLI11 said "A subcommand is required" for a misspelt command; the line names the word, the
+// closest command and the known ones, at the top level and inside `scene` and `plugins`.
+TEST(ExitStatus, AMisspeltCommandIsNamedWithTheClosestKnownOne) {
+  for (const auto& [args, expected] :
+       {std::pair<std::string, std::string>{
+            "scren designs",
+            "unknown command 'mneedle scren' (did you mean 'mneedle screen'?); "
+            "known: scene, plugins,"},
+        std::pair<std::string, std::string>{
+            "scene chek x.toml",
+            "unknown command 'mneedle scene chek' (did you mean 'mneedle scene check'?); known: "
+            "check (see mneedle --help)"},
+        std::pair<std::string, std::string>{
+            "plugins lst", "(did you mean 'mneedle plugins list'?); known: list, describe"},
+        std::pair<std::string, std::string>{"frobnicate",
+                                            "unknown command 'mneedle frobnicate'; known: "}}) {
+    const auto run = run_mneedle(args);
+    EXPECT_EQ(run.exit_code, 2) << args;
+    EXPECT_NE(run.err.find(expected), std::string::npos) << run.err;
+  }
+}
+
 }  // namespace
 
 namespace {

@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "mneedle/base/error.h"
+#include "mneedle/base/text.h"
 #include "mneedle/needle/mesh_io.h"
 #include "mneedle/needle/needle_frame.h"
 
@@ -34,23 +35,6 @@ std::string join_path(const std::string& parent, std::string_view key) {
 
 std::string indexed(const std::string& path, std::size_t i) {
   return path + "[" + std::to_string(i) + "]";
-}
-
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
-                        std::tolower(static_cast<unsigned char>(b[j - 1]));
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
 }
 
 // Reads one TOML table, remembers which keys it was asked about and reports every other key as

@@ -29,5 +29,13 @@ TEST(Text, CountTextIsWholeBelowTenMillionAndThreeDigitsAbove) {
   EXPECT_EQ(count_text(12345678.0), "1.23e+07");
 }
 
+TEST(Text, EditDistanceCountsInsertionsDeletionsAndSubstitutionsIgnoringCase) {
+  EXPECT_EQ(edit_distance("scren", "screen"), 1u);
+  EXPECT_EQ(edit_distance("chek", "check"), 1u);
+  EXPECT_EQ(edit_distance("SCREEN", "screen"), 0u);
+  EXPECT_EQ(edit_distance("", "abc"), 3u);
+  EXPECT_EQ(edit_distance("kitten", "sitting"), 3u);
+}
+
 }  // namespace
 }  // namespace mneedle
