@@ -25,6 +25,7 @@
 #include "mneedle/measurement/force_curve.h"
 #include "mneedle/measurement/toughness.h"
 #include "mneedle/plot/figure.h"
+#include "option_values.h"
 #include "run_provenance.h"
 
 namespace mneedle::cli {
@@ -54,20 +55,6 @@ std::string len(double m) {
   return format_quantity(m, Dimension::Length);
 }
 
-double option_quantity(const std::string& option, std::string_view text, Dimension d) {
-  try {
-    return parse_quantity(text, d);
-  } catch (const InputError& e) {
-    throw InputError(option + ": " + e.what());
-  }
-}
-
-double positive_option(const std::string& option, const std::string& text, Dimension d) {
-  const double v = option_quantity(option, text, d);
-  if (!(v > 0.0)) throw InputError(option + " '" + text + "': must be positive");
-  return v;
-}
-
 // "0mm:18mm,30mm:14mm,50mm:13mm" -> (depth, width) pairs, SI.
 std::vector<std::pair<double, double>> parse_widths(const std::string& text) {
   std::vector<std::pair<double, double>> pairs;
@@ -93,7 +80,7 @@ WidthChoice crack_width(const EnergyArgs& a, double depth_m) {
     throw InputError("energy: give exactly one of --crack-width or --crack-widths");
   WidthChoice w;
   if (!a.crack_width.empty()) {
-    w.mean_m = positive_option("--crack-width", a.crack_width, Dimension::Length);
+    w.mean_m = positive_option_quantity("--crack-width", a.crack_width, Dimension::Length);
     return w;
   }
   w.fit = fit_crack_width(parse_widths(a.crack_widths), depth_m);
@@ -128,8 +115,9 @@ StrainChoice strain_energy(const EnergyArgs& a, double mean_width_m) {
       option_quantity("--tissue", trim(a.tissue.substr(comma + 1)), Dimension::Dimensionless);
   s.problem.crack_width_m = mean_width_m;
   s.problem.needle_radius_m =
-      0.5 * positive_option("--needle-diameter", a.needle_diameter, Dimension::Length);
-  s.problem.block_size_m = positive_option("--block-size", a.block_size, Dimension::Length);
+      0.5 * positive_option_quantity("--needle-diameter", a.needle_diameter, Dimension::Length);
+  s.problem.block_size_m =
+      positive_option_quantity("--block-size", a.block_size, Dimension::Length);
   s.fe = fe::crack_opening_strain_energy(s.problem);
   s.J_per_m = s.fe->strain_energy_J_per_m;
   return s;
@@ -267,13 +255,14 @@ void run_energy(const EnergyArgs& a) {
   std::optional<WidthChoice> width;
   std::optional<StrainChoice> strain;
   if (balance) {
-    in.block_depth_m = positive_option("--depth", a.depth, Dimension::Length);
+    in.block_depth_m = positive_option_quantity("--depth", a.depth, Dimension::Length);
     width = crack_width(a, in.block_depth_m);
     in.mean_crack_width_m = width->mean_m;
     strain = strain_energy(a, width->mean_m);
     in.strain_energy_J_per_m = strain->J_per_m;
     if (!a.friction_force.empty())
-      in.friction_force_N = positive_option("--friction-force", a.friction_force, Dimension::Force);
+      in.friction_force_N =
+          positive_option_quantity("--friction-force", a.friction_force, Dimension::Force);
   }
   const CurveColumns columns{a.depth_col, a.force_col, "", a.depth_unit, a.force_unit};
   std::vector<Record> records;

@@ -19,6 +19,7 @@
 #include "mneedle/insertion/insertion_run.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
+#include "option_values.h"
 #include "run_provenance.h"
 
 namespace mneedle::cli {
@@ -38,7 +39,7 @@ struct ExportArgs {
 void run_export(const ExportArgs& a) {
   Scene scene = load_scene(a.scene);
   if (!a.depth.empty()) {
-    scene.insertion.depth = parse_quantity(a.depth, Dimension::Length);
+    scene.insertion.depth = option_quantity("--depth", a.depth, Dimension::Length);
     if (!(scene.insertion.depth > 0.0))
       throw InputError("export: --depth " + a.depth + ": must be positive");
   }

@@ -24,6 +24,7 @@
 #include "mneedle/plot/figure.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
+#include "option_values.h"
 #include "run_provenance.h"
 
 namespace mneedle::cli {
@@ -92,7 +93,7 @@ std::vector<double> depth_grid(double max_depth, double step, double max_points)
 ForceResult compute(const ForceOptions& options) {
   ForceResult result{load_scene(options.scene), {}, {}};
   const Scene& scene = result.scene;
-  const double step = parse_quantity(options.step, Dimension::Length);
+  const double step = option_quantity("--step", options.step, Dimension::Length);
   if (!(step > 0.0)) throw InputError("--step " + options.step + ": must be a positive length");
   if (!(scene.insertion.depth > 0.0)) {
     throw InputError(scene.source_name + ": insertion.depth must be positive for a force curve");

@@ -32,6 +32,7 @@
 #include "mneedle/screening.h"
 #include "mneedle/strength/needle_material.h"
 #include "mneedle/tip_optimizer.h"
+#include "option_values.h"
 #include "report_needles.h"
 #include "run_provenance.h"
 
@@ -405,7 +406,7 @@ void run_optimize(const OptimizeArgs& a) {
   const PluginShapeInfo& shape = registry.shape(a.plugin);
   Problem problem{scene,      registry,
                   a,          parse_parameter_settings(shape, a.settings),
-                  a.material, parse_quantity(a.min_feature, Dimension::Length),
+                  a.material, option_quantity("--min-feature", a.min_feature, Dimension::Length),
                   {},         {}};
   const auto vars = variables(shape, a);
   if (!(problem.min_feature > 0.0))
@@ -436,7 +437,7 @@ void run_optimize(const OptimizeArgs& a) {
   o.seed = a.seed;
   run_provenance().seed = a.seed;
   if (!a.max_time.empty()) {
-    o.max_time_s = parse_quantity(a.max_time, Dimension::Time);
+    o.max_time_s = option_quantity("--max-time", a.max_time, Dimension::Time);
     if (!(o.max_time_s > 0.0))
       throw InputError("--max-time: must be a positive time, got '" + a.max_time + "'");
   }

@@ -19,6 +19,7 @@
 #include "mneedle/base/units.h"
 #include "mneedle/fe/plane_strain_insertion.h"
 #include "mneedle/plot/figure.h"
+#include "option_values.h"
 
 namespace mneedle::cli {
 namespace {
@@ -32,22 +33,14 @@ struct PlaneStrainArgs {
   bool json = false;
 };
 
-double quantity(const std::string& option, std::string_view text, Dimension d) {
-  try {
-    return parse_quantity(text, d);
-  } catch (const InputError& e) {
-    throw InputError(option + ": " + e.what());
-  }
-}
-
 // "A,B" -> two quantities of one dimension.
 std::pair<double, double> pair_of(const std::string& option, const std::string& text,
                                   Dimension first, Dimension second, const char* example) {
   const auto comma = text.find(',');
   if (comma == std::string::npos)
     throw InputError(option + " '" + text + "': expected two values, e.g. " + example);
-  return {quantity(option, trim(text.substr(0, comma)), first),
-          quantity(option, trim(text.substr(comma + 1)), second)};
+  return {option_quantity(option, trim(text.substr(0, comma)), first),
+          option_quantity(option, trim(text.substr(comma + 1)), second)};
 }
 
 std::string sig(double v, int digits = 4) {
@@ -110,16 +103,18 @@ void run_plane_strain(const PlaneStrainArgs& a) {
       pair_of("--block", a.block, Dimension::Length, Dimension::Length, "160mm,86mm");
   p.block_width_m = width;
   p.block_depth_m = depth;
-  p.thickness_m = quantity("--thickness", a.thickness, Dimension::Length);
-  p.needle_width_m = quantity("--needle-width", a.needle_width, Dimension::Length);
-  p.tip_angle_rad = quantity("--tip-angle", a.tip_angle, Dimension::Angle);
+  p.thickness_m = option_quantity("--thickness", a.thickness, Dimension::Length);
+  p.needle_width_m = option_quantity("--needle-width", a.needle_width, Dimension::Length);
+  p.tip_angle_rad = option_quantity("--tip-angle", a.tip_angle, Dimension::Angle);
   p.friction_coefficient = a.friction;
-  p.travel_m = a.travel.empty() ? depth : quantity("--travel", a.travel, Dimension::Length);
+  p.travel_m = a.travel.empty() ? depth : option_quantity("--travel", a.travel, Dimension::Length);
   if (!a.shoulder_radius.empty())
-    p.shoulder_radius_m = quantity("--shoulder-radius", a.shoulder_radius, Dimension::Length);
+    p.shoulder_radius_m =
+        option_quantity("--shoulder-radius", a.shoulder_radius, Dimension::Length);
   if (!a.element_size.empty())
-    p.element_size_m = quantity("--element-size", a.element_size, Dimension::Length);
-  if (!a.step.empty()) p.step_m = quantity("--step", a.step, Dimension::Length);
+    p.element_size_m =
+        positive_option_quantity("--element-size", a.element_size, Dimension::Length);
+  if (!a.step.empty()) p.step_m = positive_option_quantity("--step", a.step, Dimension::Length);
   const bool cohesive = !a.toughness.empty();
   if (!cohesive && (!a.openings.empty() || !a.initial_cut.empty() || !a.viscosity.empty()))
     throw InputError(
@@ -128,7 +123,8 @@ void run_plane_strain(const PlaneStrainArgs& a) {
   if (cohesive) {
     if (a.openings.empty())
       throw InputError("plane-strain: --toughness needs --cohesive-openings (e.g. 7mm,7.5mm)");
-    p.cohesion.toughness_J_per_m2 = quantity("--toughness", a.toughness, Dimension::Toughness);
+    p.cohesion.toughness_J_per_m2 =
+        option_quantity("--toughness", a.toughness, Dimension::Toughness);
     if (!(p.cohesion.toughness_J_per_m2 > 0.0))
       throw InputError("--toughness '" + a.toughness +
                        "': must be positive (leave it out for a cut block)");
@@ -137,9 +133,9 @@ void run_plane_strain(const PlaneStrainArgs& a) {
     p.cohesion.peak_opening_m = peak;
     p.cohesion.failure_opening_m = failure;
     if (!a.initial_cut.empty())
-      p.cohesion.initial_cut_m = quantity("--initial-cut", a.initial_cut, Dimension::Length);
+      p.cohesion.initial_cut_m = option_quantity("--initial-cut", a.initial_cut, Dimension::Length);
     if (!a.viscosity.empty())
-      p.cohesion.viscosity_m = quantity("--viscosity", a.viscosity, Dimension::Length);
+      p.cohesion.viscosity_m = option_quantity("--viscosity", a.viscosity, Dimension::Length);
   }
   const fe::PlaneStrainInsertionResult r = fe::simulate_plane_strain_insertion(p);
   const fe::PlaneStrainInsertionStep& end = r.steps.back();

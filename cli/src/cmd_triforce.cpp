@@ -28,6 +28,7 @@
 #include "mneedle/measurement/triforce_fit.h"
 #include "mneedle/measurement/triforce_model.h"
 #include "mneedle/plot/figure.h"
+#include "option_values.h"
 #include "run_provenance.h"
 
 namespace mneedle::cli {
@@ -211,15 +212,17 @@ void run_predict(const PredictArgs& args) {
   if (!(args.frequency_Hz > 0.0)) throw InputError("predict: --perturb-frequency must be > 0 Hz");
   const TriforceModel model(read_params(args.params_file));
   InsertionProtocol protocol;
-  protocol.conditions.speed_m_per_s = parse_quantity(args.speed, Dimension::Speed);
-  protocol.conditions.angle_rad = parse_quantity(args.angle, Dimension::Angle);
-  protocol.conditions.perturbation_amplitude_m = parse_quantity(args.amplitude, Dimension::Length);
+  protocol.conditions.speed_m_per_s = option_quantity("--speed", args.speed, Dimension::Speed);
+  protocol.conditions.angle_rad = option_quantity("--angle", args.angle, Dimension::Angle);
+  protocol.conditions.perturbation_amplitude_m =
+      option_quantity("--perturb-amplitude", args.amplitude, Dimension::Length);
   protocol.conditions.perturbation_frequency_Hz = args.frequency_Hz;
-  protocol.hold_s = parse_quantity(args.hold, Dimension::Time);
-  protocol.time_step_s = parse_quantity(args.step, Dimension::Time);
+  protocol.hold_s = option_quantity("--hold", args.hold, Dimension::Time);
+  protocol.time_step_s = option_quantity("--step", args.step, Dimension::Time);
   protocol.max_samples = args.max_samples;
   if (!args.retract_speed.empty()) {
-    protocol.retraction_speed_m_per_s = parse_quantity(args.retract_speed, Dimension::Speed);
+    protocol.retraction_speed_m_per_s =
+        option_quantity("--retract-speed", args.retract_speed, Dimension::Speed);
   }
   std::optional<LoadedCurve> measured;
   if (!args.compare.empty()) {
@@ -230,7 +233,7 @@ void run_predict(const PredictArgs& args) {
     measured = load_fit_curve(args.compare, c);
   }
   if (!args.depth.empty()) {
-    protocol.max_depth_m = parse_quantity(args.depth, Dimension::Length);
+    protocol.max_depth_m = option_quantity("--depth", args.depth, Dimension::Length);
   } else if (measured) {
     protocol.max_depth_m = measured->curve.depth_m.back();
   } else {

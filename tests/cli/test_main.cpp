@@ -42,6 +42,27 @@ TEST(ExitStatus, BadCommandLineIsTwoWithTheErrorPrefix) {
   }
 }
 
+// A value error names the option it came from (it said only '"10" needs a unit'), and a zero that
+// plane-strain used to replace silently by its default is refused.
+TEST(ExitStatus, AValueErrorNamesItsOption) {
+  const std::string silicone = kRoot + "/designs/scenes/silicone_phantom.toml";
+  const std::string strip =
+      "plane-strain --tissue 7kPa,0.475 --block 160mm,86mm --needle-width 8mm --tip-angle 50deg ";
+  for (const auto& [args, expected] :
+       {std::pair<std::string, std::string>{"force '" + silicone + "' --step 10",
+                                            "--step: \"10\" needs a unit: a length"},
+        std::pair<std::string, std::string>{strip + "--thickness 15mm --element-size 0mm",
+                                            "--element-size 0mm: must be positive"},
+        std::pair<std::string, std::string>{strip + "--thickness 15mm --step -1mm",
+                                            "--step -1mm: must be positive"},
+        std::pair<std::string, std::string>{strip + "--thickness 15",
+                                            "--thickness: \"15\" needs a unit"}}) {
+    const auto run = run_mneedle(args);
+    EXPECT_EQ(run.exit_code, 1) << args;
+    EXPECT_NE(run.err.find(expected), std::string::npos) << run.err;
+  }
+}
+
 // CLI11 said "A subcommand is required" for a misspelt command; the line names the word, the
 // closest command and the known ones, at the top level and inside `scene` and `plugins`.
 TEST(ExitStatus, AMisspeltCommandIsNamedWithTheClosestKnownOne) {

@@ -190,10 +190,18 @@ ForceComponents TriforceModel::loading(double depth_m, const InsertionConditions
 
 std::vector<ProtocolSample> TriforceModel::simulate(const InsertionProtocol& p) const {
   const auto& c = p.conditions;
-  if (!(c.speed_m_per_s > 0.0) || !(p.max_depth_m > 0.0) || !(p.time_step_s > 0.0) ||
-      !(p.hold_s >= 0.0) || !(p.retraction_speed_m_per_s >= 0.0)) {
-    throw InputError("insertion protocol: speed, depth and time step must be > 0, hold >= 0");
-  }
+  // Each value named with the one that is wrong (the command line's options have these names).
+  const auto require = [](bool ok, const char* name, double value, Dimension d, const char* rule) {
+    if (!ok)
+      throw InputError(std::string("insertion protocol: ") + name + " " +
+                       format_quantity(value, d) + ": must be " + rule);
+  };
+  require(c.speed_m_per_s > 0.0, "speed", c.speed_m_per_s, Dimension::Speed, "positive");
+  require(p.max_depth_m > 0.0, "depth", p.max_depth_m, Dimension::Length, "positive");
+  require(p.time_step_s > 0.0, "time step", p.time_step_s, Dimension::Time, "positive");
+  require(p.hold_s >= 0.0, "hold", p.hold_s, Dimension::Time, "zero or positive");
+  require(p.retraction_speed_m_per_s >= 0.0, "retraction speed", p.retraction_speed_m_per_s,
+          Dimension::Speed, "positive (or 0 for the insertion speed)");
   const double lambda = params_.relaxation_time_s;
   const double back_speed =
       p.retraction_speed_m_per_s > 0.0 ? p.retraction_speed_m_per_s : c.speed_m_per_s;

@@ -1,0 +1,21 @@
+#include "option_values.h"
+
+#include "mneedle/base/error.h"
+
+namespace mneedle::cli {
+
+double option_quantity(const std::string& option, std::string_view text, Dimension d) {
+  try {
+    return parse_quantity(text, d);
+  } catch (const InputError& e) {
+    throw InputError(option + ": " + e.what());
+  }
+}
+
+double positive_option_quantity(const std::string& option, std::string_view text, Dimension d) {
+  const double v = option_quantity(option, text, d);
+  if (!(v > 0.0)) throw InputError(option + " " + std::string(text) + ": must be positive");
+  return v;
+}
+
+}  // namespace mneedle::cli
