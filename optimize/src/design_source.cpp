@@ -82,7 +82,9 @@ NeedleSource needle_from_file(const std::filesystem::path& file, double metres_p
   const FrameInfo frame = place_in_needle_frame(n.mesh, axis);
   const bool input_z = std::abs(frame.axis[2] + 1.0) < 1e-9;
   n.frame_note = repaired;
-  if (!input_z) n.frame_note += (n.frame_note.empty() ? "" : "; ") + frame.note;
+  // A guessed axis is said even when the guess is the input z (a cube, a body as wide as long).
+  if (!input_z || frame.fell_back_to_input_z)
+    n.frame_note += (n.frame_note.empty() ? "" : "; ") + frame.note;
   if (const auto jump = find_holder_jump(n.mesh)) {
     // Cut a hair below the holder's face, so the cut never runs along it.
     const double cut = jump->height_m - 1e-6 * jump->total_height_m;

@@ -5,6 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <map>
 
 #include <cmath>
@@ -12,6 +15,7 @@
 #include <string>
 
 #include "mneedle/geometry/cross_section.h"
+#include "mneedle/needle/mesh_io.h"
 #include "mneedle/plugin_host.h"
 #include "mneedle/scene/scene.h"
 
@@ -224,6 +228,31 @@ TEST_F(DesignSource, APyramidTipOnARoundShaftHasNoProfile) {
   // A closed surface the slicer takes (so the answer is the sections', not an open mesh's).
   EXPECT_NO_THROW(mneedle::CrossSectionSlicer{mesh});
   EXPECT_FALSE(mneedle::revolution_profile(mesh).has_value());
+}
+
+// A mesh file whose axis `auto` cannot find (a cube) is read along its z, and the note says so:
+// screen showed the cube's row with no word of the guess (design_source.h, frame_note).
+TEST_F(DesignSource, AMeshWithoutANarrowerEndCarriesANoteThatItsAxisWasGuessed) {
+  mneedle::TriangleMesh cube;
+  for (double z : {0.0, 0.2})
+    cube.vertices.insert(cube.vertices.end(), {{0, 0, z}, {0.2, 0, z}, {0.2, 0.2, z}, {0, 0.2, z}});
+  auto quad = [&cube](std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {
+    cube.triangles.push_back({a, b, c});
+    cube.triangles.push_back({a, c, d});
+  };
+  quad(0, 3, 2, 1);
+  quad(4, 5, 6, 7);
+  for (std::uint32_t i = 0; i < 4; ++i) quad(i, (i + 1) % 4, 4 + (i + 1) % 4, 4 + i);
+  const auto file =
+      std::filesystem::temp_directory_path() / ("cube_" + std::to_string(::getpid()) + ".stl");
+  mneedle::write_stl_binary(cube, file, 1e-3);
+  const auto needle = mneedle::needle_from_file(file, 1e-3);
+  std::filesystem::remove(file);
+  EXPECT_NE(needle.frame_note.find("no end is narrower than the other: used the input z"),
+            std::string::npos)
+      << needle.frame_note;
+  const auto cone = mneedle::needle_from_file(kRoot + "/designs/cone.stl", 1e-3);
+  EXPECT_EQ(cone.frame_note, "");
 }
 
 TEST_F(DesignSource, SimulatesPreparedNeedlesCarryTheirSymmetry) {

@@ -349,12 +349,16 @@ FrameInfo find_needle_frame(const TriangleMesh& mesh, const AxisChoice& choice) 
       if (const auto d = narrower_end_direction(
               mesh, center, normalized_direction(choice.tip_direction), info.note)) {
         direction = *d;
+      } else {
+        info.fell_back_to_input_z = true;
       }
       break;
     case AxisChoice::Kind::automatic:
       if (const auto d = narrower_end_direction(mesh, center, std::nullopt, info.note)) {
         direction = *d;
         info.auto_axis = true;
+      } else {
+        info.fell_back_to_input_z = true;
       }
       break;
   }

@@ -157,6 +157,32 @@ TEST(NeedleFrame, AutoFindsPrincipalAxisAndNarrowEnd) {
   expect_same_up_to_roll(mesh, reference, 1e-9);
 }
 
+// A cube has no principal axis and no narrower end: `auto` falls back to the input z and says so,
+// so the caller can show the guess (screen printed "done cube" with no word of it). The square
+// needle's axis is found, no fallback.
+TEST(NeedleFrame, AutoOnABodyWithoutANarrowerEndSaysItFellBackToTheInputZ) {
+  TriangleMesh cube;
+  for (double z : {0.0, 1.0})
+    cube.vertices.insert(cube.vertices.end(), {{0, 0, z}, {1, 0, z}, {1, 1, z}, {0, 1, z}});
+  auto quad = [&cube](std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {
+    cube.triangles.push_back({a, b, c});
+    cube.triangles.push_back({a, c, d});
+  };
+  quad(0, 3, 2, 1);  // bottom, outward -z
+  quad(4, 5, 6, 7);  // top
+  for (std::uint32_t i = 0; i < 4; ++i) quad(i, (i + 1) % 4, 4 + (i + 1) % 4, 4 + i);
+  AxisChoice choice;
+  choice.kind = AxisChoice::Kind::automatic;
+  const FrameInfo info = mneedle::place_in_needle_frame(cube, choice);
+  EXPECT_TRUE(info.fell_back_to_input_z);
+  EXPECT_FALSE(info.auto_axis);
+  EXPECT_NE(info.note.find("no end is narrower than the other: used the input z"),
+            std::string::npos)
+      << info.note;
+  TriangleMesh needle = square_needle();
+  EXPECT_FALSE(mneedle::place_in_needle_frame(needle, choice).fell_back_to_input_z);
+}
+
 TEST(NeedleFrame, ResultIsIndependentOfRigidMotion) {
   const TriangleMesh reference = square_needle();
   std::mt19937 random(20261122);

@@ -20,6 +20,9 @@ struct FrameInfo {
   Vec3 origin{};
   double tip_offset_m = 0.0;
   bool auto_axis = false;  ///< axis found by principal-component analysis
+  /// `auto` or a line was asked for but no end is narrower (a cube, a cylinder with flat ends):
+  /// the input z was used, a guess the caller should show (the note says why).
+  bool fell_back_to_input_z = false;
   std::string note;        ///< how the tip was found, e.g. which end `auto` chose
 };
 
