@@ -75,6 +75,15 @@ std::vector<std::string> split(const std::string& text, char sep) {
 }
 
 // One end of a --bound, in the parameter's unit; errors name --bound, not --set.
+// A plugin parameter's SI value in its unit for a message: angles in degrees, lengths scaled.
+std::string parameter_text(const std::string& unit, double value) {
+  if (unit == "rad") return format_quantity(value, Dimension::Angle);
+  if (unit == "m") return format_quantity(value, Dimension::Length);
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
 double bound_value(const PluginShapeInfo& shape, const std::string& name, const std::string& text,
                    const char* end) {
   try {
@@ -104,8 +113,22 @@ std::vector<DesignVariable> variables(const PluginShapeInfo& shape, const Optimi
       throw InputError("--vary: shape '" + shape.name + "' has no parameter '" + name + "'");
     DesignVariable v{name, it->min, it->max};
     if (const auto u = user.find(name); u != user.end()) {
-      v.lower = std::max(v.lower, bound_value(shape, name, u->second.first, "low"));
-      v.upper = std::min(v.upper, bound_value(shape, name, u->second.second, "high"));
+      // Beyond the shape's own range there are no shapes: refused, not narrowed in silence.
+      const double low = bound_value(shape, name, u->second.first, "low");
+      const double high = bound_value(shape, name, u->second.second, "high");
+      const std::string range = " (the shape's range is " + parameter_text(it->unit, it->min) +
+                                " to " + parameter_text(it->unit, it->max) + ")";
+      if (low < it->min)
+        throw InputError("--bound " + name + ": low " + u->second.first +
+                         " is below the shape's minimum" + range);
+      if (high > it->max)
+        throw InputError("--bound " + name + ": high " + u->second.second +
+                         " is above the shape's maximum" + range);
+      if (!(low < high))
+        throw InputError("--bound " + name + ": low " + u->second.first + " must be below high " +
+                         u->second.second);
+      v.lower = low;
+      v.upper = high;
     }
     out.push_back(v);
   }
@@ -253,7 +276,8 @@ void write_outputs(const std::filesystem::path& dir, const TriangleMesh& best_me
 }
 
 // The optimum's place (bound, constraint, interior) and the failures, for JSON.
-nlohmann::json optimum_json(const OptimumReport& report) {
+nlohmann::json optimum_json(const OptimumReport& report,
+                            const std::vector<std::string>& shape_limit) {
   const auto names = [](const std::vector<int>& indices) {
     nlohmann::json list = nlohmann::json::array();
     for (int i : indices) list.push_back(kConstraintNames[i]);
@@ -267,6 +291,7 @@ nlohmann::json optimum_json(const OptimumReport& report) {
   return {{"interior", report.interior()},
           {"on_lower_bound", report.on_lower_bound},
           {"on_upper_bound", report.on_upper_bound},
+          {"on_shape_limit", shape_limit},
           {"active_constraints", names(report.active_constraints)},
           {"violated_constraints", names(report.violated_constraints)},
           {"failed_evaluations", report.failed},
@@ -275,12 +300,44 @@ nlohmann::json optimum_json(const OptimumReport& report) {
           {"impossible_causes", causes(report.impossible_causes)}};
 }
 
-// One line: where the optimum is. A bound means the box stopped the search, not the physics.
-std::string optimum_text(const OptimumReport& report) {
-  if (report.interior()) return "interior (no bound and no constraint is active)";
+// The bounds the optimum sits on that are the shape's own range (no --bound can widen them).
+std::vector<std::string> on_shape_limit(const OptimumReport& report, const PluginShapeInfo& shape,
+                                        const std::vector<DesignVariable>& vars) {
+  std::vector<std::string> out;
+  const auto limit = [&](const std::string& name, bool upper) {
+    for (const DesignVariable& v : vars) {
+      if (v.name != name) continue;
+      for (const PluginParameter& p : shape.parameters)
+        if (p.name == name && (upper ? v.upper == p.max : v.lower == p.min)) return true;
+    }
+    return false;
+  };
+  for (const auto& n : report.on_lower_bound)
+    if (limit(n, false)) out.push_back(n);
+  for (const auto& n : report.on_upper_bound)
+    if (limit(n, true)) out.push_back(n);
+  return out;
+}
+
+// One line: where the optimum is. A bound means the box stopped the search, not the physics; a
+// shape's own limit cannot be widened. Points that made no valid shape are a boundary the
+// search cannot see as a constraint: an "interior" optimum may lie on it.
+std::string optimum_text(const OptimumReport& report, const std::vector<std::string>& shape_limit) {
+  const auto own = [&](const std::string& n) {
+    return std::find(shape_limit.begin(), shape_limit.end(), n) != shape_limit.end()
+               ? " (the shape's own limit)"
+               : "";
+  };
+  if (report.interior())
+    return report.impossible > 0
+               ? "interior among valid shapes (no bound and no constraint is active; " +
+                     std::to_string(report.impossible) +
+                     " points made no valid shape, so it may lie on the edge of what the shape "
+                     "allows)"
+               : "interior (no bound and no constraint is active)";
   std::vector<std::string> parts;
-  for (const auto& n : report.on_lower_bound) parts.push_back("lower bound of " + n);
-  for (const auto& n : report.on_upper_bound) parts.push_back("upper bound of " + n);
+  for (const auto& n : report.on_lower_bound) parts.push_back("lower bound of " + n + own(n));
+  for (const auto& n : report.on_upper_bound) parts.push_back("upper bound of " + n + own(n));
   const auto constraint = [](int i) {
     const std::string c = kConstraintNames[i];
     return c.substr(0, c.size() - std::string("_constraint").size()) + " constraint";
@@ -293,7 +350,7 @@ std::string optimum_text(const OptimumReport& report) {
              : text.empty() ? "beyond the "
                             : "; beyond the ") +
             constraint(report.violated_constraints[i]);
-  if (!report.on_lower_bound.empty() || !report.on_upper_bound.empty())
+  if (report.on_lower_bound.size() + report.on_upper_bound.size() > shape_limit.size())
     text += " (widen --bound to search further)";
   return text;
 }
@@ -517,7 +574,7 @@ void run_optimize(const OptimizeArgs& a) {
                                  ? nlohmann::json(*problem.evaluation.overrides.tip_size_m)
                                  : nlohmann::json(nullptr)},
       {"material", problem.material},
-      {"optimum", optimum_json(report)},
+      {"optimum", optimum_json(report, on_shape_limit(report, shape, vars))},
       {"history", history_json(r.history)},
       {"warnings", warnings}};
   if (!a.out.empty()) write_outputs(a.out, best.mesh, summary);
@@ -552,7 +609,7 @@ void run_optimize(const OptimizeArgs& a) {
                     : "not reached before " + format_quantity(e.depth_m, Dimension::Length))
             << "\n  peak force " << format_quantity(e.peak_force_n, Dimension::Force)
             << ", strength margin " << e.margin << " (safety factor " << e.safety_factor << ")\n"
-            << "  optimum " << optimum_text(report) << "\n";
+            << "  optimum " << optimum_text(report, on_shape_limit(report, shape, vars)) << "\n";
   print_causes(report.failed, r.evaluations, "failed", report.failures);
   print_causes(report.impossible, r.evaluations, "were no valid shape (infeasible)",
                report.impossible_causes);

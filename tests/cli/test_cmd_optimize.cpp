@@ -269,6 +269,33 @@ TEST(OptimizeCommand, SummarySaysWhereTheOptimumIsAndHowManyEvaluationsFailed) {
   fs::remove_all(dir);
 }
 
+// A --bound beyond the shape's own range was narrowed to it in silence (-10 deg read as 5 deg); it
+// is refused with the range. On the shape's own limit the summary does not advise widening
+// --bound, which cannot go further: the sharp bevel's 85 deg maximum.
+TEST(OptimizeCommand, ABoundBeyondTheShapesRangeIsRefusedAndItsOwnLimitIsNamedAsSuch) {
+  const auto beyond = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSilicone +
+                                  "' --vary bevel_angle --bound bevel_angle=-10deg:40deg"
+                                  " --model analytic --max-evals 2");
+  EXPECT_EQ(beyond.exit_code, 1);
+  EXPECT_NE(beyond.err.find("--bound bevel_angle: low -10deg is below the shape's minimum (the "
+                            "shape's range is 5 deg to 85 deg)"),
+            std::string::npos)
+      << beyond.err;
+  const std::string common = "optimize --plugin sharp_bevel --scene '" + kSilicone +
+                             "' --vary bevel_angle --bound bevel_angle=60deg:85deg"
+                             " --model analytic --max-evals 20";
+  const auto json = run_mneedle(common + " --json");
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  const auto optimum = nlohmann::json::parse(json.out)["optimum"];
+  EXPECT_EQ(optimum["on_upper_bound"], nlohmann::json::array({"bevel_angle"})) << optimum.dump();
+  EXPECT_EQ(optimum["on_shape_limit"], nlohmann::json::array({"bevel_angle"})) << optimum.dump();
+  const auto text = run_mneedle(common);
+  EXPECT_NE(text.out.find("optimum on the upper bound of bevel_angle (the shape's own limit)"),
+            std::string::npos)
+      << text.out;
+  EXPECT_EQ(text.out.find("widen --bound"), std::string::npos) << text.out;
+}
+
 TEST(OptimizeCommand, BevelLongerThanTheNeedleIsAnImpossibleDesignNotAFailure) {
   // The plugin's whole ranges: thin bevels on wide needles are longer than the needle.
   const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSilicone +
