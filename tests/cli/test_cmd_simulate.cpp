@@ -585,6 +585,39 @@ TEST(CmdSimulate, ARoundedBevelTipIsAPointContactAndPuncturesWhereTheSharpOneDoe
   fs::remove(file);
 }
 
+// Three refinement levels built a coarse grid whose clearance dropped the bevel's tip line (R from
+// the axis): no node lay under the tip, the force at 80 um read 0.41 mN against 0.94-1.00 mN at
+// 0-2 levels and the puncture 712.2 um (docs/validation.md, "Refinement levels beyond two"). The
+// clearance now stops at two levels' grid: 1.107 mN and 657.36 um, pinned to 0.1 % (deterministic
+// runs); 4 levels, once 123 um in skin, are refused.
+TEST(CmdSimulate, AThirdRefinementLevelKeepsTheBevelTipsGridLineAndAFourthIsRefused) {
+  std::string text = mneedle::test::file_text(std::string(MNEEDLE_SOURCE_ROOT) +
+                                              "/designs/scenes/paper_a_silicone_sharp_bevel.toml");
+  const std::string criterion = "criterion = \"pressure\"";
+  ASSERT_NE(text.find(criterion), std::string::npos);
+  const fs::path file =
+      fs::temp_directory_path() / ("refinement_" + std::to_string(::getpid()) + ".toml");
+  for (const int levels : {3, 4}) {
+    std::string scene = text;
+    scene.replace(scene.find(criterion), criterion.size(),
+                  criterion + "\nmesh_refinement = " + std::to_string(levels));
+    std::ofstream(file) << scene;
+    const CommandRun run = run_mneedle("simulate '" + file.string() + "' --fidelity fast --json");
+    if (levels == 4) {
+      EXPECT_EQ(run.exit_code, 1);
+      EXPECT_NE(run.err.find("model.mesh_refinement: must be 0 to 3, got 4"), std::string::npos)
+          << run.err;
+      continue;
+    }
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const auto needle = nlohmann::json::parse(run.out)["needles"][0];
+    EXPECT_NEAR(needle["curve"][0]["depth_m"].get<double>(), 80e-6, 1e-12);
+    EXPECT_NEAR(needle["curve"][0]["force_N"].get<double>(), 1.107e-3, 1e-3 * 1.107e-3);
+    EXPECT_NEAR(needle["puncture"]["depth_m"].get<double>(), 657.36e-6, 1e-3 * 657.36e-6);
+  }
+  fs::remove(file);
+}
+
 // Under the pressure criterion in skin a sharp tip fires at the first step: F/A_sec grows without
 // bound toward the tip (docs/model.md, "Criteria", fires at first contact). A rounded one bounds
 // it: paper A's skin sharp bevel with tip_radius 1 um at standard reads 2.814 MPa at its first

@@ -412,9 +412,9 @@ TEST(SceneErrors, AContactZoneTipNeedsItsZoneAndFitsInIt) {
                {"model.contact_zone", "needs mesh_refinement >= 1"});
 }
 
-TEST(SceneErrors, MeshRefinementOutsideZeroToSixOrNotAWholeNumber) {
-  expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\nmesh_refinement = 7"),
-               {"test.toml:31:", "model.mesh_refinement", "must be 0 to 6, got 7"});
+TEST(SceneErrors, MeshRefinementOutsideZeroToThreeOrNotAWholeNumber) {
+  expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\nmesh_refinement = 4"),
+               {"test.toml:31:", "model.mesh_refinement", "must be 0 to 3, got 4"});
   expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\nmesh_refinement = 1.5"),
                {"test.toml:31:", "model.mesh_refinement", "expected a whole number"});
   expect_error(with("fidelity = \"standard\"", "fidelity = \"standard\"\nmesh_refinement = \"2\""),

@@ -118,7 +118,7 @@ enum class Contact { Sticking, Frictionless };
 enum class CrackFaces { Contact, Free };
 
 /// Largest `[model] mesh_refinement` (each level halves the element size along the path).
-inline constexpr int kMaxMeshRefinement = 6;
+inline constexpr int kMaxMeshRefinement = 3;
 
 struct ModelOptions {
   Fidelity fidelity = Fidelity::Standard;
