@@ -138,9 +138,9 @@ void TetBisection::refine(const std::function<double(const Eigen::Vector3d&)>& t
       if (!(extent(t) > kMargin * target(centroid(t)))) continue;
       bisect_conforming(t, 0);
       if (tets_.size() > max_tets)
-        throw InputError(
-            "tissue block: mesh refinement: more than " + std::to_string(max_tets) +
-            " tetrahedra; lower [model] mesh_refinement (or coarsen the tip size override)");
+        throw InputError("tissue block: mesh refinement: more than " + std::to_string(max_tets) +
+                         " tetrahedra; a coarser [model] contact_zone or contact_zone_tip, fewer "
+                         "mesh_refinement levels or a coarser fidelity needs fewer");
     }
   }
 }

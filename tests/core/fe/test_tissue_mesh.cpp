@@ -761,6 +761,21 @@ TEST(TissueMesh, RefinedMeshKeepsTheQualityFloorAtEveryLevel) {
     }
 }
 
+// A 1 m skin block: its 20 um top layer caps the cells' width, so the plain grid alone is 10^8
+// tetrahedra; refused by its size before a node is made (it once reached 14.6 GB first).
+TEST(TissueMesh, ABlockWhoseGridAloneIsPastTheCapIsRefusedBeforeAnyNode) {
+  TissueBlockSpec spec = paper_a_skin(Fidelity::Fast, 2);
+  spec.size_x = spec.size_y = 1.0;
+  try {
+    generate_tissue_mesh(spec);
+    FAIL() << "expected an InputError";
+  } catch (const mneedle::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("tissue block: size: the block's grid alone is"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(TissueMesh, RefinementLevelsOutOfRangeAreAnInputError) {
   EXPECT_THROW(generate_tissue_mesh(refined_skin(-1)), mneedle::InputError);
   EXPECT_THROW(generate_tissue_mesh(refined_skin(4)), mneedle::InputError);
