@@ -97,6 +97,9 @@ std::size_t CsvTable::column(std::string_view name) const {
 CsvTable parse_csv(std::string_view text, std::string source) {
   CsvTable table;
   table.source = std::move(source);
+  // Excel's "CSV UTF-8" starts with a byte-order mark, which would become part of the first
+  // column's name ("\xEF\xBB\xBFdepth [mm]" looks like "depth [mm]" and matches nothing).
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
   std::size_t pos = 0;
   std::size_t line = 1;
   while (pos < text.size()) {

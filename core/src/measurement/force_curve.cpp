@@ -92,8 +92,14 @@ double column_scale(const std::string& column, const std::string& unit, Dimensio
   }
 }
 
+// The field as a number in SI (times the column's unit `scale`). Beyond kLargestSample in SI it is
+// no measurement (a force of 10^308 N once passed as a puncture, its work 5e302 J) and a value
+// that overflows only in SI (10^308 kN) would be dropped as noise two checks later: both are
+// refused here, on their own line.
+constexpr double kLargestSample = 1e9;  // N, m or s: far beyond any insertion recording
+
 double parse_number(const std::string& field, const std::string& column, const std::string& source,
-                    std::size_t line) {
+                    std::size_t line, double scale) {
   double value = 0.0;
   const char* end = field.data() + field.size();
   const auto [ptr, ec] = std::from_chars(field.data(), end, value);
@@ -101,7 +107,12 @@ double parse_number(const std::string& field, const std::string& column, const s
     throw InputError(where(source, line) + ": column '" + column + "': '" + field +
                      "' is not a number");
   }
-  return value;
+  const double si = scale * value;
+  if (!(std::abs(si) <= kLargestSample)) {
+    throw InputError(where(source, line) + ": column '" + column + "': '" + field +
+                     "' is beyond any measurement (its size in SI is above 1e9)");
+  }
+  return si;
 }
 
 double median(std::vector<double> v) {
@@ -264,13 +275,13 @@ ForceCurve read_force_curve_csv(const std::filesystem::path& file, const CurveCo
   for (const auto& row : table.rows) {
     const auto& fields = row.fields;
     const std::size_t line_number = row.line;
-    curve.depth_m.push_back(depth_scale * parse_number(fields[depth_col], header[depth_col],
-                                                       curve.source, line_number));
-    curve.force_N.push_back(force_scale * parse_number(fields[force_col], header[force_col],
-                                                       curve.source, line_number));
+    curve.depth_m.push_back(
+        parse_number(fields[depth_col], header[depth_col], curve.source, line_number, depth_scale));
+    curve.force_N.push_back(
+        parse_number(fields[force_col], header[force_col], curve.source, line_number, force_scale));
     if (time_col) {
-      curve.time_s.push_back(time_scale * parse_number(fields[*time_col], header[*time_col],
-                                                       curve.source, line_number));
+      curve.time_s.push_back(parse_number(fields[*time_col], header[*time_col], curve.source,
+                                          line_number, time_scale));
     }
     curve.line.push_back(line_number);
   }

@@ -85,6 +85,40 @@ TEST(ForceCurve, TextInANumberNamesFileLineAndColumn) {
   EXPECT_NE(msg.find("'abc' is not a number"), std::string::npos) << msg;
 }
 
+// 10^308 N passed as a puncture force (work 5e302 J); 10^308 kN, finite only before its unit,
+// was dropped as noise and reported as "no loading branch" on the last line. Both are refused on
+// their own line. Excel's "CSV UTF-8" byte-order mark no longer hides the first column's name.
+TEST(ForceCurve, ASampleBeyondAnyMeasurementIsRefusedOnItsLineAndAByteOrderMarkIsSkipped) {
+  std::filesystem::create_directories(kWork);
+  const auto write = [](const std::string& name, const std::string& text) {
+    const auto path = kWork / name;
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+  };
+  for (const auto& [header, value] : {std::pair<std::string, std::string>{"force [N]", "1e308"},
+                                      {"force [kN]", "1e308"},
+                                      {"force [N]", "-2e9"}}) {
+    const auto file =
+        write("big.csv", "depth [mm]," + header + "\n0,0\n0.1,0.01\n0.2," + value + "\n");
+    try {
+      mneedle::read_force_curve_csv(file, {});
+      FAIL() << header << " " << value;
+    } catch (const mneedle::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("big.csv:4: column '" + header + "': '" + value +
+                                           "' is beyond any measurement"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  const auto bom = write("bom.csv",
+                         "\xEF\xBB\xBF"
+                         "depth [mm],force [N]\n0,0\n0.1,0.01\n");
+  const auto curve = mneedle::read_force_curve_csv(bom, {});
+  ASSERT_EQ(curve.depth_m.size(), 2u);
+  EXPECT_EQ(curve.depth_column, "depth [mm]");
+  EXPECT_NEAR(curve.force_N[1], 0.01, 1e-15);
+}
+
 TEST(ForceCurve, FlatRecordingHasNoLoadingBranch) {
   const auto msg = error_of("no_loading_branch.csv");
   EXPECT_NE(msg.find("no_loading_branch.csv:10"), std::string::npos) << msg;
