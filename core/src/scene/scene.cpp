@@ -303,6 +303,20 @@ double read_poisson_ratio(Table& t, std::string_view key) {
   return nu;
 }
 
+// A tissue's Young's modulus, from gels (tens of Pa) to dry stratum corneum (GPa), with room on
+// either side; beyond it the stiffness matrix loses its digits (1e300 Pa overflowed at the first
+// step, 5e-324 Pa was singular) and the run failed late, naming no key.
+constexpr double kSmallestModulus = 1.0;  // Pa
+constexpr double kLargestModulus = 1e12;  // Pa
+constexpr double kLargestFrictionCoefficient = 10.0;
+
+void check_modulus(Table& t, std::string_view key, double e, std::string_view what) {
+  if (!(e >= kSmallestModulus && e <= kLargestModulus)) {
+    t.fail_key(key, std::string(what) + " " + format_quantity(e, Dimension::Pressure) +
+                        " is outside the tissues' range, 1 Pa to 1e12 Pa");
+  }
+}
+
 void reject_keys(Table& t, std::initializer_list<std::string_view> keys, std::string_view why) {
   for (const auto key : keys) {
     if (t.get(key)) t.fail_key(key, std::string(key) + " " + std::string(why));
@@ -315,6 +329,10 @@ void read_mooney_rivlin(Table& t, TissueMaterial& m) {
               "is derived from C10 and C01 for mooney_rivlin (E = 4 (C10 + C01)(1 + nu))");
   m.c10 = t.required_quantity("C10", Dimension::Pressure);
   m.c01 = t.required_quantity("C01", Dimension::Pressure);
+  // As the material model requires (each term's energy must not be negative): `scene check`
+  // accepted C10 = -30 kPa with C01 = 30.000001 kPa, which `simulate` then refused.
+  if (!(m.c10 >= 0.0)) t.fail_key("C10", "must not be negative");
+  if (!(m.c01 >= 0.0)) t.fail_key("C01", "must not be negative");
   const double mu = 2.0 * (m.c10 + m.c01);
   if (!(mu > 0.0)) t.fail_key("C10", "C10 + C01 must be positive (it is half the shear modulus)");
   const bool has_nu = t.get("nu") != nullptr;
@@ -328,8 +346,18 @@ void read_mooney_rivlin(Table& t, TissueMaterial& m) {
   } else {
     const double k = t.required_positive("K", Dimension::Pressure);
     m.poisson_ratio = (3.0 * k - 2.0 * mu) / (2.0 * (3.0 * k + mu));
+    // K far above the shear modulus makes nu 0.5 to the last digit (incompressible), far below
+    // it nu -1: named here, not as a Poisson's ratio of the [loads] model later.
+    if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5)) {
+      std::ostringstream why;
+      why << "gives Poisson's ratio " << m.poisson_ratio
+          << " with C10 + C01, outside (-1, 0.5): K must be finite, positive and not so far above "
+             "the shear modulus that nu is 0.5 to double precision";
+      t.fail_key("K", why.str());
+    }
   }
   m.youngs_modulus = 2.0 * mu * (1.0 + m.poisson_ratio);
+  check_modulus(t, "C10", m.youngs_modulus, "the Young's modulus 4 (C10 + C01)(1 + nu) =");
 }
 
 TissueMaterial read_tissue_material(Table t) {
@@ -348,6 +376,7 @@ TissueMaterial read_tissue_material(Table t) {
   } else {
     reject_keys(t, {"C10", "C01", "K"}, "applies only to model = \"mooney_rivlin\"");
     m.youngs_modulus = t.required_positive("E", Dimension::Pressure);
+    check_modulus(t, "E", m.youngs_modulus, "E =");
     m.poisson_ratio = read_poisson_ratio(t, "nu");
   }
   t.finish();
@@ -478,6 +507,19 @@ Tissue read_tissue(Table t) {
     }
   }
   stack_layers(t, drafts, tissue.depth());
+  // The stress criterion averages over a ball of this radius around points of the layer: one as
+  // large as the block averages the whole block (1 m read as no puncture, without a word).
+  const double smallest = std::min({tissue.size[0], tissue.size[1], tissue.size[2]});
+  for (std::size_t i = 0; i < drafts.size(); ++i) {
+    const auto& strength = drafts[i].layer.strength;
+    if (strength && !(strength->length < 0.5 * smallest)) {
+      t.fail(indexed(t.key_path("layers"), i) + ".strength_length", drafts[i].layer.line,
+             format_quantity(strength->length, Dimension::Length) +
+                 " must be below half the block's smallest side (" +
+                 format_quantity(smallest, Dimension::Length) +
+                 "): the stress is averaged over a ball of this radius");
+    }
+  }
   for (auto& d : drafts) {
     if (!d.layer.fracture) d.layer.fracture = tissue.fracture;
     tissue.layers.push_back(std::move(d.layer));
@@ -815,6 +857,13 @@ Loads read_loads(std::optional<Table> t) {
       t->fail_key("friction_coefficient", "applies only to friction = \"coulomb\"");
     }
     if (*mu < 0.0) t->fail_key("friction_coefficient", "must not be negative");
+    // Measured needle-tissue coefficients lie below 1; 10 leaves room and keeps the friction
+    // force finite (1e300 overflowed the force curve to +Inf, naming an output, not this key).
+    if (*mu > kLargestFrictionCoefficient) {
+      std::ostringstream why;
+      why << "must be at most 10 (measured needle-tissue values are below 1), got " << *mu;
+      t->fail_key("friction_coefficient", why.str());
+    }
     l.friction_coefficient = *mu;
   }
   const auto max_force = t->optional_positive("friction_max_force", Dimension::Force);

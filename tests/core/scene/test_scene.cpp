@@ -638,8 +638,32 @@ TEST(SceneErrors, MooneyRivlinConstantsAreChecked) {
                {"tissue.layers[1].material.E", "derived from C10 and C01"});
   expect_error(with(linear, R"(model = "linear", E = "0.08 MPa", nu = 0.4, C10 = "1 kPa")"),
                {"tissue.layers[1].material.C10", "mooney_rivlin"});
-  expect_error(with(linear, R"(model = "mooney_rivlin", C10 = "-1 kPa", C01 = "0", nu = 0.4)"),
+  expect_error(with(linear, R"(model = "mooney_rivlin", C10 = "0", C01 = "0", nu = 0.4)"),
                {"tissue.layers[1].material.C10", "C10 + C01 must be positive"});
+  // Each term, as the material model requires (scene check once passed this one, simulate not).
+  expect_error(
+      with(linear, R"(model = "mooney_rivlin", C10 = "-30 kPa", C01 = "30.000001 kPa", nu = 0.45)"),
+      {"tissue.layers[1].material.C10", "must not be negative"});
+  expect_error(with(linear, R"(model = "mooney_rivlin", C10 = "30 kPa", C01 = "-1 Pa", nu = 0.45)"),
+               {"tissue.layers[1].material.C01", "must not be negative"});
+  // A bulk modulus that makes nu 0.5 or -1 is named as K (it was "[loads] layer 1: Poisson ratio").
+  for (const char* k : {"1e300 Pa", "1e-300 Pa"})
+    expect_error(
+        with(linear,
+             std::string(R"(model = "mooney_rivlin", C10 = "30 kPa", C01 = "3 kPa", K = ")") + k +
+                 "\""),
+        {"tissue.layers[1].material.K", "gives Poisson's ratio"});
+}
+
+// E far outside any tissue failed late (1e300 Pa: "puncture: step 0 is not finite"; 5e-324 Pa: a
+// singular stiffness), naming no key.
+TEST(SceneErrors, AModulusOutsideTheTissuesRangeIsNamed) {
+  const std::string_view linear = R"(model = "linear", E = "0.08 MPa", nu = 0.4)";
+  for (const char* e : {"1e300 Pa", "5e-324 Pa", "0.5 Pa", "2e12 Pa"})
+    expect_error(with(linear, std::string(R"(model = "linear", nu = 0.4, E = ")") + e + "\""),
+                 {"tissue.layers[1].material.E", "outside the tissues' range, 1 Pa to 1e12 Pa"});
+  parse(with(linear, R"(model = "linear", E = "1 Pa", nu = 0.4)"));
+  parse(with(linear, R"(model = "linear", E = "1e12 Pa", nu = 0.4)"));
 }
 
 TEST(SceneErrors, UnknownMaterialModel) {
@@ -650,6 +674,14 @@ TEST(SceneErrors, UnknownMaterialModel) {
 TEST(SceneErrors, StrengthNeedsItsLength) {
   expect_error(with("thickness = \"20 um\"", "thickness = \"20 um\"\nstrength = \"20 MPa\""),
                {"test.toml:8:", "tissue.layers[0].strength", "strength_length"});
+}
+
+// A 1 m averaging length in a 3 mm block averaged the whole block: "no puncture", no word.
+TEST(SceneErrors, AStrengthLengthAsLargeAsTheBlockIsRefused) {
+  expect_error(with("thickness = \"20 um\"",
+                    "thickness = \"20 um\"\nstrength = \"20 MPa\"\nstrength_length = \"1 m\""),
+               {"test.toml:5:", "tissue.layers[0].strength_length",
+                "must be below half the block's smallest side"});  // the layer's line
 }
 
 TEST(SceneErrors, ExplicitCriterionNeedsItsData) {
@@ -675,6 +707,9 @@ TEST(SceneErrors, LinearGrowthFrictionNeedsBothConstants) {
                {"test.toml:33:", "loads.friction_saturation_depth", "missing"});
   expect_error(std::string(kBase) + "\n[loads]\nfriction = \"none\"\nfriction_coefficient = 0.3\n",
                {"test.toml:35:", "loads.friction_coefficient", "coulomb"});
+  // 1e300 overflowed the force curve to +Inf, named as an output, not as this key.
+  expect_error(std::string(kBase) + "\n[loads]\nfriction_coefficient = 1e300\n",
+               {"test.toml:34:", "loads.friction_coefficient", "must be at most 10"});
   expect_error(std::string(kBase) + "\n[loads]\nfriction_max_force = \"1 N\"\n",
                {"loads.friction_max_force", "linear_growth"});
   expect_error(std::string(kBase) + "\n[loads]\nscale = -0.1\n", {"loads.scale", "positive"});
