@@ -55,7 +55,12 @@ std::map<std::string, double> parse_settings(const std::vector<std::string>& set
                        "' (parameters: " + names + ")");
     }
     if (si.count(key) != 0) throw InputError("--set " + key + ": given twice");
-    const Quantity q = parse_quantity(setting.substr(equals + 1));
+    Quantity q{};
+    try {
+      q = parse_quantity(setting.substr(equals + 1));
+    } catch (const InputError& e) {
+      throw InputError("--set " + key + ": " + e.what());  // which value it was
+    }
     si[key] = quantity_in(q, parameter_dimension(parameter->unit), "--set " + key);
   }
   return si;

@@ -492,7 +492,10 @@ void run_optimize(const OptimizeArgs& a) {
   o.starts = a.starts;
   o.max_evaluations = a.max_evals;
   o.seed = a.seed;
-  run_provenance().seed = a.seed;
+  // Recorded only when something random runs (docs/cli.md, "Provenance": null otherwise): the
+  // scattered starts, ISRES and MLSL; a single local run from the start point draws nothing.
+  const bool random = a.starts > 1 || a.algorithm == "isres" || a.algorithm == "mlsl";
+  if (random) run_provenance().seed = a.seed;
   if (!a.max_time.empty()) {
     o.max_time_s = option_quantity("--max-time", a.max_time, Dimension::Time);
     if (!(o.max_time_s > 0.0))

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "commands.h"
 #include "json_output.h"
@@ -141,7 +142,19 @@ ScreenSetup prepare_screen(const ScreenArgs& args, bool writer) {
   // needles are built and placed although the designs replace them, so a scene `scene check`
   // refuses is refused here too, before any design runs.
   check_needle_placement(s.scene, prepare_needles(s.registry, s.scene));
-  if (writer) record_scene(s.scene, args.scene);
+  if (writer) {
+    record_scene(s.scene, args.scene);
+    // Each design's file, as the scene's own STL needles are (a design list once, however many
+    // designs it holds): the provenance names every byte the ranking came from.
+    std::set<std::filesystem::path> lists;
+    for (const DesignInput& d : s.designs) {
+      if (d.plugin) {
+        if (lists.insert(d.file).second) record_input("design list", d.file);
+      } else {
+        record_input("design " + d.name, d.file);
+      }
+    }
+  }
   if (s.designs.empty()) {
     std::string inputs;
     for (const auto& d : args.designs) inputs += (inputs.empty() ? "" : ", ") + d;
@@ -174,6 +187,7 @@ ScreenSetup prepare_screen(const ScreenArgs& args, bool writer) {
     for (const auto& spec : args.vary) options.vary.push_back(parse_varied_value(spec));
     options.uncertainty.samples = args.uncertainty;
     options.uncertainty.seed = args.seed;
+    run_provenance().seed = args.seed;
     options.uncertainty.latin_hypercube = args.method == "lhs";
     // Every path checked against the scene once, before any design runs.
     std::vector<std::pair<VariedValue, double>> medians;

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -147,6 +148,7 @@ void run_uncertainty_command(const UncertaintyArgs& args) {
   UncertaintyOptions options;
   options.samples = args.samples;
   options.seed = args.seed;
+  run_provenance().seed = args.seed;  // the draws are random (docs/cli.md, "Provenance")
   options.latin_hypercube = args.method == "lhs";
   options.jobs = args.jobs;
   options.fidelity = args.fidelity;
@@ -154,9 +156,20 @@ void run_uncertainty_command(const UncertaintyArgs& args) {
   if (!args.material.empty()) options.material = args.material;
   options.sensitivity = !args.no_sensitivity;
   const bool terminal = writer && !args.json && ::isatty(STDERR_FILENO) == 1;
+  // As every long run (docs/cli.md, "Progress"): redrawn on a terminal; to a file or a pipe one
+  // line per ten runs once a second has passed (200 samples ran for minutes without a word).
+  const auto started = std::chrono::steady_clock::now();
   const auto progress = [&](int done, int total) {
-    if (terminal && (done == total || done % 10 == 0))
+    if (!writer || !(done == total || done % 10 == 0)) return;
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    if (terminal) {
       std::cerr << "\runcertainty: " << done << " of " << total << " runs" << std::flush;
+    } else if (elapsed >= 1.0) {
+      char seconds[32];
+      std::snprintf(seconds, sizeof seconds, "%.1f", elapsed);
+      std::cerr << "uncertainty: " << done << " of " << total << " runs, " << seconds << " s\n";
+    }
   };
   std::optional<UncertaintyResult> result;
   if (session) {

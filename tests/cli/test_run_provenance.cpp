@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -124,6 +125,26 @@ TEST_F(Provenance, CsvStartsWithTheProvenanceLine) {
   ASSERT_EQ(first.rfind("# provenance: ", 0), 0u) << first;
   EXPECT_EQ(Json::parse(first.substr(14))["inputs"][0]["sha256"], mneedle::sha256_of_file(kScene));
   EXPECT_EQ(header, "needle,depth_m,force_N,alpha_N,beta_N,friction_N");
+}
+
+// screen's provenance named only the scene; every design's file is an input too (a design list
+// once). A single local optimize run draws nothing random: its seed is null, as documented.
+TEST_F(Provenance, ScreenNamesEveryDesignFileAndOneLocalSearchHasNoSeed) {
+  const std::string skin = mneedle::test::skin_scene_with_criterion("pressure");
+  const auto run =
+      run_mneedle("screen '" + kRoot + "/designs/cone.stl' '" + kRoot +
+                  "/designs/cylinder.stl' --scene '" + skin + "' --model analytic --json");
+  const Json inputs = Json::parse(run.out)["provenance"]["inputs"];
+  std::map<std::string, std::string> digest;
+  for (const auto& i : inputs) digest[i["role"].get<std::string>()] = i["sha256"];
+  EXPECT_EQ(digest["design cone"], mneedle::sha256_of_file(kRoot + "/designs/cone.stl"))
+      << inputs.dump(2);
+  EXPECT_EQ(digest["design cylinder"], mneedle::sha256_of_file(kRoot + "/designs/cylinder.stl"))
+      << inputs.dump(2);
+  const auto optimize = run_mneedle("optimize --plugin cone --scene '" + skin +
+                                    "' --vary half_angle --model analytic --max-evals 3 --json");
+  ASSERT_EQ(optimize.exit_code, 0) << optimize.err;
+  EXPECT_TRUE(Json::parse(optimize.out)["provenance"]["seed"].is_null());
 }
 
 TEST_F(Provenance, ScreenRowsCarryTheFileAndMeshDigests) {
