@@ -74,7 +74,6 @@ std::vector<std::string> split(const std::string& text, char sep) {
   return parts;
 }
 
-// One end of a --bound, in the parameter's unit; errors name --bound, not --set.
 // A plugin parameter's SI value in its unit for a message: angles in degrees, lengths scaled.
 std::string parameter_text(const std::string& unit, double value) {
   if (unit == "rad") return format_quantity(value, Dimension::Angle);
@@ -84,6 +83,7 @@ std::string parameter_text(const std::string& unit, double value) {
   return out.str();
 }
 
+// One end of a --bound, in the parameter's unit; errors name --bound, not --set.
 double bound_value(const PluginShapeInfo& shape, const std::string& name, const std::string& text,
                    const char* end) {
   try {

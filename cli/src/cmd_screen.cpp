@@ -12,13 +12,9 @@
 #include "mneedle/base/error.h"
 #include "mneedle/base/files.h"
 #include "mneedle/base/units.h"
-#include "mneedle/design_evaluation.h"
-#include "mneedle/design_source.h"
-#include "mneedle/insertion/insertion_run.h"
 #include "mneedle/needle/needle_frame.h"
 #include "mneedle/screening.h"
 #include "mneedle/screening_mpi.h"
-#include "mneedle/strength/needle_material.h"
 #include "mneedle/uncertainty.h"
 #include "mpi_start.h"
 #include "report_needles.h"
@@ -138,10 +134,6 @@ ScreenSetup prepare_screen(const ScreenArgs& args, bool writer) {
       PluginRegistry::discover({args.plugin_dirs.begin(), args.plugin_dirs.end()}),
       collect_designs({args.designs.begin(), args.designs.end()}, length_unit_scale(args.unit)),
       {}};
-  // The scene is checked as every command that runs it checks it (docs/scene.md): its own
-  // needles are built and placed although the designs replace them, so a scene `scene check`
-  // refuses is refused here too, before any design runs.
-  check_needle_placement(s.scene, prepare_needles(s.registry, s.scene));
   if (writer) {
     record_scene(s.scene, args.scene);
     // Each design's file, as the scene's own STL needles are (a design list once, however many
@@ -155,30 +147,16 @@ ScreenSetup prepare_screen(const ScreenArgs& args, bool writer) {
       }
     }
   }
-  if (s.designs.empty()) {
-    std::string inputs;
-    for (const auto& d : args.designs) inputs += (inputs.empty() ? "" : ", ") + d;
-    throw InputError(
-        "screen: no mesh files (.stl, .obj, .ply, .off) or design lists (.toml) found in " +
-        inputs);
-  }
   ScreeningOptions& options = s.options;
   options.jobs = args.jobs;
-  if (!args.material.empty()) {
-    // An unknown material is a usage error before any design runs, as in `optimize`.
-    try {
-      find_needle_material(args.material, scene_needle_materials(s.scene));
-    } catch (const InputError& e) {
-      throw InputError(std::string("screen: --material: ") + e.what());
-    }
-    options.material = args.material;
-  }
+  if (!args.material.empty()) options.material = args.material;
   options.resume = args.resume;
   options.fidelity = args.fidelity;
   options.model = args.model;
   options.axis = args.axis;
   options.repair = args.repair;
   parse_axis_choice(args.axis);  // a bad --axis is a usage error before any design runs
+  check_screening_scene(s.scene, s.registry, options);
   if (args.uncertainty > 0 && args.vary.empty())
     throw InputError("screen: --uncertainty N needs the values to vary (--vary PATH=DIST)");
   if (args.uncertainty == 0 && !args.vary.empty())

@@ -155,7 +155,7 @@ void run_uncertainty_command(const UncertaintyArgs& args) {
   options.model = args.model;
   if (!args.material.empty()) options.material = args.material;
   options.sensitivity = !args.no_sensitivity;
-  const bool terminal = writer && !args.json && ::isatty(STDERR_FILENO) == 1;
+  const bool terminal = writer && ::isatty(STDERR_FILENO) == 1;
   // As every long run (docs/cli.md, "Progress"): redrawn on a terminal; to a file or a pipe one
   // line per ten runs once a second has passed (200 samples ran for minutes without a word).
   const auto started = std::chrono::steady_clock::now();

@@ -42,6 +42,12 @@ std::string unknown_command(CLI::App& app, int argc, char** argv) {
       const std::size_t d = mneedle::edit_distance(word, sub->get_name());
       if (d < best_distance) best_distance = d, best = sub->get_name();
     }
+    // An abbreviation is closest to the command it starts ("sim": simulate, not fit).
+    for (CLI::App* sub : level->get_subcommands({}))
+      if (word.size() >= 2 && sub->get_name().rfind(word, 0) == 0) {
+        best = sub->get_name();
+        break;
+      }
     return "unknown command '" + path + " " + word + "'" +
            (best.empty() ? "" : " (did you mean '" + path + " " + best + "'?)") +
            "; known: " + known;

@@ -20,7 +20,10 @@
 #include "mneedle/base/error.h"
 #include "mneedle/base/files.h"
 #include "mneedle/blas_threads.h"
+#include "mneedle/design_evaluation.h"
 #include "mneedle/design_source.h"
+#include "mneedle/insertion/insertion_run.h"
+#include "mneedle/strength/needle_material.h"
 #include "screening_batch.h"
 
 namespace mneedle {
@@ -532,7 +535,30 @@ std::vector<DesignInput> collect_designs(const std::vector<fs::path>& inputs,
                        ": not a mesh file (.stl .obj .ply .off) or design list (.toml)");
     }
   }
+  if (out.empty()) {
+    std::string names;
+    for (const auto& input : inputs) names += (names.empty() ? "" : ", ") + input.string();
+    throw InputError(
+        "screen: no mesh files (.stl, .obj, .ply, .off) or design lists (.toml) found "
+        "in " +
+        names);
+  }
   return out;
+}
+
+void check_screening_scene(const Scene& scene, const PluginRegistry& registry,
+                           const ScreeningOptions& options) {
+  // As every command that runs a scene checks it (docs/scene.md): its own needles are built and
+  // placed although the designs replace them, so a scene `scene check` refuses is refused here.
+  check_needle_placement(scene, prepare_needles(registry, scene));
+  if (options.material) {
+    // An unknown name would fail every row after its FE run: refused first, as in `optimize`.
+    try {
+      find_needle_material(*options.material, scene_needle_materials(scene));
+    } catch (const InputError& e) {
+      throw InputError(std::string("screen: needle material: ") + e.what());
+    }
+  }
 }
 
 ScreeningRow screening_error_row(const DesignInput& d, const std::string& message) {

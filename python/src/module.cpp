@@ -100,8 +100,8 @@ nlohmann::json screen(const std::vector<std::string>& designs, const std::string
   const Scene scene = load_scene(file);
   const PluginRegistry& registry = registry_for(plugin_dirs);
   const auto inputs = collect_designs(paths(designs), length_unit_scale(unit));
-  if (inputs.empty()) throw InputError("screen: no mesh files or designs found in the inputs");
   parse_axis_choice(options.axis);
+  check_screening_scene(scene, registry, options);  // as the CLI's screen, before any design
   const auto rows = rank_rows(screen_designs(inputs, scene, file, registry, options));
   return screening_json(rows, file, options, screening_warnings(rows, scene));
 }

@@ -362,7 +362,7 @@ TEST(ScreenCommand, ASceneWhoseNeedleSceneCheckRefusesAndAnUnknownMaterialStopIt
   const auto material =
       run_mneedle("screen '" + kRoot + "/designs' --scene '" + kSkin + "' --material plaa");
   EXPECT_EQ(material.exit_code, 1);
-  EXPECT_NE(material.err.find("screen: --material: unknown needle material 'plaa'"),
+  EXPECT_NE(material.err.find("screen: needle material: unknown needle material 'plaa'"),
             std::string::npos)
       << material.err;
   EXPECT_EQ(material.err.find("done"), std::string::npos) << material.err;

@@ -665,10 +665,10 @@ TEST(CmdSimulate,
     EXPECT_TRUE(needle["puncture"].is_null());
     const double bound = curve[0]["section_pressure_Pa"].get<double>();
     EXPECT_LT(bound, 3e6);  // the scene's critical pressure
-    for (const auto& point : curve) {
-      if (point["stage"] != "pre") continue;
-      EXPECT_LE(point["section_pressure_Pa"].get<double>(), bound)
-          << point["depth_m"].get<double>();
+    for (std::size_t i = 1; i < curve.size(); ++i) {
+      if (curve[i]["stage"] != "pre") continue;
+      EXPECT_LE(curve[i]["section_pressure_Pa"].get<double>(), bound)
+          << curve[i]["depth_m"].get<double>();
     }
   }
   fs::remove(file);

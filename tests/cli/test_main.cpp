@@ -77,6 +77,7 @@ TEST(ExitStatus, AMisspeltCommandIsNamedWithTheClosestKnownOne) {
             "check (see mneedle --help)"},
         std::pair<std::string, std::string>{
             "plugins lst", "(did you mean 'mneedle plugins list'?); known: list, describe"},
+        std::pair<std::string, std::string>{"sim x.toml", "(did you mean 'mneedle simulate'?)"},
         std::pair<std::string, std::string>{"frobnicate",
                                             "unknown command 'mneedle frobnicate'; known: "}}) {
     const auto run = run_mneedle(args);

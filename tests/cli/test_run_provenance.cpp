@@ -128,8 +128,9 @@ TEST_F(Provenance, CsvStartsWithTheProvenanceLine) {
 }
 
 // screen's provenance named only the scene; every design's file is an input too (a design list
-// once). A single local optimize run draws nothing random: its seed is null, as documented.
-TEST_F(Provenance, ScreenNamesEveryDesignFileAndOneLocalSearchHasNoSeed) {
+// once). A single local optimize run draws nothing random: its seed is null, as documented;
+// scattered starts draw from it: recorded.
+TEST_F(Provenance, ScreenNamesEveryDesignFileAndOnlyASearchThatDrawsRecordsItsSeed) {
   const std::string skin = mneedle::test::skin_scene_with_criterion("pressure");
   const auto run =
       run_mneedle("screen '" + kRoot + "/designs/cone.stl' '" + kRoot +
@@ -145,6 +146,12 @@ TEST_F(Provenance, ScreenNamesEveryDesignFileAndOneLocalSearchHasNoSeed) {
                                     "' --vary half_angle --model analytic --max-evals 3 --json");
   ASSERT_EQ(optimize.exit_code, 0) << optimize.err;
   EXPECT_TRUE(Json::parse(optimize.out)["provenance"]["seed"].is_null());
+  // Scattered starts draw from the seed: recorded.
+  const auto scattered =
+      run_mneedle("optimize --plugin cone --scene '" + skin +
+                  "' --vary half_angle --model analytic --max-evals 4 --starts 2 --seed 7 --json");
+  ASSERT_EQ(scattered.exit_code, 0) << scattered.err;
+  EXPECT_EQ(Json::parse(scattered.out)["provenance"]["seed"], 7);
 }
 
 TEST_F(Provenance, ScreenRowsCarryTheFileAndMeshDigests) {

@@ -92,14 +92,14 @@ double column_scale(const std::string& column, const std::string& unit, Dimensio
   }
 }
 
-// The field as a number in SI (times the column's unit `scale`). Beyond kLargestSample in SI it is
-// no measurement (a force of 10^308 N once passed as a puncture, its work 5e302 J) and a value
-// that overflows only in SI (10^308 kN) would be dropped as noise two checks later: both are
-// refused here, on their own line.
-constexpr double kLargestSample = 1e9;  // N, m or s: far beyond any insertion recording
+// The field as a number in SI (times the column's unit `scale`). A depth or force (`bounded`)
+// beyond kLargestSample in SI is no measurement (a force of 10^308 N once passed as a puncture, its
+// work 5e302 J) and a value that overflows only in SI (10^308 kN) would be dropped as noise two
+// checks later: both are refused here, on their own line.
+constexpr double kLargestSample = 1e9;  // N or m: far beyond any insertion recording
 
 double parse_number(const std::string& field, const std::string& column, const std::string& source,
-                    std::size_t line, double scale) {
+                    std::size_t line, double scale, bool bounded = true) {
   double value = 0.0;
   const char* end = field.data() + field.size();
   const auto [ptr, ec] = std::from_chars(field.data(), end, value);
@@ -108,9 +108,11 @@ double parse_number(const std::string& field, const std::string& column, const s
                      "' is not a number");
   }
   const double si = scale * value;
-  if (!(std::abs(si) <= kLargestSample)) {
+  if (!std::isfinite(si) || (bounded && !(std::abs(si) <= kLargestSample))) {
     throw InputError(where(source, line) + ": column '" + column + "': '" + field +
-                     "' is beyond any measurement (its size in SI is above 1e9)");
+                     (std::isfinite(si)
+                          ? "' is beyond any measurement (its size in SI is above 1e9)"
+                          : "' overflows in SI units"));
   }
   return si;
 }
@@ -280,8 +282,9 @@ ForceCurve read_force_curve_csv(const std::filesystem::path& file, const CurveCo
     curve.force_N.push_back(
         parse_number(fields[force_col], header[force_col], curve.source, line_number, force_scale));
     if (time_col) {
+      // Clock time (Unix seconds, 1.7e9) is a time too: only a non-finite one is refused.
       curve.time_s.push_back(parse_number(fields[*time_col], header[*time_col], curve.source,
-                                          line_number, time_scale));
+                                          line_number, time_scale, false));
     }
     curve.line.push_back(line_number);
   }

@@ -27,8 +27,8 @@ struct DesignInput {
 };
 
 /// Mesh files (STL, OBJ, PLY, OFF) as given, every mesh file of a folder (sorted, not recursive)
-/// and every [[designs]] entry of a TOML design list. InputError for a path that does not exist or
-/// a design list with an error (naming file:line).
+/// and every [[designs]] entry of a TOML design list. InputError for a path that does not exist,
+/// a design list with an error (naming file:line) or inputs that hold no design (naming them).
 std::vector<DesignInput> collect_designs(const std::vector<std::filesystem::path>& inputs,
                                          double metres_per_unit);
 
@@ -48,6 +48,11 @@ struct ScreeningOptions {
   std::vector<VariedValue> vary;
   UncertaintyOptions uncertainty;
 };
+
+/// The checks of a screen before any design runs (InputError): the scene's own needles built and
+/// placed as `scene check` does, and `options.material` a known needle material.
+void check_screening_scene(const Scene& scene, const PluginRegistry& registry,
+                           const ScreeningOptions& options);
 
 /// A two-stage curve as screening rows and optimize's summary write it: [{depth_m, force_N,
 /// stage}], SI, stage "pre" or "post".

@@ -95,21 +95,30 @@ TEST(ForceCurve, ASampleBeyondAnyMeasurementIsRefusedOnItsLineAndAByteOrderMarkI
     std::ofstream(path, std::ios::binary) << text;
     return path;
   };
-  for (const auto& [header, value] : {std::pair<std::string, std::string>{"force [N]", "1e308"},
-                                      {"force [kN]", "1e308"},
-                                      {"force [N]", "-2e9"}}) {
+  struct Case {
+    std::string header, value, problem;
+  };
+  for (const auto& [header, value, problem] :
+       {Case{"force [N]", "1e308", "is beyond any measurement"},
+        Case{"force [kN]", "1e308", "overflows in SI units"},
+        Case{"force [N]", "-2e9", "is beyond any measurement"}}) {
     const auto file =
         write("big.csv", "depth [mm]," + header + "\n0,0\n0.1,0.01\n0.2," + value + "\n");
     try {
       mneedle::read_force_curve_csv(file, {});
       FAIL() << header << " " << value;
     } catch (const mneedle::InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("big.csv:4: column '" + header + "': '" + value +
-                                           "' is beyond any measurement"),
+      EXPECT_NE(std::string(e.what()).find("big.csv:4: column '" + header + "': '" + value + "' " +
+                                           problem),
                 std::string::npos)
           << e.what();
     }
   }
+  // A time column may hold clock time (Unix seconds): read, not refused.
+  const auto clock = write("clock.csv",
+                           "time [s],depth [mm],force [N]\n1733600000,0,0\n"
+                           "1733600001,0.1,0.01\n");
+  EXPECT_NEAR(mneedle::read_force_curve_csv(clock, {}).time_s[1], 1733600001.0, 1e-6);
   const auto bom = write("bom.csv",
                          "\xEF\xBB\xBF"
                          "depth [mm],force [N]\n0,0\n0.1,0.01\n");

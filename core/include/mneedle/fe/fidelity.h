@@ -47,7 +47,7 @@ inline constexpr double kContactZoneReach = 1.0;
 
 /// Largest refinement_levels: each level halves the element size along the needle's path. From
 /// four levels a thin stiff top layer (skin's) caps the base grid and its cells degenerate
-/// (dihedral angles down to 1.5 deg), reading the puncture 6-10 % shallow (docs/validation.md,
+/// (dihedral angles down to 1.5 deg), reading the puncture 5-10 % shallow (docs/validation.md,
 /// "Refinement levels beyond two").
 inline constexpr int kMaxRefinementLevels = 3;
 
