@@ -16,6 +16,7 @@
 #include "mneedle/needle/mesh.h"
 #include "mneedle/needle/mesh_io.h"
 #include "mneedle/plugin_host.h"
+#include "option_values.h"
 
 namespace mneedle::cli {
 namespace {
@@ -67,7 +68,7 @@ std::map<std::string, double> parse_settings(const std::vector<std::string>& set
 }
 
 void run_generate(const GenerateOptions& options) {
-  const double metres_per_unit = length_unit_scale(options.unit);
+  const double metres_per_unit = option_length_unit(options.unit);
   const PluginRegistry registry = PluginRegistry::discover(options.plugin_dirs);
   const PluginShapeInfo& shape = registry.shape(options.name);
   const auto si = parse_settings(options.settings, shape);

@@ -20,6 +20,7 @@
 #include "mneedle/needle/needle_frame.h"
 
 #include "json_output.h"
+#include "option_values.h"
 #include "run_provenance.h"
 #include "surface_report_json.h"
 
@@ -62,7 +63,7 @@ InspectResult inspect(const InspectOptions& options) {
   InspectResult result;
   result.file = options.file;
   result.unit = options.unit;
-  result.mesh = load_mesh(options.file, length_unit_scale(options.unit));
+  result.mesh = load_mesh(options.file, option_length_unit(options.unit));
   record_input("needle", options.file);
   if (options.repair) result.repair = repair_mesh(result.mesh);
   result.validation = validate_mesh(result.mesh);
@@ -172,7 +173,7 @@ void run_inspect(const InspectOptions& options) {
   if (!result.validation.valid) throw InputError(defects_line(result));
   if (!options.output.empty()) {
     // Input coordinates and unit, with the unit in the header so loaders read it back.
-    write_stl_binary(result.mesh, options.output, length_unit_scale(options.unit),
+    write_stl_binary(result.mesh, options.output, option_length_unit(options.unit),
                      "mneedle inspect unit=" + options.unit);
     if (!options.json) {
       std::cout << "wrote " << options.output << " (" << result.mesh.triangles.size()

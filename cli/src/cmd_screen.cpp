@@ -17,6 +17,7 @@
 #include "mneedle/screening_mpi.h"
 #include "mneedle/uncertainty.h"
 #include "mpi_start.h"
+#include "option_values.h"
 #include "report_needles.h"
 #include "run_provenance.h"
 
@@ -132,7 +133,7 @@ ScreenSetup prepare_screen(const ScreenArgs& args, bool writer) {
   ScreenSetup s{
       load_scene(args.scene),
       PluginRegistry::discover({args.plugin_dirs.begin(), args.plugin_dirs.end()}),
-      collect_designs({args.designs.begin(), args.designs.end()}, length_unit_scale(args.unit)),
+      collect_designs({args.designs.begin(), args.designs.end()}, option_length_unit(args.unit)),
       {}};
   if (writer) {
     record_scene(s.scene, args.scene);

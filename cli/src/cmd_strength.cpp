@@ -13,6 +13,7 @@
 #include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
 #include "mneedle/needle/needle_frame.h"
+#include "option_values.h"
 #include "run_provenance.h"
 
 namespace mneedle::cli {
@@ -41,7 +42,8 @@ void run_strength(const StrengthArgs& args) {
       args.file.empty()
           ? needle_from_plugin(registry, args.plugin,
                                parse_parameter_settings(registry.shape(args.plugin), args.settings))
-          : needle_from_file(args.file, length_unit_scale(args.unit), parse_axis_choice(args.axis));
+          : needle_from_file(args.file, option_length_unit(args.unit),
+                             parse_axis_choice(args.axis));
   if (!needle.frame_note.empty())
     std::cerr << "mneedle: " << args.file << ": " << needle.frame_note << "\n";
   if (args.file.empty())

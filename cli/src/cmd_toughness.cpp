@@ -20,6 +20,7 @@
 #include "mneedle/measurement/force_curve.h"
 #include "mneedle/measurement/toughness.h"
 #include "mneedle/plot/figure.h"
+#include "option_values.h"
 #include "run_provenance.h"
 
 namespace mneedle::cli {
@@ -87,7 +88,7 @@ CrackAreaChoice crack_area(const ToughnessArgs& a, double end_depth_m) {
       a.needle.empty()
           ? needle_from_plugin(registry, a.plugin,
                                parse_parameter_settings(registry.shape(a.plugin), a.settings))
-          : needle_from_file(a.needle, length_unit_scale(a.unit));
+          : needle_from_file(a.needle, option_length_unit(a.unit));
   if (a.needle.empty())
     record_mesh(needle.name, needle.mesh);
   else

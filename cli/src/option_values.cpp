@@ -18,4 +18,12 @@ double positive_option_quantity(const std::string& option, std::string_view text
   return v;
 }
 
+double option_length_unit(std::string_view text) {
+  try {
+    return length_unit_scale(text);
+  } catch (const InputError& e) {
+    throw InputError(std::string("--unit: ") + e.what());
+  }
+}
+
 }  // namespace mneedle::cli

@@ -16,4 +16,7 @@ double option_quantity(const std::string& option, std::string_view text, Dimensi
 /// As option_quantity, and above zero: InputError "OPTION TEXT: must be positive" otherwise.
 double positive_option_quantity(const std::string& option, std::string_view text, Dimension d);
 
+/// A mesh file's length unit (`--unit um|mm|m`) in metres; InputError "--unit: problem".
+double option_length_unit(std::string_view text);
+
 }  // namespace mneedle::cli

@@ -9,6 +9,7 @@
 namespace {
 
 using mneedle::Dimension;
+using mneedle::cli::option_length_unit;
 using mneedle::cli::option_quantity;
 using mneedle::cli::positive_option_quantity;
 
@@ -41,6 +42,14 @@ TEST(OptionValues, APositiveOptionRefusesZeroAndBelowWithTheTextGiven) {
             "--element-size 0mm: must be positive");
   EXPECT_EQ(error_of([] { positive_option_quantity("--step", "-1mm", Dimension::Length); }),
             "--step -1mm: must be positive");
+}
+
+// inspect and screen said "unknown length unit 'cm'" without naming --unit.
+TEST(OptionValues, AMeshUnitIsReadInMetresAndAnUnknownOneNamesTheOption) {
+  EXPECT_DOUBLE_EQ(option_length_unit("um"), 1e-6);
+  EXPECT_DOUBLE_EQ(option_length_unit("mm"), 1e-3);
+  EXPECT_EQ(error_of([] { option_length_unit("cm"); }).rfind("--unit: unknown length unit 'cm'", 0),
+            0u);
 }
 
 }  // namespace

@@ -599,6 +599,9 @@ StlGeometry read_stl_geometry(Table& g, NeedleDraft& draft, const std::filesyste
     g.fail_key("stl", "no such file: " + stl.path.string() + " (relative paths start at the " +
                           "scene file's folder)");
   }
+  // An empty file has no unit to declare: say what it is, not that the unit is missing.
+  if (std::filesystem::file_size(stl.path, ec) == 0 && !ec)
+    g.fail_key("stl", stl.path.string() + ": empty file");
   // No unit and none in the file: a guess (CAD tools write mm, others um or m) is refused.
   const auto declared = declared_length_unit(stl.path);
   const auto given_unit = g.optional_string("unit");

@@ -601,6 +601,16 @@ TEST(SceneErrors, StlWithoutUnitThatDoesNotDeclareOneIsRefused) {
     EXPECT_NE(msg.find("needles[0].geometry.unit"), std::string::npos) << msg;
     EXPECT_NE(msg.find("n.stl does not say its length unit"), std::string::npos) << msg;
   }
+  // An empty file is named as such, not as a missing unit.
+  std::ofstream(dir / "n.stl", std::ios::trunc).close();
+  try {
+    mneedle::parse_scene(toml, (dir / "s.toml").string());
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("needles[0].geometry.stl"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("n.stl: empty file"), std::string::npos) << msg;
+  }
   std::filesystem::remove_all(dir);
 }
 
