@@ -23,7 +23,7 @@ struct FrameInfo {
   /// `auto` or a line was asked for but no end is narrower (a cube, a cylinder with flat ends):
   /// the input z was used, a guess the caller should show (the note says why).
   bool fell_back_to_input_z = false;
-  std::string note;        ///< how the tip was found, e.g. which end `auto` chose
+  std::string note;  ///< how the tip was found, e.g. which end `auto` chose
 };
 
 /// How the caller names the tip direction.
