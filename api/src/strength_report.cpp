@@ -18,18 +18,16 @@ SectionTable section_table(const PluginRegistry& registry, const NeedleSource& n
   if (!needle.plugin || !registry.shape(*needle.plugin).has_section_properties)
     return SectionTable::from_mesh(needle.mesh, samples);
   const double length = bounding_box(needle.mesh).max[2];
-  std::vector<double> heights;
-  std::vector<SectionProperties> sections;
-  for (int i = 0; i <= samples; ++i) {
-    const double h = length * i / samples;
-    const auto s = registry.section_properties(*needle.plugin, needle.params, h);
+  // The table lives within strength_report(), inside the registry's lifetime.
+  SectionProfile exact = [&registry, plugin = *needle.plugin,
+                          params = needle.params](double height_m) {
+    const auto s = registry.section_properties(plugin, params, height_m);
     // The hook gives no fibre distance: 2√(I/A) is exact for a solid circle, an upper bound
     // for a tube (conservative for the bending check).
     const double fibre = s->area_m2 > 0 ? 2.0 * std::sqrt(s->i_min_m4 / s->area_m2) : 0.0;
-    heights.push_back(h);
-    sections.push_back({s->area_m2, s->i_min_m4, fibre});
-  }
-  return SectionTable(std::move(heights), std::move(sections));
+    return SectionProperties{s->area_m2, s->i_min_m4, fibre};
+  };
+  return SectionTable::from_profile(std::move(exact), length, samples);
 }
 
 }  // namespace

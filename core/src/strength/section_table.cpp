@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <utility>
 
 #include "mneedle/base/error.h"
@@ -69,29 +70,37 @@ SectionProperties polygon_section_properties(const std::vector<Loop>& loops) {
   return out;
 }
 
-SectionTable::SectionTable(std::vector<double> heights_m, std::vector<SectionProperties> sections)
-    : heights_(std::move(heights_m)), sections_(std::move(sections)) {
+SectionTable::SectionTable(std::vector<double> heights_m, std::vector<SectionProperties> sections,
+                           SectionProfile exact)
+    : heights_(std::move(heights_m)), sections_(std::move(sections)), exact_(std::move(exact)) {
   if (heights_.size() < 2 || heights_.size() != sections_.size())
     throw InputError("section table: needs at least two heights, one section each");
   if (!std::is_sorted(heights_.begin(), heights_.end()))
     throw InputError("section table: heights must increase");
 }
 
+SectionTable SectionTable::from_profile(SectionProfile exact, double length_m, int samples) {
+  std::vector<double> heights;
+  std::vector<SectionProperties> sections;
+  for (int i = 0; i <= samples; ++i) {
+    heights.push_back(length_m * i / samples);
+    sections.push_back(exact(heights.back()));
+  }
+  return SectionTable(std::move(heights), std::move(sections), std::move(exact));
+}
+
 SectionTable SectionTable::from_mesh(const TriangleMesh& mesh, int samples) {
   const BoundingBox box = bounding_box(mesh);
   const double length = box.max[2] - box.min[2];
   if (!(length > 0.0)) throw InputError("section table: the needle has no length along its axis");
-  const CrossSectionSlicer slicer(mesh);
-  std::vector<double> heights;
-  std::vector<SectionProperties> sections;
+  const auto slicer = std::make_shared<const CrossSectionSlicer>(mesh);
   // Planes exactly through the tip or base vertices give degenerate loops: stay just inside.
   const double inset = 1e-7 * length;
-  for (int i = 0; i <= samples; ++i) {
-    const double h = std::clamp(length * i / samples, inset, length - inset);
-    heights.push_back(length * i / samples);
-    sections.push_back(polygon_section_properties(slicer.slice(h).polygons));
-  }
-  return SectionTable(std::move(heights), std::move(sections));
+  SectionProfile exact = [slicer, inset, length](double height_m) {
+    const double h = std::clamp(height_m, inset, length - inset);
+    return polygon_section_properties(slicer->slice(h).polygons);
+  };
+  return from_profile(std::move(exact), length, samples);
 }
 
 SectionProperties SectionTable::at(double height_m) const {
@@ -110,8 +119,27 @@ SectionProfile SectionTable::profile() const {
 double SectionTable::tip_length_m(double fraction) const {
   double largest = 0.0;
   for (const auto& s : sections_) largest = std::max(largest, s.area_m2);
-  for (std::size_t i = 0; i < sections_.size(); ++i)
-    if (sections_[i].area_m2 >= fraction * largest) return heights_[i];
+  // Between the samples that bracket the area sought, linearly: the height then moves
+  // continuously with the needle, not in steps of the slicing grid (which scales with the
+  // needle's length, so the same tip on a longer shaft would read another length).
+  const double sought = fraction * largest;
+  for (std::size_t i = 0; i < sections_.size(); ++i) {
+    if (sections_[i].area_m2 < sought) continue;
+    if (i == 0) return heights_[0];
+    double lo = heights_[i - 1], hi = heights_[i];
+    if (!exact_) {
+      const double a0 = sections_[i - 1].area_m2, a1 = sections_[i].area_m2;
+      return lo + (sought - a0) / (a1 - a0) * (hi - lo);
+    }
+    // Bisection: a tip's area is not linear in height (quadratic on a cone, with a kink where
+    // the taper meets the shaft), so the chord would still follow the grid.
+    const double resolution = 1e-9 * (hi - lo);
+    while (hi - lo > resolution) {
+      const double mid = 0.5 * (lo + hi);
+      (exact_(mid).area_m2 >= sought ? hi : lo) = mid;
+    }
+    return hi;
+  }
   return heights_.back();
 }
 
