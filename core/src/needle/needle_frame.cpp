@@ -44,6 +44,10 @@ constexpr double kSideFaceSlope = 0.2;
 constexpr double kShaftFaceSlope = 0.01;
 // ... and the share of the first pass's face area those must carry to be the shaft.
 constexpr double kShaftFaceShare = 0.5;
+// The trimmed pass's (trimmed_side_face_axis): its shaft's share of the first set, and how evenly
+// its normals must spread round the axis (smaller over larger moment).
+constexpr double kTrimmedShaftShare = 0.25;
+constexpr double kTrimmedSpread = 0.1;
 
 double size_of(const TriangleMesh& mesh) {
   const BoundingBox box = bounding_box(mesh);
@@ -207,6 +211,52 @@ std::optional<Vector3d> side_face_axis(const TriangleMesh& mesh, const Vector3d&
   return refined.dot(axis) < 0.0 ? Vector3d(-refined) : refined;
 }
 
+// When the faces within kSideFaceSlope of parallel to the principal axis hold more than the
+// shaft, their normals span no plane and side_face_axis finds none: a long bevel (17 deg and
+// less) tilts the principal axis by 6 deg, within which its face then counts as a side. The
+// shaft's faces lie on one plane of normals, the bevel's off it: drop the faces furthest off the
+// current estimate's plane (beyond half the furthest) and estimate again, while the faces kept
+// are still kTrimmedShaftShare of the first set's area (a 15 deg bevel's shaft holds 32 % of it,
+// the face the rest). The plane found must be spread round the axis (its two moments within
+// kTrimmedSpread), as a shaft's walls are and a flat's two sides are not. Empty otherwise.
+std::optional<Vector3d> trimmed_side_face_axis(const TriangleMesh& mesh, const Vector3d& axis) {
+  struct Face {
+    Vector3d normal;
+    double area;
+  };
+  std::vector<Face> faces;
+  double total = 0.0;
+  for (const Triangle& t : mesh.triangles) {
+    const Vector3d a = to_eigen(mesh.vertices[t[0]]);
+    const Vector3d n2 =
+        (to_eigen(mesh.vertices[t[1]]) - a).cross(to_eigen(mesh.vertices[t[2]]) - a);
+    const double twice_area = n2.norm();
+    if (!(twice_area > 0.0) || !(std::abs(n2.dot(axis)) < kSideFaceSlope * twice_area)) continue;
+    faces.push_back({n2 / twice_area, 0.5 * twice_area});
+    total += 0.5 * twice_area;
+  }
+  Vector3d estimate = axis;
+  for (int round = 0; round < 64; ++round) {
+    Matrix3d tensor = Matrix3d::Zero();
+    double kept = 0.0;
+    for (const Face& f : faces) tensor += f.area * f.normal * f.normal.transpose(), kept += f.area;
+    const Eigen::SelfAdjointEigenSolver<Matrix3d> solver(tensor);
+    const auto& lambda = solver.eigenvalues();
+    if (!(kept >= kTrimmedShaftShare * total)) return std::nullopt;
+    if (!(lambda[1] > 0.0)) return std::nullopt;
+    estimate = solver.eigenvectors().col(0);
+    if (estimate.dot(axis) < 0.0) estimate = -estimate;
+    if (lambda[0] < 1e-3 * lambda[1])
+      return lambda[1] >= kTrimmedSpread * lambda[2] ? std::optional<Vector3d>(estimate)
+                                                     : std::nullopt;
+    double furthest = 0.0;
+    for (const Face& f : faces) furthest = std::max(furthest, std::abs(f.normal.dot(estimate)));
+    std::erase_if(faces,
+                  [&](const Face& f) { return std::abs(f.normal.dot(estimate)) > 0.5 * furthest; });
+  }
+  return std::nullopt;
+}
+
 // Faces within kSideFaceSlope of parallel take in more than the shaft: a rounded edge's last
 // steps before the wall (within 6 deg of it for 16 steps a quarter turn) tilt the axis where they
 // are not spread evenly around it (4.6e-5 rad for a rounded blunt bevel, which lifted part of its
@@ -217,7 +267,8 @@ std::optional<Vector3d> side_face_axis(const TriangleMesh& mesh, const Vector3d&
 // Returns `axis` unchanged without a clear shaft.
 Vector3d refined_by_side_faces(const TriangleMesh& mesh, const Vector3d& axis) {
   double first_area = 0.0, shaft_area = 0.0;
-  const std::optional<Vector3d> first = side_face_axis(mesh, axis, kSideFaceSlope, &first_area);
+  std::optional<Vector3d> first = side_face_axis(mesh, axis, kSideFaceSlope, &first_area);
+  if (!first) first = trimmed_side_face_axis(mesh, axis);
   if (!first) return axis;
   const std::optional<Vector3d> shaft = side_face_axis(mesh, *first, kShaftFaceSlope, &shaft_area);
   return shaft && shaft_area >= kShaftFaceShare * first_area ? *shaft : *first;

@@ -226,6 +226,27 @@ TEST(NeedleFrame, BevelIsPlacedByItsShaftAxisNotByItsTip) {
   EXPECT_NEAR(info.tip_offset_m, o.radius, 1e-12);
 }
 
+// A long bevel (15 deg, 1 mm long: its face reaches 858 um up the 1 mm shaft) tilts the principal
+// axis by 6.5 deg, within which the face counts as a side: the first pass found no shaft and
+// the tilted axis was kept, so a 15 deg STL from `generate` was placed askew and read a
+// capacity of 0.016 uN. The shaft's own walls, trimmed out of the side faces, give the axis.
+TEST(NeedleFrame, AutoFindsTheShaftAxisOfALongBevel) {
+  for (const double degrees : {15.0, 10.0}) {
+    mneedle::test::ShapeOptions o;
+    o.length = 1e-3 * (degrees == 10.0 ? 2.0 : 1.0);
+    const TriangleMesh reference =
+        mneedle::test::sharp_bevel(o, degrees * std::numbers::pi / 180.0);
+    const Eigen::Matrix3d rotation =
+        Eigen::AngleAxisd(0.9, Eigen::Vector3d(1, -2, 1).normalized()).toRotationMatrix();
+    TriangleMesh placed = moved(reference, rotation, {2e-4, 1e-4, -3e-4});
+    AxisChoice choice;
+    choice.kind = AxisChoice::Kind::automatic;
+    mneedle::place_in_needle_frame(placed, choice);
+    // Round-off of millimetre-sized sums over micrometre features: 1e-12 m.
+    expect_same_up_to_roll(placed, reference, 1e-12);
+  }
+}
+
 // A rod of radius r whose lower edge is chamfered on the +x half only: the chamfer's faces lie
 // 8.5 deg from the axis, inside the first pass's 11.5 deg, and one-sided they tilt that pass's
 // axis (as a rounded blunt bevel's last pipe steps did: 4.6e-5 rad, lifting part of its flat
