@@ -10,6 +10,7 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -20,6 +21,7 @@
 #include "json_output.h"
 #include "mneedle/api/fit_report.h"
 #include "mneedle/base/error.h"
+#include "mneedle/base/files.h"
 #include "mneedle/base/units.h"
 #include "mneedle/measurement/anova.h"
 #include "mneedle/measurement/curve_metrics.h"
@@ -80,10 +82,23 @@ void print_fit(const TriforceFit& fit, const std::vector<LoadedCurve>& curves) {
   }
 }
 
+// Each curve writes <stem>_fit.csv: two curves of one stem (from two folders) would share it.
+void require_distinct_stems(const std::vector<std::string>& files) {
+  std::map<std::string, std::string> stems;
+  for (const std::string& file : files) {
+    const std::string stem = std::filesystem::path(file).stem().string();
+    const auto [it, fresh] = stems.emplace(stem, file);
+    if (!fresh)
+      throw InputError("--out: the curves '" + it->second + "' and '" + file +
+                       "' would both write " + stem + "_fit.csv; rename one");
+  }
+}
+
 void write_fit_files(const std::string& dir, const nlohmann::json& report, const TriforceFit& fit,
                      const std::vector<LoadedCurve>& curves) {
-  std::filesystem::create_directories(dir);
-  std::ofstream(std::filesystem::path(dir) / "fit.json") << with_provenance(report).dump(2) << "\n";
+  create_output_folder(dir, "--out");
+  write_output_file(std::filesystem::path(dir) / "fit.json", with_provenance(report).dump(2) + "\n",
+                    "--out");
   const TriforceModel model(fit.params);
   for (std::size_t i = 0; i < curves.size(); ++i) {
     const auto& c = curves[i].curve;
@@ -93,12 +108,14 @@ void write_fit_files(const std::string& dir, const nlohmann::json& report, const
                          {"depth_m", "measured_N", "model_N"},
                          c.name + " row " + std::to_string(j + 1), "fit");
     }
-    std::ofstream csv(std::filesystem::path(dir) /
-                      (std::filesystem::path(c.name).stem().string() + "_fit.csv"));
+    std::ostringstream csv;
     csv << "depth_m,measured_N,model_N\n" << std::setprecision(8);
     for (std::size_t j = 0; j < c.depth_m.size(); ++j) {
       csv << c.depth_m[j] << "," << c.force_N[j] << "," << predicted[j] << "\n";
     }
+    write_output_file(
+        std::filesystem::path(dir) / (std::filesystem::path(c.name).stem().string() + "_fit.csv"),
+        csv.str(), "--out");
   }
 }
 
@@ -106,6 +123,10 @@ void run_fit(const FitArgs& args) {
   if (args.model != "triforce")
     throw InputError("fit: unknown --model '" + args.model + "' (known: triforce)");
   for (const auto& f : args.files) record_input("curve", f);
+  if (!args.out_dir.empty()) {
+    require_distinct_stems(args.files);
+    create_output_folder(args.out_dir, "--out");
+  }
   const FitOutcome outcome = fit_recordings(args.files, args.settings);
   const TriforceFit& fit = outcome.fit;
   const std::vector<LoadedCurve>& curves = outcome.curves;
@@ -347,7 +368,14 @@ void run_stats(const StatsArgs& args) {
                      " (" + std::to_string(groups * (groups - 1) / 2) +
                      " Tukey pairs); raise --max-groups to compare them all");
   }
-  const auto r = one_way_anova(labels, values, args.alpha);
+  // The analysis's own errors (too few groups, no spread, values too large) name the file.
+  const auto r = [&] {
+    try {
+      return one_way_anova(labels, values, args.alpha);
+    } catch (const InputError& e) {
+      throw InputError(args.file + ": " + e.what());
+    }
+  }();
   {
     nlohmann::json groups = nlohmann::json::array(), pairs = nlohmann::json::array();
     for (const auto& g : r.groups)

@@ -104,6 +104,25 @@ TEST(CmdCalibrate, RecoversTheConstantsOfACurveForceMadeAndWritesAFittedScene) {
             std::string::npos);
 }
 
+// The README's example writes `--out fitted.toml` next to a scene in the current folder: both
+// folders are "" there, which std::filesystem::absolute refuses (it ended as internal error 4).
+TEST(CmdCalibrate, ABareOutputFileNameBesideABareSceneNameIsWritten) {
+  const CommandRun force = run_mneedle("force '" + write("bare_made.toml", silicone_scene("")) +
+                                       "' --csv --step 20um" + plugins());
+  ASSERT_EQ(force.exit_code, 0) << force.err;
+  write("bare_made.csv", force.out);
+  write("bare_start.toml", silicone_scene(""));
+  std::filesystem::remove(kWork / "bare_fitted.toml");
+  const CommandRun run = mneedle::test::run_command(
+      "cd '" + kWork.string() + "' && '" + mneedle::test::mneedle_binary() +
+      "' calibrate bare_start.toml --curve bare_made.csv --fit "
+      "scale --contact-at 0mm --puncture-at 0.02mm --out "
+      "bare_fitted.toml" +
+      plugins());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(read(kWork / "bare_fitted.toml").find("pressure_scale"), std::string::npos);
+}
+
 std::string punch_scene(const std::string& modulus) {
   return "[tissue]\nsize = [\"3 mm\", \"3 mm\", \"3 mm\"]\n[[tissue.layers]]\nname = "
          "\"silicone\"\nmaterial = { model = \"linear\", E = \"" +

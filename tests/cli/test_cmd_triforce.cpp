@@ -76,6 +76,26 @@ TEST(CmdTriforce, FitJsonReportsParametersErrorsAndCurveMetrics) {
   EXPECT_TRUE(std::filesystem::exists(kWork / "fit" / "recording_fit.csv"));
 }
 
+// Each curve writes <name>_fit.csv under --out: two curves of one name from two folders would
+// share a file (the second overwrote the first), and a folder under a file cannot be made (it
+// ended as internal error 4). Both are refused with one line before the fit runs.
+TEST(CmdTriforce, FitRefusesTwoCurvesOfOneNameAndAnOutputFolderUnderAFile) {
+  const std::string file = write_recording();
+  std::filesystem::create_directories(kWork / "other");
+  std::filesystem::copy_file(file, kWork / "other" / "recording.csv",
+                             std::filesystem::copy_options::overwrite_existing);
+  const CommandRun twice =
+      run_mneedle("fit '" + file + "' '" + (kWork / "other" / "recording.csv").string() +
+                  "' --out '" + (kWork / "twice").string() + "'");
+  EXPECT_EQ(twice.exit_code, 1);
+  EXPECT_NE(twice.err.find("would both write recording_fit.csv"), std::string::npos) << twice.err;
+  EXPECT_FALSE(std::filesystem::exists(kWork / "twice"));
+  const CommandRun under = run_mneedle("fit '" + file + "' --out '" + file + "/x'");
+  EXPECT_EQ(under.exit_code, 1);
+  EXPECT_NE(under.err.find("--out '" + file + "/x': cannot create the folder"), std::string::npos)
+      << under.err;
+}
+
 TEST(CmdTriforce, PredictGoesInHoldsAndComesOut) {
   const auto file = write_recording();
   ASSERT_EQ(

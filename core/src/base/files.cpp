@@ -30,4 +30,11 @@ void create_output_folder(const fs::path& dir, std::string_view option) {
   if (ec) throw InputError(where + ": cannot create the folder (" + ec.message() + ")");
 }
 
+void write_output_file(const fs::path& file, std::string_view text, std::string_view option) {
+  std::ofstream out(file, std::ios::binary);
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
+  out.close();
+  if (!out) throw InputError(std::string(option) + ": cannot write '" + file.string() + "'");
+}
+
 }  // namespace mneedle

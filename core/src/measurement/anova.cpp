@@ -1,5 +1,6 @@
 #include "mneedle/measurement/anova.h"
 
+#include <algorithm>
 #include <boost/math/distributions/fisher_f.hpp>
 #include <boost/math/distributions/normal.hpp>
 #include <boost/math/quadrature/gauss_kronrod.hpp>
@@ -46,23 +47,40 @@ std::size_t column_index(const std::vector<std::string>& header, const std::stri
   throw InputError(where + ": no column '" + name + "' (columns: " + names + ")");
 }
 
+// Squares of values beyond this overflow (and sums of them lose the group's spread).
+constexpr double kLargestValue = 1e150;
+
 AnovaTable anova_table(const std::vector<GroupSummary>& groups, std::size_t total) {
+  // F and p are computed on the values over their largest magnitude, so that neither 1e200 nor
+  // 1e-200 overflows or underflows when squared; the sums of squares are then scaled back.
+  double scale = 0.0;
+  for (const auto& g : groups) scale = std::max({scale, std::abs(g.mean), g.sd});
+  if (!(scale <= kLargestValue))
+    throw InputError(
+        "ANOVA: values beyond 1e150 in magnitude (their squares overflow); "
+        "give the column in a larger unit");
+  if (!(scale > 0.0)) scale = 1.0;
   double grand = 0.0;
-  for (const auto& g : groups) grand += g.mean * static_cast<double>(g.n);
+  for (const auto& g : groups) grand += g.mean / scale * static_cast<double>(g.n);
   grand /= static_cast<double>(total);
-  AnovaTable t;
+  double between = 0.0, within = 0.0;  // in units of scale^2
   for (const auto& g : groups) {
-    t.ss_between += static_cast<double>(g.n) * (g.mean - grand) * (g.mean - grand);
-    t.ss_within += g.sd * g.sd * static_cast<double>(g.n - 1);
+    const double offset = g.mean / scale - grand, spread = g.sd / scale;
+    between += static_cast<double>(g.n) * offset * offset;
+    within += spread * spread * static_cast<double>(g.n - 1);
   }
+  AnovaTable t;
   t.df_between = groups.size() - 1;
   t.df_within = total - groups.size();
-  t.ms_between = t.ss_between / static_cast<double>(t.df_between);
-  t.ms_within = t.ss_within / static_cast<double>(t.df_within);
-  if (!(t.ms_within > 0.0)) {
+  if (!(within > 0.0)) {
     throw InputError("ANOVA: no variance within the groups (all values of each group equal)");
   }
-  t.f = t.ms_between / t.ms_within;
+  t.ss_between = between * scale * scale;
+  t.ss_within = within * scale * scale;
+  t.ms_between = t.ss_between / static_cast<double>(t.df_between);
+  t.ms_within = t.ss_within / static_cast<double>(t.df_within);
+  t.root_ms_within = std::sqrt(within / static_cast<double>(t.df_within)) * scale;
+  t.f = (between / static_cast<double>(t.df_between)) / (within / static_cast<double>(t.df_within));
   const boost::math::fisher_f_distribution<double> dist(static_cast<double>(t.df_between),
                                                         static_cast<double>(t.df_within));
   t.p = boost::math::cdf(boost::math::complement(dist, t.f));
@@ -285,14 +303,24 @@ OneWayAnova one_way_anova(const std::vector<std::string>& labels, const std::vec
                      std::to_string(values.size()) + " values in " +
                      std::to_string(out.groups.size()) + " groups)");
   }
+  // Means and spreads on the values over their largest magnitude: squares of 1e200 overflow
+  // and of 1e-200 underflow (anova_table refuses beyond kLargestValue).
+  double scale = 0.0;
+  for (double v : values) scale = std::max(scale, std::abs(v));
+  if (!(scale <= kLargestValue))
+    throw InputError(
+        "ANOVA: values beyond 1e150 in magnitude (their squares overflow); "
+        "give the column in a larger unit");
+  if (!(scale > 0.0)) scale = 1.0;
   for (std::size_t g = 0; g < members.size(); ++g) {
     auto& s = out.groups[g];
     s.n = members[g].size();
-    for (double v : members[g]) s.mean += v;
-    s.mean /= static_cast<double>(s.n);
-    double ss = 0.0;
-    for (double v : members[g]) ss += (v - s.mean) * (v - s.mean);
-    s.sd = s.n > 1 ? std::sqrt(ss / static_cast<double>(s.n - 1)) : 0.0;
+    double mean = 0.0, ss = 0.0;
+    for (double v : members[g]) mean += v / scale;
+    mean /= static_cast<double>(s.n);
+    for (double v : members[g]) ss += (v / scale - mean) * (v / scale - mean);
+    s.mean = mean * scale;
+    s.sd = s.n > 1 ? std::sqrt(ss / static_cast<double>(s.n - 1)) * scale : 0.0;
   }
   out.anova = anova_table(out.groups, values.size());
   const int k = static_cast<int>(out.groups.size());
@@ -310,8 +338,8 @@ OneWayAnova one_way_anova(const std::vector<std::string>& labels, const std::vec
       TukeyComparison c{a.name, b.name, a.mean - b.mean};
       // Tukey–Kramer standard error of a difference of means.
       const double se =
-          std::sqrt(out.anova.ms_within / 2.0 *
-                    (1.0 / static_cast<double>(a.n) + 1.0 / static_cast<double>(b.n)));
+          out.anova.root_ms_within *
+          std::sqrt(0.5 * (1.0 / static_cast<double>(a.n) + 1.0 / static_cast<double>(b.n)));
       c.p_adjusted = std::clamp(1.0 - range.cdf(std::abs(c.mean_difference) / se), 0.0, 1.0);
       c.ci_low = c.mean_difference - out.q_critical * se;
       c.ci_high = c.mean_difference + out.q_critical * se;

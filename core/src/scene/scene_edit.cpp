@@ -105,8 +105,13 @@ std::string edited_scene_text(const std::filesystem::path& scene_file,
       fracture->insert_or_assign("toughness", quantity(*edits.toughness_J_per_m2, "J/m^2"));
     }
   }
-  const std::filesystem::path scene_dir = scene_file.parent_path();
-  const std::filesystem::path out_dir = out_file.parent_path();
+  // A bare file name's folder is the current one ("" has no absolute form).
+  const auto folder = [](const std::filesystem::path& file) {
+    const std::filesystem::path dir = file.parent_path();
+    return dir.empty() ? std::filesystem::path(".") : dir;
+  };
+  const std::filesystem::path scene_dir = folder(scene_file);
+  const std::filesystem::path out_dir = folder(out_file);
   if (std::filesystem::absolute(scene_dir).lexically_normal() !=
       std::filesystem::absolute(out_dir).lexically_normal()) {
     make_stl_paths_absolute(root, scene_dir);

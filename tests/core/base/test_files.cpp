@@ -64,4 +64,19 @@ TEST(Files, FileWhereTheOutputFolderShouldBeIsNamedWithItsOption) {
   fs::remove_all(scratch());
 }
 
+// A written file holds every byte; a folder in its place, or a full device, is the option's
+// one-line error (a stream's failure was not looked at, and rows were lost with exit 0).
+TEST(Files, OutputFileIsWrittenWholeOrItsFailureNamed) {
+  const fs::path dir = scratch();
+  mneedle::write_output_file(dir / "a.json", std::string("{}\n\0z", 5), "--out");
+  EXPECT_EQ(mneedle::read_input_file(dir / "a.json"), std::string("{}\n\0z", 5));
+  EXPECT_EQ(error_of([&] { mneedle::write_output_file(dir, "x", "--out"); }),
+            "--out: cannot write '" + dir.string() + "'");
+  if (fs::exists("/dev/full")) {
+    EXPECT_EQ(error_of([&] { mneedle::write_output_file("/dev/full", "x", "--csv"); }),
+              "--csv: cannot write '/dev/full'");
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace

@@ -164,6 +164,27 @@ TEST(Anova, NoVarianceWithinGroupsIsRejected) {
                mneedle::InputError);
 }
 
+// F, p and the Tukey intervals do not depend on the values' unit: the same data times 1e-200
+// (whose squares underflow) and 1e140 give Montgomery's F to round-off, and 1e200 (whose squares
+// overflow) is refused rather than failing inside the F distribution.
+TEST(Anova, ResultsDoNotDependOnTheValuesScaleAndOverflowingValuesAreRefused) {
+  const std::vector<std::string> labels{"a", "a", "a", "b", "b", "b", "c", "c", "c"};
+  const std::vector<double> base{1.0, 2.0, 3.5, 4.0, 5.5, 6.0, 2.0, 2.5, 4.0};
+  const auto reference = mneedle::one_way_anova(labels, base);
+  for (const double scale : {1e-200, 1e140}) {
+    std::vector<double> values;
+    for (double v : base) values.push_back(v * scale);
+    const auto r = mneedle::one_way_anova(labels, values);
+    EXPECT_NEAR(r.anova.f, reference.anova.f, 1e-12 * reference.anova.f) << scale;
+    EXPECT_NEAR(r.tukey[0].ci_low / scale, reference.tukey[0].ci_low,
+                1e-12 * std::abs(reference.tukey[0].ci_low))
+        << scale;
+  }
+  std::vector<double> huge;
+  for (double v : base) huge.push_back(v * 1e200);
+  EXPECT_THROW(mneedle::one_way_anova(labels, huge), mneedle::InputError);
+}
+
 TEST(Anova, GroupedCsvTextValueNamesFileAndLine) {
   std::vector<std::string> labels;
   std::vector<double> values;

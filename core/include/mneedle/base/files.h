@@ -16,4 +16,9 @@ std::string read_input_file(const std::filesystem::path& file);
 /// path when it is a file or cannot be created.
 void create_output_folder(const std::filesystem::path& dir, std::string_view option);
 
+/// Writes `text` to `file` (replacing it) and checks that every byte reached it. InputError
+/// "<option>: cannot write '<file>'" otherwise (a full disk, a folder of that name).
+void write_output_file(const std::filesystem::path& file, std::string_view text,
+                       std::string_view option);
+
 }  // namespace mneedle

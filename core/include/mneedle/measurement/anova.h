@@ -25,6 +25,9 @@ struct AnovaTable {
   std::size_t df_within = 0;
   double ms_between = 0.0;
   double ms_within = 0.0;
+  /// sqrt(ms_within), found without squaring the values' unit (so it does not underflow where
+  /// ms_within does: values of 1e-200)
+  double root_ms_within = 0.0;
   double f = 0.0;
   double p = 1.0;  ///< P(F' > f) for F' ~ F(df_between, df_within)
 };
