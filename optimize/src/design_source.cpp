@@ -469,6 +469,16 @@ std::vector<PreparedNeedle> prepare_needles(const PluginRegistry& registry, cons
     n.name = spec.name;
     n.x = spec.at[0];
     n.y = spec.at[1];
+    // The scene checks a length it is given (geometry.length); a plugin's default length or an
+    // STL's is known only now. A needle shorter than the depth would be pushed on past its base
+    // with the force of its last section.
+    const BoundingBox box = bounding_box(source.mesh);
+    const double length = box.max[2] - box.min[2];
+    if (scene.insertion.depth >= length)
+      throw InputError(where + ": the needle is " + format_quantity(length, Dimension::Length) +
+                       " long (its mesh) and insertion.depth = " +
+                       format_quantity(scene.insertion.depth, Dimension::Length) +
+                       " would put its base into the tissue");
     apply_symmetry(needle_symmetry(registry, source, where), n);
     n.frame_note = source.frame_note;
     n.mesh = std::move(source.mesh);

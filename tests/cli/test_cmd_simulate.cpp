@@ -1188,6 +1188,25 @@ std::string gel_layer(const std::string& name, const std::string& thickness,
          "material = { model = \"linear\", E = \"" + modulus + "\", nu = 0.49 }\n";
 }
 
+// The gel scene's cone without its length: the plugin's default (1 mm) is known only from its
+// mesh, and 1 mm of insertion reaches it. The scene refuses a written length that short; this
+// ran on past the base with the force of the last section (exit 0).
+TEST(CmdSimulate, ANeedleWhoseMeshIsShorterThanTheDepthIsRefusedLikeAWrittenLength) {
+  std::string text = gel_scene(gel_layer("gel", "", "0.2 MPa"));
+  text.replace(text.find(", length = \"2 mm\""), 17, "");
+  const fs::path file = fs::temp_directory_path() / "mneedle_short_cone.toml";
+  std::ofstream(file) << text;
+  for (const char* model : {"", " --model analytic"}) {
+    const CommandRun run = run_mneedle("simulate '" + file.string() + "'" + model);
+    EXPECT_EQ(run.exit_code, 1) << model;
+    EXPECT_NE(run.err.find(":13: needle 'cone': the needle is 1 mm long (its mesh) and "
+                           "insertion.depth = 1 mm would put its base into the tissue"),
+              std::string::npos)
+        << run.err;
+  }
+  fs::remove(file);
+}
+
 double gel_puncture_depth(const fs::path& file, const std::string& layers) {
   std::ofstream(file) << gel_scene(layers);
   const CommandRun run = run_mneedle("simulate '" + file.string() + "' --json");
