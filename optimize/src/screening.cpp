@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <mutex>
@@ -401,8 +403,16 @@ void truncate_partial_line(const fs::path& file) {
   fs::resize_file(file, keep == std::string::npos ? 0 : keep + 1);
 }
 
+// A device or a pipe in the results' place would be read without end.
+void require_regular_results(const fs::path& jsonl) {
+  std::error_code error;
+  if (fs::exists(jsonl, error) && !fs::is_regular_file(jsonl, error))
+    throw InputError(jsonl.string() + ": not a regular file");
+}
+
 std::map<std::string, ScreeningRow> finished_rows(const fs::path& jsonl) {
   std::map<std::string, ScreeningRow> done;
+  require_regular_results(jsonl);
   truncate_partial_line(jsonl);
   std::ifstream in(jsonl);
   std::string line;
@@ -488,6 +498,7 @@ std::string csv_preamble(const fs::path& out) {
 void rebuild_csv(const fs::path& out) {
   std::error_code error;
   if (!fs::exists(out / "results.jsonl", error)) return;
+  require_regular_results(out / "results.jsonl");
   std::ifstream in(out / "results.jsonl");
   const fs::path temporary = out / "results.csv.partial";
   {
@@ -632,6 +643,14 @@ std::optional<std::size_t> ScreeningBatch::claim() {
   std::lock_guard<std::mutex> lock(claim_mutex_);
   while (next_ < designs_.size()) {
     const std::size_t i = next_++;
+    {
+      // Out of room for results: what is evaluated now would be lost, so nothing more is.
+      std::lock_guard<std::mutex> record_lock(record_mutex_);
+      if (!write_error_.empty()) {
+        rows_[i] = error_row(designs_[i], "not evaluated: " + write_error_);
+        continue;
+      }
+    }
     if (!done_.empty()) {
       const auto previous = done_.find(hashes_[i]);
       if (previous != done_.end()) {
@@ -664,6 +683,12 @@ void ScreeningBatch::record(std::size_t i, ScreeningRow row) {
       // Flushed per row: a run killed half-way keeps every finished design.
       jsonl_ << row.json << "\n" << std::flush;
       csv_ << line << "\n" << std::flush;
+      if (!jsonl_ || !csv_) {
+        write_error_ =
+            "the results in --out could not be written (" + std::string(std::strerror(errno)) + ")";
+        row = error_row(designs_[i], "evaluated, but " + write_error_ +
+                                         "; rerun with --resume once there is room");
+      }
     }
     if (on_row_) on_row_(row);
   } catch (const std::exception& e) {

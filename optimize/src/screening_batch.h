@@ -71,6 +71,8 @@ class ScreeningBatch {
   std::mutex claim_mutex_, record_mutex_;
   std::size_t next_ = 0;
   std::vector<ScreeningRow> rows_;
+  // Set when a row could not be written to out/ (a full disk): no further design is dealt.
+  std::string write_error_;
 };
 
 /// An error row for design `d` (what a design that fails to evaluate gets).

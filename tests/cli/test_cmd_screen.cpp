@@ -325,6 +325,37 @@ TEST(ScreenCommand, ResumeWithoutOutIsAnError) {
   EXPECT_NE(run.err.find("--resume needs --out"), std::string::npos) << run.err;
 }
 
+// A results file that cannot take a row (a full disk; here /dev/full behind results.csv): the
+// finished design's row says it was not saved, no further design is evaluated, and the run exits
+// 1 (rows were cut off with exit 0). A device in place of results.jsonl is refused (reading it
+// for --resume never ended).
+TEST(ScreenCommand, ResultsThatCannotBeWrittenStopTheBatchAndFailIt) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const fs::path out = fs::temp_directory_path() / "mneedle_screen_full";
+  fs::remove_all(out);
+  fs::create_directories(out);
+  fs::create_symlink("/dev/full", out / "results.csv");
+  const std::string designs =
+      "'" + kRoot + "/designs/cone.stl' '" + kRoot + "/designs/sharp_bevel.stl'";
+  const auto run = run_mneedle("screen " + designs + " --scene '" + kSkin +
+                               "' --model analytic --out '" + out.string() + "'");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.out.find("evaluated, but the results in --out could not be written (No space"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("not evaluated: the results in --out could not be written"),
+            std::string::npos)
+      << run.out;
+  fs::remove_all(out);
+  fs::create_directories(out);
+  fs::create_symlink("/dev/full", out / "results.jsonl");
+  const auto device = run_mneedle("screen " + designs + " --scene '" + kSkin +
+                                  "' --model analytic --out '" + out.string() + "' --resume");
+  EXPECT_EQ(device.exit_code, 1);
+  EXPECT_NE(device.err.find("results.jsonl: not a regular file"), std::string::npos) << device.err;
+  fs::remove_all(out);
+}
+
 // docs/scene.md: every command that takes a scene checks it as `scene check` does. screen
 // replaces the scene's needles by the designs, but a scene whose own needle is wrong (a misspelled
 // plugin parameter, one without its unit) is refused with its file and line before any design
