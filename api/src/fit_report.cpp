@@ -28,7 +28,8 @@ LoadedCurve load_fit_curve(const std::string& file, const CurveSettings& a) {
   out.curve.force_N = out.branch.curve.force_N;
   out.curve.conditions.speed_m_per_s =
       a.speed.empty() ? loading_speed(out.branch) : parse_quantity(a.speed, Dimension::Speed);
-  out.curve.conditions.angle_rad = parse_quantity(a.angle, Dimension::Angle);
+  out.curve.conditions.angle_rad =
+      checked_insertion_angle(parse_quantity(a.angle, Dimension::Angle), "--angle");
   return out;
 }
 
@@ -51,7 +52,11 @@ std::pair<std::string, double> parse_fixed_parameter(const std::string& text) {
     throw InputError("--fix '" + text + "': expected NAME=VALUE, e.g. mu=0.2");
   }
   const std::string name = text.substr(0, eq);
-  return {name, parse_quantity(text.substr(eq + 1), parameter_dimension(name))};
+  try {
+    return {name, parse_quantity(text.substr(eq + 1), parameter_dimension(name))};
+  } catch (const InputError& e) {
+    throw InputError("--fix " + name + ": " + e.what());
+  }
 }
 
 nlohmann::json fit_json(const TriforceFit& fit, const std::vector<LoadedCurve>& curves) {
@@ -120,7 +125,13 @@ FitOutcome fit_recordings(const std::vector<std::string>& files, const FitSettin
     std::sort(options.initial.layers.begin(), options.initial.layers.end(),
               [](const auto& a, const auto& b) { return a.start_m < b.start_m; });
   }
-  for (const auto& text : s.fix) options.fixed.insert(parse_fixed_parameter(text));
+  for (const auto& text : s.fix) {
+    const auto [name, value] = parse_fixed_parameter(text);
+    if (!options.fixed.emplace(name, value).second)
+      throw InputError("--fix " + name + ": given twice");
+    if (std::find(s.free.begin(), s.free.end(), name) != s.free.end())
+      throw InputError("--fix " + name + ": also given to --free; a parameter is one or the other");
+  }
   options.free = s.free;
   FitOutcome out{std::move(curves), fit_triforce(data, options), {}, {}};
   for (const auto& l : options.initial.layers) out.initial_layer_starts_m.push_back(l.start_m);

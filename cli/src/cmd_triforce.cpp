@@ -190,10 +190,19 @@ TriforceParams read_params(const std::string& file) {
     throw InputError(file + ": no \"params\" object (write it with mneedle fit --json)");
   }
   TriforceParams p;
+  std::set<std::string> given;
   for (const auto& [name, value] : j["params"].items()) {
     if (!value.is_number()) throw InputError(file + ": params." + name + ": not a number");
     set_parameter(p, name, value.get<double>());
+    given.insert(name);
   }
+  // Every parameter of the layers the file names: a missing one would be the model's built-in
+  // default (a beta left out tripled the predicted peak).
+  std::string missing;
+  for (const auto& [name, value] : named_parameters(p))
+    if (!given.count(name)) missing += (missing.empty() ? "" : ", ") + name;
+  if (!missing.empty())
+    throw InputError(file + ": params: missing " + missing + " (write it with mneedle fit --json)");
   TriforceModel{p};  // validates
   return p;
 }
@@ -234,7 +243,8 @@ void run_predict(const PredictArgs& args) {
   const TriforceModel model(read_params(args.params_file));
   InsertionProtocol protocol;
   protocol.conditions.speed_m_per_s = option_quantity("--speed", args.speed, Dimension::Speed);
-  protocol.conditions.angle_rad = option_quantity("--angle", args.angle, Dimension::Angle);
+  protocol.conditions.angle_rad =
+      checked_insertion_angle(option_quantity("--angle", args.angle, Dimension::Angle), "--angle");
   protocol.conditions.perturbation_amplitude_m =
       option_quantity("--perturb-amplitude", args.amplitude, Dimension::Length);
   protocol.conditions.perturbation_frequency_Hz = args.frequency_Hz;

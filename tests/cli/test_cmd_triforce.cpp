@@ -96,6 +96,35 @@ TEST(CmdTriforce, FitRefusesTwoCurvesOfOneNameAndAnOutputFolderUnderAFile) {
       << under.err;
 }
 
+// What gave numbers with exit 0: an angle whose sine is negative (-90 deg predicted -50 N) or
+// repeats (200 deg), a params file missing a parameter (the built-in beta tripled the peak), a
+// parameter both fixed and free or fixed twice (nothing fitted, or the first value kept).
+TEST(CmdTriforce, AnglesOutsideTheQuarterTurnMissingParametersAndFixFreeClashesAreRefused) {
+  const std::string file = write_recording();
+  const std::filesystem::path dir = kWork / "clash";
+  ASSERT_EQ(run_mneedle("fit '" + file + "' --starts 2 --out '" + dir.string() + "'").exit_code, 0);
+  const std::string params = (dir / "fit.json").string();
+  const auto refused = [](const std::string& arguments, const std::string& message) {
+    const CommandRun run = run_mneedle(arguments);
+    EXPECT_EQ(run.exit_code, 1) << arguments;
+    EXPECT_NE(run.err.find(message), std::string::npos) << run.err;
+  };
+  refused("predict --params '" + params + "' --depth 5mm --angle -90deg",
+          "--angle: -90 deg is outside (0, 90] deg");
+  refused("predict --params '" + params + "' --depth 5mm --angle 200deg",
+          "--angle: 200 deg is outside (0, 90] deg");
+  refused("fit '" + file + "' --angle 0deg", "--angle: 0 deg is outside (0, 90] deg");
+  nlohmann::json j;
+  std::ifstream(params) >> j;
+  j["params"].erase("beta");
+  const std::filesystem::path partial = dir / "partial.json";
+  std::ofstream(partial) << j.dump();
+  refused("predict --params '" + partial.string() + "' --depth 5mm", ": params: missing beta");
+  refused("fit '" + file + "' --fix beta=0 --free beta", "--fix beta: also given to --free");
+  refused("fit '" + file + "' --fix beta=0 --fix beta=1", "--fix beta: given twice");
+  refused("fit '" + file + "' --fix K0_N=2", "--fix K0_N: \"2\" needs a unit");
+}
+
 TEST(CmdTriforce, PredictGoesInHoldsAndComesOut) {
   const auto file = write_recording();
   ASSERT_EQ(

@@ -202,6 +202,8 @@ TriforceFit fit_triforce(const std::vector<FitCurve>& curves, const TriforceFitO
       throw InputError("tri-force fit: parameter '" + n + "' given twice");
   }
   TriforceModel{base};  // the fixed values must be valid on their own
+  if (free.empty())
+    throw InputError("tri-force fit: every parameter is fixed; nothing is left to fit");
 
   const DataScale scale = data_scale(curves, base);
   const double max_offset =

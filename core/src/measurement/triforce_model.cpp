@@ -278,4 +278,12 @@ double get_parameter(const TriforceParams& params, std::string_view name) {
   return *locate(copy, name);
 }
 
+double checked_insertion_angle(double angle_rad, std::string_view option) {
+  if (!(angle_rad > 0.0) || !(angle_rad <= std::numbers::pi / 2.0 * (1.0 + 1e-12)))
+    throw InputError(std::string(option) + ": " + format_quantity(angle_rad, Dimension::Angle) +
+                     " is outside (0, 90] deg (the needle-to-surface angle; 90 deg is "
+                     "perpendicular)");
+  return angle_rad;
+}
+
 }  // namespace mneedle

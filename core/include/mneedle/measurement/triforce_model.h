@@ -118,4 +118,9 @@ void set_parameter(TriforceParams& params, std::string_view name, double value);
 /// Reads one named parameter. Throws InputError naming `name` when it is unknown.
 double get_parameter(const TriforceParams& params, std::string_view name);
 
+/// `angle_rad` when 0 < angle <= pi/2 (paper B's needle-to-surface angle, pi/2 perpendicular:
+/// the model's sin(angle) is the depth's share along the surface normal, which is negative or
+/// repeats beyond that range). InputError naming `option` otherwise.
+double checked_insertion_angle(double angle_rad, std::string_view option);
+
 }  // namespace mneedle
