@@ -268,9 +268,34 @@ class CondensedSurface {
   // Candidate displacements and forces with the captured nodes prescribed and the rest free;
   // each pair in `closed` (condensed dof indices {inner u_r, outer u_r}) held at zero gap,
   // u_r(outer) = u_r(inner), by a Lagrange multiplier.
+  // `stiffness`, when given, replaces S (S with a cohesive interface's springs, with_springs).
   void solve(const AxisymmetricMesh& mesh, const ContactState& state, double depth,
              Eigen::VectorXd& u, Eigen::VectorXd& f,
-             const std::vector<std::array<int, 2>>& closed = {}) const {
+             const std::vector<std::array<int, 2>>& closed = {},
+             const Eigen::MatrixXd* stiffness = nullptr) const {
+    const Eigen::MatrixXd& S = stiffness ? *stiffness : S_;
+    std::vector<Eigen::Index> free, fixed;
+    partition(mesh, state, depth, u, free, fixed);
+    if (!free.empty() && !closed.empty()) {
+      solve_closed(free, fixed, closed, u);  // no springs: pairs in contact or cohesive, not both
+    } else if (!free.empty()) {
+      Eigen::MatrixXd S_ff(free.size(), free.size());
+      Eigen::VectorXd rhs = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(free.size()));
+      for (std::size_t a = 0; a < free.size(); ++a) {
+        for (std::size_t b = 0; b < free.size(); ++b) S_ff(a, b) = S(free[a], free[b]);
+        for (Eigen::Index c : fixed) rhs[a] -= S(free[a], c) * u[c];
+      }
+      const Eigen::VectorXd uf = S_ff.ldlt().solve(rhs);
+      for (std::size_t a = 0; a < free.size(); ++a) u[free[a]] = uf[a];
+    }
+    f = S * u;
+  }
+
+  // The condensed dofs held by the needle (captured) or the axis, `fixed`, with their values in
+  // u (zero elsewhere), and the rest, `free`.
+  void partition(const AxisymmetricMesh& mesh, const ContactState& state, double depth,
+                 Eigen::VectorXd& u, std::vector<Eigen::Index>& free,
+                 std::vector<Eigen::Index>& fixed) const {
     const auto m = static_cast<Eigen::Index>(dofs_.size());
     std::vector<char> prescribed(static_cast<std::size_t>(m), 0);
     u = Eigen::VectorXd::Zero(m);
@@ -282,21 +307,9 @@ class CondensedSurface {
       u[j] = axis_fixed_[j] ? 0.0 : d.x();
       u[j + 1] = d.y();
     }
-    std::vector<Eigen::Index> free, fixed;
+    free.clear();
+    fixed.clear();
     for (Eigen::Index j = 0; j < m; ++j) (prescribed[j] ? fixed : free).push_back(j);
-    if (!free.empty() && !closed.empty()) {
-      solve_closed(free, fixed, closed, u);
-    } else if (!free.empty()) {
-      Eigen::MatrixXd S_ff(free.size(), free.size());
-      Eigen::VectorXd rhs = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(free.size()));
-      for (std::size_t a = 0; a < free.size(); ++a) {
-        for (std::size_t b = 0; b < free.size(); ++b) S_ff(a, b) = S_(free[a], free[b]);
-        for (Eigen::Index c : fixed) rhs[a] -= S_(free[a], c) * u[c];
-      }
-      const Eigen::VectorXd uf = S_ff.ldlt().solve(rhs);
-      for (std::size_t a = 0; a < free.size(); ++a) u[free[a]] = uf[a];
-    }
-    f = S_ * u;
   }
 
   // The free part of solve() with zero-gap pairs: the saddle-point system
@@ -365,6 +378,24 @@ class CondensedSurface {
   }
 
   int index_of(std::uint32_t node) const { return index_.at(node); }
+
+  /// A spring of stiffness k (N/m, the whole ring) between two condensed dofs.
+  struct Spring {
+    int a = 0, b = 0;
+    double k = 0.0;
+  };
+  /// S with the springs added: the condensed stiffness of the tissue held across a cohesive
+  /// interface whose nodes are all condensed.
+  Eigen::MatrixXd with_springs(const std::vector<Spring>& springs) const {
+    Eigen::MatrixXd S = S_;
+    for (const Spring& s : springs) {
+      S(s.a, s.a) += s.k;
+      S(s.b, s.b) += s.k;
+      S(s.a, s.b) -= s.k;
+      S(s.b, s.a) -= s.k;
+    }
+    return S;
+  }
 
   /// Gap u_r(outer) - u_r(inner) of each crack-face pair in condensed displacements u (every
   /// pair node condensed; zeros before the first solve).
@@ -651,21 +682,75 @@ class NonlinearStepper : public Stepper {
   double last_step_ = 0.0;
 };
 
+// A cohesive ring crack's face pairs with what the law needs of each (docs/model.md, "Cohesive
+// ring crack"): its share of the ring's face area and its depth, and the largest mixed-mode
+// opening it has reached at the last committed depth.
+struct CohesiveRing {
+  CohesiveLaw law;
+  std::vector<double> area_m2, depth_m, reached_m;
+  double line_depth_m = 0.0;  // the crack line's end (the shared front node)
+};
+
+// Shares of the line r = radius, 0 >= z > -depth: the line is a column of quadratic edges whose
+// nodes alternate corner, mid-edge, corner from the surface down to the front; each edge of
+// length L gives L/6 to its corners and 4L/6 to its mid node (Simpson: nodal integration, which
+// keeps the interface's tractions free of the oscillations a Gauss rule gives at a stiff law).
+CohesiveRing cohesive_ring(const AxisymmetricMesh& mesh, const FacePairs& pairs, double radius,
+                           double depth, const CohesiveLaw& law) {
+  CohesiveRing ring;
+  ring.law = law;
+  ring.line_depth_m = depth;
+  std::vector<std::size_t> order(pairs.size());
+  for (std::size_t p = 0; p < pairs.size(); ++p) order[p] = p;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return mesh.nodes[pairs[a][0]].y() > mesh.nodes[pairs[b][0]].y();
+  });
+  std::vector<double> z;  // down the line, the front last
+  for (std::size_t p : order) z.push_back(-mesh.nodes[pairs[p][0]].y());
+  z.push_back(depth);
+  if (z.size() % 2 == 0)
+    throw InputError("cohesive ring crack: the crack line is not a column of quadratic edges");
+  ring.area_m2.assign(pairs.size(), 0.0);
+  ring.depth_m.assign(pairs.size(), 0.0);
+  ring.reached_m.assign(pairs.size(), 0.0);
+  const double circumference = 2.0 * kPi * radius;
+  for (std::size_t k = 0; k + 2 < z.size(); k += 2) {
+    const double edge = z[k + 2] - z[k];
+    ring.area_m2[order[k]] += circumference * edge / 6.0;
+    ring.area_m2[order[k + 1]] += circumference * 4.0 * edge / 6.0;
+    if (k + 2 < pairs.size()) ring.area_m2[order[k + 2]] += circumference * edge / 6.0;
+  }
+  for (std::size_t k = 0; k < pairs.size(); ++k) ring.depth_m[order[k]] = z[k];
+  return ring;
+}
+
+// Cohesive rounds per solve: each lets the damage of the pairs grow to what their openings
+// say; an unstable crack advances about a cell per round. A damage change below
+// kDamageTolerance ends them.
+constexpr int kMaxCohesiveRounds = 20000;
+constexpr double kDamageTolerance = 1e-6;
+// Conjugate gradients per round before the free block is factorised again, and their residual
+// (relative to the right-hand side; the direct solve's round-off is ~1e-14 of it).
+constexpr int kMaxCgIterations = 40;
+constexpr double kCgTolerance = 1e-12;
+
 // Linear layers, sticking: the condensed surface; sub-steps only refine where captures happen,
 // the solve itself is exact at any depth.
 class LinearStepper : public Stepper {
  public:
   // pairs: the ring crack's faces (cracked twin), kept apart when `close_pairs` is set.
+  // cohesive: the pairs' law and shares (then `pairs` are the cohesive ring's, not in contact).
   LinearStepper(AxisymmetricModel& model, const AxisymmetricNeedle& needle,
                 const InsertionOptions& options, bool keep_field, FacePairs pairs = {},
-                bool close_pairs = false)
+                bool close_pairs = false, std::optional<CohesiveRing> cohesive = std::nullopt)
       : mesh_(model.mesh()),
         needle_(needle),
         candidates_(reachable_surface_nodes(mesh_, needle, options.depth_m)),
         n_(model.dof_count()),
         sub_step_(options.depth_m / (options.output_steps * kSubsteps)),
         pairs_(std::move(pairs)),
-        close_pairs_(close_pairs) {
+        close_pairs_(close_pairs),
+        cohesive_(std::move(cohesive)) {
     previous_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_));
     if (!candidates_.empty())
       surface_ = std::make_unique<CondensedSurface>(model, with_face_nodes(candidates_, pairs_),
@@ -712,6 +797,7 @@ class LinearStepper : public Stepper {
       }
       depth_ = next;
       previous_ = surface_->scatter(u_, n_);
+      if (cohesive_) cohesive_->reached_m = trial_reached_;
     }
     double force = 0.0;
     for (const auto& entry : state_.captured) {
@@ -720,8 +806,10 @@ class LinearStepper : public Stepper {
       force -= f_[it - dofs.begin()];
     }
     const double area = contact_area(mesh_, needle_, state_, previous_);
-    return make_step(depth_, force, area, 0.5 * u_.dot(f_), solves,
-                     static_cast<int>(state_.captured.size()));
+    InsertionStep step = make_step(depth_, force, area, 0.5 * u_.dot(f_), solves,
+                                   static_cast<int>(state_.captured.size()));
+    if (cohesive_) describe_cohesive(step);
+    return step;
   }
 
   Eigen::VectorXd displacement() const override {
@@ -734,6 +822,10 @@ class LinearStepper : public Stepper {
   // whose contact force pulls (the outer node's radial force below zero) open, open pairs whose
   // faces overlap close, until nothing changes.
   void solve_contact(double depth) {
+    if (cohesive_) {
+      solve_cohesive(depth);
+      return;
+    }
     if (!close_pairs_ || pairs_.empty()) {
       surface_->solve(mesh_, state_, depth, u_, f_);
       return;
@@ -780,6 +872,133 @@ class LinearStepper : public Stepper {
                       format_depth(depth));
   }
 
+  // The cohesive ring's springs at the largest openings `reached` (the whole ring, N/m): the
+  // law's damaged secant on both the radial opening and the axial slip, and the undamaged
+  // initial stiffness radially where the faces press on each other (`pressed`).
+  std::vector<CondensedSurface::Spring> cohesive_springs(const std::vector<double>& reached,
+                                                         const std::vector<char>& pressed) const {
+    const CohesiveLaw& law = cohesive_->law;
+    const double initial = cohesive_peak_traction(law) / law.peak_opening_m;  // Pa/m
+    std::vector<CondensedSurface::Spring> springs;
+    for (std::size_t p = 0; p < pairs_.size(); ++p) {
+      const double k = initial * cohesive_->area_m2[p];
+      const double kept = (1.0 - cohesive_damage(law, reached[p])) * k;
+      const int in = surface_->index_of(pairs_[p][0]), out = surface_->index_of(pairs_[p][1]);
+      springs.push_back({in, out, pressed[p] ? k : kept});
+      springs.push_back({in + 1, out + 1, kept});
+    }
+    return springs;
+  }
+
+  // The cohesive ring at `depth` from the committed damage: solve with the springs of the
+  // damage so far, let each pair's damage grow to what its opening says, until no damage moves
+  // by kDamageTolerance and no pair changes between pressed and open (a secant fixed point; the
+  // damage only grows, so the rounds end on the state the law allows nearest the committed one).
+  void solve_cohesive(double depth) {
+    std::vector<double> reached = cohesive_->reached_m;
+    std::vector<char> pressed(pairs_.size(), 0);
+    const CohesiveLaw& law = cohesive_->law;
+    std::vector<Eigen::Index> free, fixed;
+    Eigen::VectorXd u;
+    surface_->partition(mesh_, state_, depth, u, free, fixed);
+    const auto nf = static_cast<Eigen::Index>(free.size());
+    // Each round changes the springs of the few pairs whose damage moved: the factor of an
+    // earlier round's free block preconditions conjugate gradients on this one's (the change is
+    // of low rank, so they converge in about as many iterations as pairs changed); refactored
+    // when they take more than kMaxCgIterations.
+    Eigen::LLT<Eigen::MatrixXd> factor;
+    bool factored = false;
+    Eigen::VectorXd uf = Eigen::VectorXd::Zero(nf);
+    for (int round = 0;; ++round) {
+      if (round == kMaxCohesiveRounds)
+        throw SolverError("cohesive ring crack: the damage did not settle in " +
+                          std::to_string(kMaxCohesiveRounds) + " rounds at depth " +
+                          format_depth(depth));
+      const Eigen::MatrixXd S = surface_->with_springs(cohesive_springs(reached, pressed));
+      if (nf > 0) {
+        Eigen::MatrixXd A(nf, nf);
+        Eigen::VectorXd b = Eigen::VectorXd::Zero(nf);
+        for (Eigen::Index a = 0; a < nf; ++a) {
+          for (Eigen::Index c = 0; c < nf; ++c) A(a, c) = S(free[a], free[c]);
+          for (Eigen::Index c : fixed) b[a] -= S(free[a], c) * u[c];
+        }
+        if (!factored || !conjugate_gradients(A, b, factor, uf)) {
+          factor.compute(A);
+          if (factor.info() != Eigen::Success)
+            throw SolverError(
+                "cohesive ring crack: the stiffness lost its positive definiteness "
+                "at depth " +
+                format_depth(depth));
+          factored = true;
+          uf = factor.solve(b);
+        }
+        for (Eigen::Index a = 0; a < nf; ++a) u[free[a]] = uf[a];
+      }
+      u_ = u;
+      f_ = S * u_;
+      ++rounds_;
+      bool changed = false;
+      for (std::size_t p = 0; p < pairs_.size(); ++p) {
+        const int in = surface_->index_of(pairs_[p][0]), out = surface_->index_of(pairs_[p][1]);
+        const double radial = u_[out] - u_[in], slip = u_[out + 1] - u_[in + 1];
+        const char press = radial < 0.0 ? 1 : 0;
+        if (press != pressed[p]) pressed[p] = press, changed = true;
+        const double opening = std::hypot(std::max(radial, 0.0), slip);
+        if (opening <= reached[p]) continue;
+        const double before = cohesive_damage(law, reached[p]);
+        reached[p] = opening;
+        if (cohesive_damage(law, opening) - before > kDamageTolerance) changed = true;
+      }
+      if (!changed) break;
+    }
+    trial_reached_ = std::move(reached);
+  }
+
+  // Preconditioned conjugate gradients on A x = b from x, the preconditioner `factor` (of a
+  // nearby A): true when the residual falls below kCgTolerance of b within kMaxCgIterations.
+  static bool conjugate_gradients(const Eigen::MatrixXd& A, const Eigen::VectorXd& b,
+                                  const Eigen::LLT<Eigen::MatrixXd>& factor, Eigen::VectorXd& x) {
+    const double target = kCgTolerance * b.norm();
+    Eigen::VectorXd r = b - A * x;
+    if (r.norm() <= target) return true;
+    Eigen::VectorXd z = factor.solve(r), p = z;
+    double rz = r.dot(z);
+    for (int k = 0; k < kMaxCgIterations; ++k) {
+      const Eigen::VectorXd Ap = A * p;
+      const double alpha = rz / p.dot(Ap);
+      x += alpha * p;
+      r -= alpha * Ap;
+      if (r.norm() <= target) return true;
+      z = factor.solve(r);
+      const double next = r.dot(z);
+      p = z + (next / rz) * p;
+      rz = next;
+    }
+    return false;
+  }
+
+  // The crack's extent, process zone and dissipated energy at the committed damage.
+  void describe_cohesive(InsertionStep& step) {
+    const CohesiveRing& ring = *cohesive_;
+    for (std::size_t p = 0; p < pairs_.size(); ++p) {
+      const double damage = cohesive_damage(ring.law, ring.reached_m[p]);
+      step.fracture_energy_J +=
+          ring.area_m2[p] * cohesive_dissipated_energy(ring.law, ring.reached_m[p]);
+      if (damage >= 1.0) step.cohesive_crack_m = std::max(step.cohesive_crack_m, ring.depth_m[p]);
+      if (damage > 0.0) step.cohesive_zone_m = std::max(step.cohesive_zone_m, ring.depth_m[p]);
+    }
+    // Process-zone cells: edges (two mid-edge spacings) between the failed crack and the
+    // damaged zone's end.
+    for (std::size_t p = 0; p < pairs_.size(); ++p) {
+      const double damage = cohesive_damage(ring.law, ring.reached_m[p]);
+      if (damage > 0.0 && damage < 1.0 && ring.depth_m[p] > step.cohesive_crack_m)
+        ++step.process_zone_cells;
+    }
+    step.process_zone_cells /= 2;
+    step.cohesive_rounds = rounds_;
+    rounds_ = 0;
+  }
+
   static constexpr int kSubsteps = 4;
   const AxisymmetricMesh& mesh_;
   AxisymmetricNeedle needle_;
@@ -793,6 +1012,9 @@ class LinearStepper : public Stepper {
   FacePairs pairs_;
   bool close_pairs_ = false;
   std::vector<std::size_t> closed_;  // sorted
+  std::optional<CohesiveRing> cohesive_;
+  std::vector<double> trial_reached_;  // the last solve's largest openings, committed per step
+  int rounds_ = 0;
 };
 
 // Linear layers, frictionless: active set on the condensed surface; each depth solved
@@ -939,7 +1161,32 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
   const auto start = std::chrono::steady_clock::now();
   const int before = model.factorization_count();
   const bool keep_field = options.stress_average_length_m > 0.0 || !options.vtu_directory.empty();
-  std::unique_ptr<Stepper> intact = make_stepper(model, needle, options, keep_field);
+  // A cohesive ring crack replaces the intact model by the split one, its faces held by the law.
+  std::unique_ptr<AxisymmetricModel> cohesive_model;
+  AxisymmetricModel* run_model = &model;
+  std::unique_ptr<Stepper> intact;
+  if (options.cohesive_depth_m > 0.0) {
+    const CohesiveLaw& law = options.cohesive;
+    if (frictionless || !model.is_linear())
+      throw InputError("cohesive ring crack: needs linear layers and sticking contact");
+    if (options.crack_depth_m > 0.0)
+      throw InputError("cohesive ring crack: not together with the energy criterion's crack");
+    if (!(law.toughness_J_per_m2 > 0.0) || !(law.peak_opening_m > 0.0) ||
+        !(law.failure_opening_m > law.peak_opening_m) || !std::isfinite(law.failure_opening_m))
+      throw InputError("cohesive ring crack: the law needs G_c > 0 and 0 < delta_y < delta_0");
+    const double radius = ring_crack_radius(needle, options.depth_m);
+    FacePairs pairs;
+    cohesive_model = std::make_unique<AxisymmetricModel>(
+        crack_axisymmetric_mesh(model.mesh(), radius, options.cohesive_depth_m, nullptr, &pairs),
+        model.layer_materials());
+    CohesiveRing ring =
+        cohesive_ring(cohesive_model->mesh(), pairs, radius, options.cohesive_depth_m, law);
+    intact = std::make_unique<LinearStepper>(*cohesive_model, needle, options, keep_field,
+                                             std::move(pairs), false, std::move(ring));
+    run_model = cohesive_model.get();
+  } else {
+    intact = make_stepper(model, needle, options, keep_field);
+  }
   // Energy release rate: a ring-cracked twin advanced in lock-step with the intact model.
   std::unique_ptr<AxisymmetricModel> cracked_model;
   std::unique_ptr<Stepper> cracked;
@@ -988,14 +1235,14 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
       // The stress criterion's probe searches the top layer within the needle's outline at
       // this depth plus two averaging lengths (docs/model.md, "Criteria", stress).
       if (options.stress_average_length_m > 0.0)
-        step.tip_stress_Pa = model.peak_averaged_max_principal_stress(
+        step.tip_stress_Pa = run_model->peak_averaged_max_principal_stress(
             u, outline_radius_up_to(needle, depth) + 2.0 * options.stress_average_length_m,
             options.stress_average_length_m, 0);
       if (!options.vtu_directory.empty()) {
         const std::filesystem::path dir(options.vtu_directory);
         const std::string file = "step_" + std::to_string(k) + ".vtu",
                           needle_file = "needles_" + std::to_string(k) + ".vtu";
-        model.write_vtu((dir / file).string(), u, depth, options.vtu_comment);
+        run_model->write_vtu((dir / file).string(), u, depth, options.vtu_comment);
         VtuFile profile = axi::needle_profile_vtu(needle, depth);
         profile.comment = options.vtu_comment;
         write_vtu((dir / needle_file).string(), profile);
@@ -1011,8 +1258,8 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
   result.factorizations = model.is_linear() ? 1 : model.factorization_count() - before;
   if (cracked_model)
     result.factorizations += cracked_model->is_linear() ? 1 : cracked_model->factorization_count();
-  result.nodes = model.mesh().nodes.size();
-  result.elements = model.mesh().elements.size();
+  result.nodes = run_model->mesh().nodes.size();
+  result.elements = run_model->mesh().elements.size();
   result.solve_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
@@ -1123,6 +1370,15 @@ AxisymmetricMeshOptions mesh_options_for(const AxisymmetricProblem& problem) {
     o.fine_radius_m = std::max(o.fine_radius_m, 1.5 * r_c);
     o.depth_breaks_m.push_back(problem.crack_depth_m);
   }
+  // A cohesive ring crack: the fine cells run down its whole line, where the process zone may
+  // travel (docs/model.md, "Cohesive ring crack").
+  if (problem.cohesive_depth_m > 0.0) {
+    const double r_c = ring_crack_radius(needle, problem.depth_m);
+    o.radial_breaks_m.push_back(r_c);
+    o.fine_radius_m = std::max(o.fine_radius_m, 1.5 * r_c);
+    o.fine_depth_m = std::max(o.fine_depth_m, problem.cohesive_depth_m);
+    o.depth_breaks_m.push_back(problem.cohesive_depth_m);
+  }
   return o;
 }
 
@@ -1157,6 +1413,8 @@ InsertionResult simulate_axisymmetric(const AxisymmetricProblem& problem) {
   options.stress_average_length_m = problem.stress_average_length_m;
   options.crack_depth_m = problem.crack_depth_m;
   options.crack_face_contact = problem.crack_face_contact;
+  options.cohesive_depth_m = problem.cohesive_depth_m;
+  options.cohesive = problem.cohesive;
   options.on_step = problem.on_step;
   options.vtu_directory = problem.vtu_directory;
   options.vtu_comment = problem.vtu_comment;

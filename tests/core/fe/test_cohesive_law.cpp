@@ -9,11 +9,16 @@ namespace {
 // 2 G_c / delta_0 = 4648 Pa): the envelope encloses G_c, a cell unloads and reloads along its
 // damaged secant through the origin, and its damage follows the largest opening only, so it
 // never heals (docs/model.md, "Cohesive interface").
-TEST(CohesiveLaw, ACellUnloadsAlongItsDamagedSecantAndNeverHeals) {
+CohesiveLaw paper_c_law() {
   CohesiveLaw law;
   law.toughness_J_per_m2 = 17.43;
   law.peak_opening_m = 7e-3;
   law.failure_opening_m = 7.5e-3;
+  return law;
+}
+
+TEST(CohesiveLaw, ACellUnloadsAlongItsDamagedSecantAndNeverHeals) {
+  const CohesiveLaw law = paper_c_law();
   const double peak = 2.0 * 17.43 / 7.5e-3;
   // The envelope (loading: the opening is the largest reached) and its area, Simpson on a grid
   // with nodes at delta_y and delta_0, where the law has its corners: exact for linear pieces.
@@ -43,6 +48,19 @@ TEST(CohesiveLaw, ACellUnloadsAlongItsDamagedSecantAndNeverHeals) {
   EXPECT_EQ(cohesive_traction(CohesiveLaw{}, 1e-3, 1e-3), 0.0);
   EXPECT_NEAR(cohesive_peak_traction(law), peak, 1e-9 * peak);
   EXPECT_EQ(cohesive_peak_traction(CohesiveLaw{}), 0.0);
+}
+
+// What a cell has dissipated is the work done on it less what unloading returns: 0 up to
+// delta_y, G_c once failed, and at 7.25 mm the envelope's area there (G_c - the remaining
+// triangle, 17.43 - 0.5 (peak / 2) 0.25 mm) less the secant's 0.5 (peak / 2) 7.25 mm.
+TEST(CohesiveLaw, DissipatedEnergyIsTheWorkDoneLessWhatUnloadingReturns) {
+  const CohesiveLaw law = paper_c_law();
+  const double peak = 2.0 * 17.43 / 7.5e-3;
+  EXPECT_EQ(cohesive_dissipated_energy(law, 6e-3), 0.0);
+  EXPECT_EQ(cohesive_dissipated_energy(law, 8e-3), 17.43);
+  const double work = 17.43 - 0.5 * (0.5 * peak) * 0.25e-3;
+  EXPECT_NEAR(cohesive_dissipated_energy(law, 7.25e-3), work - 0.5 * (0.5 * peak) * 7.25e-3, 1e-12);
+  EXPECT_EQ(cohesive_dissipated_energy(CohesiveLaw{}, 1e-3), 0.0);
 }
 
 }  // namespace

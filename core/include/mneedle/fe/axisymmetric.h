@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "mneedle/base/error.h"
+#include "mneedle/fe/cohesive_law.h"
 #include "mneedle/fe/fidelity.h"
 #include "mneedle/fe/material.h"
 
@@ -224,6 +225,16 @@ struct InsertionStep {
   /// in contact").
   double crack_face_overlap_m = 0.0;
   int crack_face_contacts = 0;
+  /// The cohesive ring crack (cohesive_depth_m > 0; docs/model.md, "Cohesive ring crack"):
+  /// depth below the surface of its deepest failed face pair (damage 1) and of its deepest
+  /// damaged one (m, reference), the cells of the process zone between them (edges of the
+  /// crack line with a damaged but unfailed end), the energy its law has dissipated (J, the
+  /// whole ring) and the damage rounds solved since the previous output.
+  double cohesive_crack_m = 0.0;
+  double cohesive_zone_m = 0.0;
+  int process_zone_cells = 0;
+  double fracture_energy_J = 0.0;
+  int cohesive_rounds = 0;
 };
 
 struct InsertionOptions {
@@ -242,6 +253,13 @@ struct InsertionOptions {
   /// (exact on linear layers, an augmented Lagrangian on nonlinear ones; with frictionless needle
   /// contact the faces stay free and only their overlap is reported); false leaves them free.
   bool crack_face_contact = true;
+  /// A cohesive ring crack (docs/model.md, "Cohesive ring crack"): when cohesive_depth_m > 0 the
+  /// tissue is split along r = ring_crack_radius(needle, depth_m) from the surface down this
+  /// deep and its faces held by `cohesive` (paper C's bilinear law on the mixed-mode opening;
+  /// in compression a penalty of the law's initial stiffness). Linear layers and sticking
+  /// contact only; the mesh needs the node column and row as for crack_depth_m.
+  double cohesive_depth_m = 0.0;
+  CohesiveLaw cohesive;
   /// Called after each output step; returning false stops the insertion there.
   std::function<bool(const InsertionStep&)> on_step;
   /// When set, step_<k>.vtu (k = 1..output steps) is written there (AxisymmetricModel::write_vtu)
@@ -282,6 +300,8 @@ struct AxisymmetricProblem {
   double stress_average_length_m = 0.0;  ///< as InsertionOptions
   double crack_depth_m = 0.0;            ///< as InsertionOptions
   bool crack_face_contact = true;        ///< as InsertionOptions
+  double cohesive_depth_m = 0.0;         ///< as InsertionOptions
+  CohesiveLaw cohesive;                  ///< as InsertionOptions
   std::function<bool(const InsertionStep&)> on_step;
   /// Called once the mesh is built, before the first step, with the result's nodes, elements and
   /// mesh_seconds filled and no steps: a caller that keeps what a run reached before it stopped

@@ -36,4 +36,9 @@ double cohesive_damage(const CohesiveLaw& law, double largest_opening_m);
 /// and reloading along the damaged secant, through the origin). 0 without cohesion.
 double cohesive_traction(const CohesiveLaw& law, double opening_m, double largest_opening_m);
 
+/// Energy per unit crack area (J/m^2) the law has dissipated at a cell that has reached
+/// `largest_opening_m`: the area under the envelope up to it less what unloading along the
+/// damaged secant would return; G_c once the cell has failed, 0 up to delta_y.
+double cohesive_dissipated_energy(const CohesiveLaw& law, double largest_opening_m);
+
 }  // namespace mneedle::fe
