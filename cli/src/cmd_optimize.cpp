@@ -508,6 +508,7 @@ void run_optimize(const OptimizeArgs& a) {
   };
   const std::string objective_key =
       a.objective == "peak-force" ? "peak_force_N" : "puncture_depth_m";
+  if (!a.report.empty()) create_output_folder(a.report, "--report");  // before the search
   std::unique_ptr<HistoryWriter> history;
   if (!a.out.empty()) {
     create_output_folder(a.out, "--out");
@@ -581,9 +582,11 @@ void run_optimize(const OptimizeArgs& a) {
       {"history", history_json(r.history)},
       {"warnings", warnings}};
   if (!a.out.empty()) write_outputs(a.out, best.mesh, summary);
-  if (!a.report.empty()) write_report_folder(a.report, summary, a.plugin_dirs);
+  // The report after what is printed: one that cannot be written loses none of it.
   if (a.json) {
     print_checked_json(std::cout, summary, "optimize");
+    std::cout.flush();
+    if (!a.report.empty()) write_report_folder(a.report, summary, a.plugin_dirs);
     return;
   }
   std::cout << (r.feasible ? "best design" : "INFEASIBLE: least-violated design") << " of "
@@ -616,6 +619,8 @@ void run_optimize(const OptimizeArgs& a) {
   print_causes(report.failed, r.evaluations, "failed", report.failures);
   print_causes(report.impossible, r.evaluations, "were no valid shape (infeasible)",
                report.impossible_causes);
+  std::cout.flush();
+  if (!a.report.empty()) write_report_folder(a.report, summary, a.plugin_dirs);
 }
 
 }  // namespace

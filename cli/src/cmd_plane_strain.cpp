@@ -108,9 +108,11 @@ void run_plane_strain(const PlaneStrainArgs& a) {
   p.tip_angle_rad = option_quantity("--tip-angle", a.tip_angle, Dimension::Angle);
   p.friction_coefficient = a.friction;
   p.travel_m = a.travel.empty() ? depth : option_quantity("--travel", a.travel, Dimension::Length);
+  // 0 is the library's "default" (w / 4); given on the command line it would be a sharp
+  // shoulder, which is not offered (docs/model.md, "Plane-strain insertion along a cut").
   if (!a.shoulder_radius.empty())
     p.shoulder_radius_m =
-        option_quantity("--shoulder-radius", a.shoulder_radius, Dimension::Length);
+        positive_option_quantity("--shoulder-radius", a.shoulder_radius, Dimension::Length);
   if (!a.element_size.empty())
     p.element_size_m =
         positive_option_quantity("--element-size", a.element_size, Dimension::Length);

@@ -183,6 +183,8 @@ ScreenSetup prepare_screen(const ScreenArgs& args, bool writer) {
       append_provenance_line(args.out);
     }
   }
+  // Checked before any design runs (it was refused only after the whole batch).
+  if (writer && !args.report.empty()) create_output_folder(args.report, "--report");
   return s;
 }
 
@@ -218,18 +220,19 @@ void run_screen(const ScreenArgs& args) {
   for (const std::string& w : warnings) std::cerr << "mneedle: warning: " << w << "\n";
   std::size_t failed = 0;
   for (const auto& r : rows) failed += r.ok ? 0 : 1;
-  if (args.json || !args.report.empty()) {
-    const nlohmann::json out = screening_json(rows, args.scene, options, warnings);
-    // The report first: a design that failed still leaves every finished row in it.
-    if (!args.report.empty()) write_report_folder(args.report, out, args.plugin_dirs);
-    if (args.json) std::cout << with_provenance(out).dump(2) << "\n";
-  }
-  if (!args.json) {
+  const nlohmann::json out = screening_json(rows, args.scene, options, warnings);
+  if (args.json) {
+    std::cout << with_provenance(out).dump(2) << "\n";
+  } else {
     std::string material = args.material;
     for (const auto& r : rows)
       if (r.ok && material.empty()) material = nlohmann::json::parse(r.json)["material"];
     print_table(rows, scene, material);
   }
+  // After the table (a report that cannot be written loses none of it), before the failures'
+  // error: a design that failed still leaves every finished row in the report.
+  std::cout.flush();
+  if (!args.report.empty()) write_report_folder(args.report, out, args.plugin_dirs);
   if (failed > 0)
     throw InputError("screen: " + std::to_string(failed) + " of " + std::to_string(rows.size()) +
                      " designs failed (their rows say why)");

@@ -20,6 +20,7 @@
 #include "json_output.h"
 #include "mneedle/api/simulation.h"
 #include "mneedle/base/error.h"
+#include "mneedle/base/files.h"
 #include "mneedle/base/units.h"
 #include "mneedle/design_source.h"
 #include "mneedle/fe/tissue_mesh.h"
@@ -191,6 +192,7 @@ void run(SimulateOptions o) {
   // only after every mesh of a 10 000-needle scene was made.
   const std::vector<PreparedNeedle> needles =
       prepare_needles(registry, scene, o.settings.max_needles);
+  if (!o.report.empty()) create_output_folder(o.report, "--report");  // before the run
   record_scene(scene, o.scene);
   record_plugin_meshes(scene, needles);
   for (const PreparedNeedle& n : needles) {
@@ -220,13 +222,14 @@ void run(SimulateOptions o) {
     std::cerr << "mneedle: warning: " << w << "\n";
   if (!o.plot.empty())
     plot::write_svg(o.plot, simulate_figure(result, "simulate: " + o.scene.filename().string()));
-  if (!o.report.empty()) write_report_folder(o.report, tree, o.plugin_dirs);
   if (o.json)
     std::cout << with_provenance(tree).dump(2) << "\n";
   else if (o.csv)
     print_csv(result);
   else
     print_table(result);
+  std::cout.flush();  // printed before the report: a report that cannot be written loses none
+  if (!o.report.empty()) write_report_folder(o.report, tree, o.plugin_dirs);
   if (result.stopped) {
     std::cout.flush();
     throw SolverError(result.stopped->reason);  // exit status 3, the one-line error

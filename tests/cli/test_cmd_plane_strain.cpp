@@ -105,6 +105,14 @@ TEST(CmdPlaneStrain, CohesiveOptionsWithoutToughnessAreRefused) {
   EXPECT_NE(run.err.find("need --toughness"), std::string::npos) << run.err;
 }
 
+// 0 is the library's "default" radius; on the command line it would be a sharp shoulder, which
+// is not offered (it ran with the default 2 mm, exit 0).
+TEST(CmdPlaneStrain, AZeroShoulderRadiusIsRefusedNotReplacedByTheDefault) {
+  const auto run = run_mneedle(kPaperC + " --shoulder-radius 0mm");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("--shoulder-radius 0mm: must be positive"), std::string::npos) << run.err;
+}
+
 TEST(CmdPlaneStrain, ValueWithoutUnitIsOneLineNamingTheOption) {
   const auto run = run_mneedle(
       "plane-strain --tissue 7kPa,0.475 --block 160mm,86mm --thickness 15 --needle-width 8mm "

@@ -356,6 +356,21 @@ TEST(ScreenCommand, ResultsThatCannotBeWrittenStopTheBatchAndFailIt) {
   fs::remove_all(out);
 }
 
+// A --report path that cannot be a folder is refused before any design runs (it was refused
+// after the whole batch, and the table was lost with it).
+TEST(ScreenCommand, AReportPathThatIsAFileIsRefusedBeforeAnyDesign) {
+  const fs::path file = fs::temp_directory_path() / "mneedle_screen_report_file";
+  std::ofstream(file) << "x";
+  const auto run = run_mneedle("screen '" + kRoot + "/designs/cone.stl' --scene '" + kSkin +
+                               "' --report '" + file.string() + "'");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("--report '" + file.string() + "': is a file, not a folder"),
+            std::string::npos)
+      << run.err;
+  EXPECT_EQ(run.err.find("done "), std::string::npos) << run.err;
+  fs::remove(file);
+}
+
 // docs/scene.md: every command that takes a scene checks it as `scene check` does. screen
 // replaces the scene's needles by the designs, but a scene whose own needle is wrong (a misspelled
 // plugin parameter, one without its unit) is refused with its file and line before any design

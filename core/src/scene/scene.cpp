@@ -68,8 +68,12 @@ class Table {
 
   [[noreturn]] void fail_missing(std::string_view key, std::string_view expected) const {
     // A missing key is most often a misspelt one: report the typo, it is the real mistake.
+    // Up to half the shorter name's letters (at least one, at most two) may differ: `nu` is not a
+    // misspelt `E`.
     for (const auto& [given, node] : table_) {
-      if (!known_.count(std::string(given.str())) && edit_distance(given.str(), key) < 3) {
+      const std::size_t shorter = std::min(given.str().size(), key.size());
+      const std::size_t allowed = std::clamp<std::size_t>(shorter / 2, 1, 2);
+      if (!known_.count(std::string(given.str())) && edit_distance(given.str(), key) <= allowed) {
         fail(key_path(given.str()), line_of(node),
              "unknown key (did you mean '" + std::string(key) + "'?)");
       }

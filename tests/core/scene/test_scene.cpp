@@ -472,6 +472,10 @@ TEST(SceneErrors, MissingRequiredKey) {
                {"test.toml:10:", "tissue.layers[1].name", "missing"});
   expect_error(with("model = \"linear\", E = \"1 GPa\"", "E = \"1 GPa\""),
                {"tissue.layers[0].material.model", "missing"});
+  // `nu` is two letters from `E` but no misspelling of it (it was reported as "unknown key (did
+  // you mean 'E'?)").
+  expect_error(with("E = \"1 GPa\", nu = 0.4", "nu = 0.4"),
+               {"test.toml:8:", "tissue.layers[0].material.E", "required key is missing"});
 }
 
 TEST(SceneErrors, MissingTopLevelTable) {
