@@ -12,6 +12,7 @@
 
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
+#include "mneedle/needle/mesh.h"
 #include "mneedle/needle/mesh_validation.h"
 #include "mneedle/plugin.h"
 #include "plugin_descriptor.h"
@@ -28,6 +29,25 @@ namespace mneedle {
 namespace fs = std::filesystem;
 
 namespace {
+
+// Largest needle length (m) the metre contract allows: a plugin that writes micrometres as
+// metres makes needles of hundreds of metres.
+constexpr double kLongestNeedle = 1.0;
+
+// The plugin contract's frame (docs/plugins.md): metres, the tip the lowest point at z = 0. A
+// mesh outside it was used as it came (strength read its sections from the wrong heights).
+void require_needle_frame(const TriangleMesh& mesh, const std::string& source) {
+  const BoundingBox box = bounding_box(mesh);
+  const double length = box.max[2] - box.min[2];
+  if (std::abs(box.min[2]) > 1e-9 * length)
+    throw InputError(source + ": the mesh's lowest point is at z = " +
+                     format_quantity(box.min[2], Dimension::Length) +
+                     ", not 0: the plugin contract puts the tip at the origin (docs/plugins.md)");
+  if (length > kLongestNeedle)
+    throw InputError(source + ": the needle is " + format_quantity(length, Dimension::Length) +
+                     " long: the plugin contract is metres (a length in micrometres or "
+                     "millimetres given as metres?)");
+}
 
 // Far beyond any needle mesh; guards the host against a plugin asking for absurd buffers.
 constexpr std::size_t kMaxMeshElements = std::size_t{1} << 26;
@@ -193,7 +213,13 @@ struct PluginRegistry::Impl {
     const PluginShapeInfo& info = infos[index];
     std::string text = info.library.string() + ": shape '" + info.name + "' " +
                        std::string(action) + " failed (" + status_name(status) + ")";
-    if (message[0] != '\0') text += ": " + std::string(message);
+    if (message[0] != '\0') {
+      // One line, as every error (docs/cli.md, "Exit status"): line breaks become spaces.
+      std::string said(message);
+      std::replace_if(
+          said.begin(), said.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+      text += ": " + said;
+    }
     if (status == MNEEDLE_STATUS_INVALID_PARAMETER) throw InvalidShapeError(text);
     throw InputError(text);
   }
@@ -337,6 +363,7 @@ TriangleMesh PluginRegistry::generate(std::string_view shape_name,
     mesh.triangles.push_back(t);
   }
   require_valid_mesh(mesh, source);
+  require_needle_frame(mesh, source);
   return mesh;
 }
 

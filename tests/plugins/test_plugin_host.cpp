@@ -178,6 +178,23 @@ TEST(PluginHost, OpenMeshIsRejectedNamingTheFileAndTheDefect) {
   EXPECT_TRUE(contains(message, "not closed")) << message;
 }
 
+// The contract's frame (docs/plugins.md): a mesh whose tip is not at z = 0, or hundreds of
+// metres long (micrometres written as metres), was used as it came; strength read its sections
+// from the wrong heights. A message over two lines is one line.
+TEST(PluginHost, AMeshOutsideTheNeedleFrameAndAMessageOverTwoLinesAreOneLineErrors) {
+  const PluginRegistry registry = registry_with_bad_shapes();
+  const std::string lifted = input_error_of([&] { registry.generate("lifted", {}); });
+  EXPECT_TRUE(contains(lifted,
+                       "bad_shapes.so: shape 'lifted': the mesh's lowest point is at "
+                       "z = 50 um, not 0"))
+      << lifted;
+  const std::string huge = input_error_of([&] { registry.generate("micrometres", {}); });
+  EXPECT_TRUE(contains(huge, "the needle is 600 m long: the plugin contract is metres")) << huge;
+  const std::string two = input_error_of([&] { registry.generate("two_lines", {}); });
+  EXPECT_TRUE(contains(two, "line one line two")) << two;
+  EXPECT_EQ(two.find('\n'), std::string::npos) << two;
+}
+
 TEST(PluginHost, OutOfRangeVertexIndexIsRejected) {
   const PluginRegistry registry = registry_with_bad_shapes();
   const std::string message = input_error_of([&] { registry.generate("bad_index", {}); });

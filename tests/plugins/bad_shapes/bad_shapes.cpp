@@ -78,6 +78,25 @@ mneedle_status serial_only(const double* p, size_t, mneedle_mesh_sink* out, char
   return emit_tetrahedron(p[0], out, true);
 }
 
+// The tetrahedron 50 um above the origin: outside the needle frame's contract.
+mneedle_status lifted(const double* p, size_t, mneedle_mesh_sink* out, char*, size_t) {
+  const mneedle_status s = emit_tetrahedron(p[0], out, true);
+  if (s == MNEEDLE_STATUS_OK)
+    for (int v = 0; v < 4; ++v) out->vertices[3 * v + 2] += 50e-6;
+  return s;
+}
+
+// A needle given in micrometres as if they were metres: 600 "m" long.
+mneedle_status micrometres(const double*, size_t, mneedle_mesh_sink* out, char*, size_t) {
+  return emit_tetrahedron(600.0, out, true);
+}
+
+// A message over two lines.
+mneedle_status two_lines(const double*, size_t, mneedle_mesh_sink*, char* message, size_t size) {
+  write_message(message, size, "line one\nline two");
+  return MNEEDLE_STATUS_INVALID_PARAMETER;
+}
+
 mneedle_status negative_area(const double*, size_t, double, double* area, char*, size_t) {
   *area = -1;
   return MNEEDLE_STATUS_OK;
@@ -96,6 +115,9 @@ constexpr mneedle_shape kShapes[] = {
     Shape("bad_index", bad_index),
     Shape("no_mesh", no_mesh),
     Shape("serial_only", serial_only, 0),
+    Shape("lifted", lifted),
+    Shape("micrometres", micrometres),
+    Shape("two_lines", two_lines),
     {"negative_area", "test shape", kParameters, 1, 1, tetrahedron, negative_area, nullptr},
 };
 
