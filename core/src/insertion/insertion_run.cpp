@@ -860,6 +860,7 @@ std::vector<RunPoint> total_curve(const std::vector<NeedleRun>& needles) {
         sum.lateral_force_N[0] += p.lateral_force_N[0];
         sum.lateral_force_N[1] += p.lateral_force_N[1];
         sum.contact_area_m2 += p.contact_area_m2;
+        sum.section_area_m2 += p.section_area_m2;
         sum.alpha_N += p.alpha_N;
         sum.beta_N += p.beta_N;
         sum.friction_N += p.friction_N;
@@ -867,6 +868,13 @@ std::vector<RunPoint> total_curve(const std::vector<NeedleRun>& needles) {
         if (i == 0) sum.strain_energy_J = p.strain_energy_J;  // one tissue: the system's energy
       }
       sum.contact_pressure_Pa = sum.contact_area_m2 > 0.0 ? sum.force_N / sum.contact_area_m2 : 0.0;
+      // Before any puncture the sections carry the whole force (the post-puncture force is not
+      // a section's pressure: 0 there, as on each needle's own curve).
+      sum.section_pressure_Pa = sum.section_area_m2 > 0.0 && sum.alpha_N == 0.0 &&
+                                        sum.beta_N == 0.0 && sum.friction_N == 0.0 &&
+                                        sum.collar_N == 0.0
+                                    ? sum.force_N / sum.section_area_m2
+                                    : 0.0;
       total.push_back(sum);
     }
   }

@@ -976,16 +976,22 @@ TEST(Arrays, EachNeedlePuncturesOnItsOwnAndTheTotalIsTheirSum) {
   EXPECT_LT(run.needles[1].puncture->depth_m, run.needles[0].puncture->depth_m);
   int compared = 0;
   for (const RunPoint& t : run.total_curve) {
-    double sum = 0.0;
+    double sum = 0.0, sections = 0.0;
     std::size_t found = 0;
     for (const NeedleRun& n : run.needles) {
       int here = 0;
       for (const RunPoint& p : n.curve)
-        if (p.depth_m == t.depth_m) sum += (here++ == 0 ? p.force_N : 0.0);
+        if (p.depth_m == t.depth_m && here++ == 0) sum += p.force_N, sections += p.section_area_m2;
       found += here == 1 ? 1 : 0;  // a puncture depth (two points) is checked by the curve tests
     }
     if (found != run.needles.size()) continue;
     EXPECT_NEAR(t.force_N, sum, 1e-12 + 1e-9 * sum) << "at " << t.depth_m;
+    // The sections add up too (the total's were 0); before any puncture the total's section
+    // pressure is the total force over them.
+    EXPECT_NEAR(t.section_area_m2, sections, 1e-9 * sections) << "at " << t.depth_m;
+    if (t.stage == Stage::Pre && t.depth_m < run.needles[1].puncture->depth_m) {
+      EXPECT_NEAR(t.section_pressure_Pa, sum / sections, 1e-9 * sum / sections) << t.depth_m;
+    }
     ++compared;
   }
   EXPECT_GE(compared, 3);
