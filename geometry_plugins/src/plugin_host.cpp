@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <mutex>
 #include <sstream>
 #include <system_error>
@@ -58,6 +59,21 @@ struct ShapeEntry {
   std::shared_ptr<void> library;          // keeps the code of `shape` mapped
   std::shared_ptr<std::mutex> serialise;  // for shapes that are not thread safe
 };
+
+// One lock per shape in the process: two registries that load the same library (the Python
+// module keeps one per plugin folder list) reach the same code, and a shape that is not thread
+// safe must never run twice at once through either.
+std::shared_ptr<std::mutex> shape_lock(const mneedle_shape* shape) {
+  static std::mutex guard;
+  static std::map<const mneedle_shape*, std::weak_ptr<std::mutex>> locks;
+  const std::lock_guard<std::mutex> hold(guard);
+  std::shared_ptr<std::mutex> lock = locks[shape].lock();
+  if (!lock) {
+    lock = std::make_shared<std::mutex>();
+    locks[shape] = lock;
+  }
+  return lock;
+}
 
 struct HostBuffers {
   std::vector<double> vertices;
@@ -284,8 +300,7 @@ void PluginRegistry::load_library(const fs::path& library) {
                          known.library.string());
   for (std::size_t i = 0; i < infos.size(); ++i) {
     const mneedle_shape* shape = &plugin.shapes[i];
-    impl_->entries.push_back(
-        {shape, handle, shape->thread_safe ? nullptr : std::make_shared<std::mutex>()});
+    impl_->entries.push_back({shape, handle, shape->thread_safe ? nullptr : shape_lock(shape)});
     impl_->infos.push_back(std::move(infos[i]));
   }
 }

@@ -230,6 +230,20 @@ TEST(PluginHost, CallsToAShapeThatIsNotThreadSafeAreSerialised) {
   for (auto& call : calls) EXPECT_NO_THROW(call.get());
 }
 
+// Two registries of the same library (Python keeps one per plugin folder list) share the
+// shape's lock: calls through both at once were let in together.
+TEST(PluginHost, TwoRegistriesOfOneLibrarySerialiseAShapeThatIsNotThreadSafe) {
+  const PluginRegistry first = registry_with_bad_shapes();
+  const PluginRegistry second = registry_with_bad_shapes();
+  std::vector<std::future<TriangleMesh>> calls;
+  for (int i = 0; i < 8; ++i) {
+    const PluginRegistry& registry = i % 2 == 0 ? first : second;
+    calls.push_back(std::async(std::launch::async,
+                               [&registry] { return registry.generate("serial_only", {}); }));
+  }
+  for (auto& call : calls) EXPECT_NO_THROW(call.get());
+}
+
 TEST(PluginHost, OutOfBoundsParameterNamesTheParameterAndTheBound) {
   const PluginRegistry registry = PluginRegistry::discover();
   const std::string above = input_error_of([&] {
