@@ -1,6 +1,8 @@
 // `mneedle generate NAME --set key=value ... -o out.stl`: build a needle mesh with a tip-shape
 // plugin and write it as binary STL.
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
 
 #include <filesystem>
 #include <iostream>
@@ -68,6 +70,13 @@ std::map<std::string, double> parse_settings(const std::vector<std::string>& set
 }
 
 void run_generate(const GenerateOptions& options) {
+  // The file is always binary STL: another extension would be read as its own format later.
+  std::string extension = options.output.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (extension != ".stl")
+    throw InputError("-o '" + options.output.string() +
+                     "': generate writes binary STL; name the file *.stl");
   const double metres_per_unit = option_length_unit(options.unit);
   const PluginRegistry registry = PluginRegistry::discover(options.plugin_dirs);
   const PluginShapeInfo& shape = registry.shape(options.name);

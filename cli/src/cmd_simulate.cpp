@@ -52,6 +52,11 @@ struct SimulateOptions {
 
 InsertionRunOptions run_options(const Scene& scene, const SimulateOptions& o) {
   InsertionRunOptions r = simulate_run_options(scene, o.settings);
+  // The closed form has no field to write (it made an empty folder and said nothing).
+  if (!o.vtu.empty() && o.settings.model == "analytic")
+    throw InputError(
+        "--vtu: the analytic model has no field to write; use --model "
+        "axisymmetric or 3d");
   r.vtu_directory = o.vtu;
   if (r.vtu_directory.empty() && scene.model.wants(Output::Fields)) {
     // The scene asks for fields: write them beside the working directory, named after it.

@@ -85,7 +85,7 @@ int segment_count(double value) {
   if (!std::isfinite(value) || value != std::floor(value) || value < 3) {
     // The range (each shape's declared minimum, 8 for the built-in ones) is the host's check.
     char got[32];
-    std::snprintf(got, sizeof got, "%g", value);
+    std::snprintf(got, sizeof got, "%.17g", value);
     throw ParameterError(std::string("resolution must be a whole number of segments, got ") + got);
   }
   return static_cast<int>(value);

@@ -310,6 +310,7 @@ TEST(ErrorPaths, EveryBadInputGivesOneClearLineAndNoInternalText) {
       {"generate: -o is a directory", "generate cone -o {D}/folder", 1},
       {"generate: -o in a missing folder", "generate cone -o {D}/missing_dir/out.stl", 1},
       {"generate: no -o", "generate cone", 2},
+      {"generate: -o not an STL name", "generate cone -o {D}/out.obj", 1},
       {"inspect: missing file", "inspect {D}/missing.stl", 1},
       {"inspect: a directory", "inspect {D}/folder", 1},
       {"inspect: empty STL", "inspect {D}/empty.stl", 1},

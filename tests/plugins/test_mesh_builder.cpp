@@ -54,6 +54,13 @@ TEST(ShapeKitMeshBuilder, RefusesNonFiniteCoordinates) {
 TEST(ShapeKitMeshBuilder, SegmentCountMustBeAWholeNumber) {
   EXPECT_EQ(segment_count(64), 64);
   EXPECT_THROW(segment_count(64.5), ParameterError);
+  // All the digits: a value a hair off a whole number was reported as that number ("got 64").
+  try {
+    segment_count(64.0000001);
+    ADD_FAILURE() << "64.0000001 segments accepted";
+  } catch (const ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("got 64.0000001"), std::string::npos) << e.what();
+  }
   EXPECT_THROW(segment_count(2), ParameterError);
 }
 
