@@ -1,3 +1,4 @@
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 
@@ -84,8 +85,10 @@ double MeshBuilder::signed_volume() const {
 int segment_count(double value) {
   if (!std::isfinite(value) || value != std::floor(value) || value < 3) {
     // The range (each shape's declared minimum, 8 for the built-in ones) is the host's check.
+    // The shortest text that reads back as the value: a hair off a whole number shows.
     char got[32];
-    std::snprintf(got, sizeof got, "%.17g", value);
+    const auto end = std::to_chars(got, got + sizeof got - 1, value).ptr;
+    *end = '\0';
     throw ParameterError(std::string("resolution must be a whole number of segments, got ") + got);
   }
   return static_cast<int>(value);
