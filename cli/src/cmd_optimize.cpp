@@ -616,6 +616,9 @@ void run_optimize(const OptimizeArgs& a) {
             << "\n  peak force " << format_quantity(e.peak_force_n, Dimension::Force)
             << ", strength margin " << e.margin << " (safety factor " << e.safety_factor << ")\n"
             << "  optimum " << optimum_text(report, on_shape_limit(report, shape, vars)) << "\n";
+  // Why a design scores as it does (a puncture at first contact scores as none: docs/cli.md,
+  // "Optimisation").
+  for (const std::string& note : e.notes) std::cout << "  note: " << note << "\n";
   print_causes(report.failed, r.evaluations, "failed", report.failures);
   print_causes(report.impossible, r.evaluations, "were no valid shape (infeasible)",
                report.impossible_causes);
