@@ -123,6 +123,30 @@ TEST(CmdCalibrate, ABareOutputFileNameBesideABareSceneNameIsWritten) {
   EXPECT_NE(read(kWork / "bare_fitted.toml").find("pressure_scale"), std::string::npos);
 }
 
+// A curve deeper than the scene's needle (2.5 mm) cannot be its insertion: the model has no
+// needle there (a liver curve in skin's scene fitted nothing, exit 0); a contact after the
+// recording leaves no sample.
+TEST(CmdCalibrate, ACurveDeeperThanTheNeedleAndAContactAfterTheRecordingAreRefused) {
+  std::string rows = "depth_mm,force_N\n";
+  for (int i = 0; i <= 30; ++i)
+    rows += std::to_string(0.1 * i) + "," + std::to_string(0.01 * i) + "\n";
+  const std::string curve = write("deep.csv", rows);
+  const std::string scene = write("deep_start.toml", silicone_scene(""));
+  const CommandRun deep = run_mneedle("calibrate '" + scene + "' --curve '" + curve +
+                                      "' --fit scale --contact-at 0mm" + plugins());
+  EXPECT_EQ(deep.exit_code, 1);
+  EXPECT_NE(deep.err.find("deep.csv reaches 3 mm below its contact, past the scene's needle "
+                          "(2.5 mm long)"),
+            std::string::npos)
+      << deep.err;
+  const CommandRun late = run_mneedle("calibrate '" + scene + "' --curve '" + curve +
+                                      "' --fit scale --contact-at 5mm" + plugins());
+  EXPECT_EQ(late.exit_code, 1);
+  EXPECT_NE(late.err.find("--contact-at 5 mm: at or after the end of the recorded travel"),
+            std::string::npos)
+      << late.err;
+}
+
 std::string punch_scene(const std::string& modulus) {
   return "[tissue]\nsize = [\"3 mm\", \"3 mm\", \"3 mm\"]\n[[tissue.layers]]\nname = "
          "\"silicone\"\nmaterial = { model = \"linear\", E = \"" +

@@ -176,7 +176,29 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
   }
   const std::vector<LayerPressure> base_q = layer_pressures(base);
 
+  if (options.contact_travel_m && !measured.depth_m.empty()) {
+    // Contact after the recorded travel leaves no sample; one long before it is caught below
+    // (its samples lie deeper than the block).
+    const double last = *std::max_element(measured.depth_m.begin(), measured.depth_m.end());
+    if (*options.contact_travel_m >= last)
+      fail("--contact-at " + format_quantity(*options.contact_travel_m, Dimension::Length) +
+           ": at or after the end of the recorded travel of " + measured.source + " (" +
+           format_quantity(last, Dimension::Length) + ")");
+  }
   const Samples all = samples_from(measured, options.contact_travel_m);
+  // A curve deeper than the scene's needle is long cannot be its insertion: the model has no
+  // needle there and fits nothing (a liver curve to 43 mm with skin's 1 mm needle fitted no
+  // constant, exit 0). A curve deeper than the block is fine: the tip leaves a thin sample.
+  if (!all.depth_m.empty()) {
+    const double deepest = *std::max_element(all.depth_m.begin(), all.depth_m.end());
+    const BoundingBox box = bounding_box(needle.mesh);
+    const double needle_length = box.max[2] - box.min[2];
+    if (deepest >= needle_length)
+      fail(measured.source + " reaches " + format_quantity(deepest, Dimension::Length) +
+           " below its contact, past the scene's needle (" +
+           format_quantity(needle_length, Dimension::Length) +
+           " long): calibrate a scene of that insertion, or cut the curve");
+  }
   std::optional<double> given_puncture_depth;
   if (options.puncture_travel_m) {
     given_puncture_depth = *options.puncture_travel_m - all.contact_travel_m;
