@@ -6,11 +6,15 @@
 #include "mneedle/api/finite_json.h"
 #include "mneedle/base/error.h"
 #include "mneedle/base/units.h"
+#include "mneedle/geometry/cross_section.h"
 #include "mneedle/strength/needle_strength.h"
 #include "mneedle/strength/section_table.h"
 
 namespace mneedle {
 namespace {
+
+// How far a plugin's section hook may differ from a slice of its mesh (relative to the larger).
+constexpr double kHookMeshTolerance = 0.2;
 
 // The plugin's analytic hook when it has one (exact, cheap); the sliced mesh otherwise.
 SectionTable section_table(const PluginRegistry& registry, const NeedleSource& needle) {
@@ -27,6 +31,20 @@ SectionTable section_table(const PluginRegistry& registry, const NeedleSource& n
     const double fibre = s->area_m2 > 0 ? 2.0 * std::sqrt(s->i_min_m4 / s->area_m2) : 0.0;
     return SectionProperties{s->area_m2, s->i_min_m4, fibre};
   };
+  // The hook is the plugin's word for its own mesh: checked against slices of it at a few
+  // heights, so that a hook that is wrong (a unit slip, another shape's formula) is named rather
+  // than trusted (it gave a capacity 1000 times too large). kHookMeshTolerance: the coarsest
+  // mesh a plugin may make (8 segments) holds 10 % less than its circle.
+  const CrossSectionSlicer slicer(needle.mesh);
+  for (const double share : {0.25, 0.5, 0.75, 0.999}) {
+    const double h = share * length;
+    const double hook = exact(h).area_m2, mesh = slicer.slice(h).area_m2;
+    if (std::abs(hook - mesh) > kHookMeshTolerance * std::max(hook, mesh))
+      throw InputError(needle.name + ": the plugin's section hook gives " + std::to_string(hook) +
+                       " m^2 at " + format_quantity(h, Dimension::Length) +
+                       " above the tip, its mesh " + std::to_string(mesh) +
+                       " m^2: the hook does not describe the shape");
+  }
   return SectionTable::from_profile(std::move(exact), length, samples);
 }
 

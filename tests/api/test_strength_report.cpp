@@ -45,6 +45,27 @@ TEST(StrengthReport, PluginSectionsAndTheSlicedMeshAgree) {
   EXPECT_LT(b, a);  // an inscribed polygon is thinner than its circle
 }
 
+// A plugin's hook that does not describe its own mesh (here: the 200 um cone's hook over a
+// 300 um cone's mesh, 2.25 times its area) is named, not trusted: a plugin whose hook had a
+// unit slip gave a capacity 1000 times too large, exit 0.
+TEST(StrengthReport, AHookThatDisagreesWithItsMeshIsRefused) {
+  const PluginRegistry registry = PluginRegistry::discover({});
+  NeedleSource needle = cone(registry);
+  needle.mesh = needle_from_plugin(registry, "cone",
+                                   parse_parameter_settings(registry.shape("cone"),
+                                                            {"diameter=300um", "length=600um"}))
+                    .mesh;
+  StrengthSettings s;
+  s.material = "pla";
+  try {
+    strength_report(registry, needle, s);
+    ADD_FAILURE() << "a hook 2.25 times off its mesh was trusted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("the hook does not describe the shape"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(StrengthReport, BadSettingsAreInputErrors) {
   const PluginRegistry registry = PluginRegistry::discover({});
   const NeedleSource needle = cone(registry);
