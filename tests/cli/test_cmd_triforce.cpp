@@ -123,6 +123,9 @@ TEST(CmdTriforce, AnglesOutsideTheQuarterTurnMissingParametersAndFixFreeClashesA
   refused("fit '" + file + "' --fix beta=0 --free beta", "--fix beta: also given to --free");
   refused("fit '" + file + "' --fix beta=0 --fix beta=1", "--fix beta: given twice");
   refused("fit '" + file + "' --fix K0_N=2", "--fix K0_N: \"2\" needs a unit");
+  // Bounded work (50 detected layers ran over 90 s); 0 starts ran as 1.
+  refused("fit '" + file + "' --starts 0", "--starts 0: must be 1 to 1000");
+  refused("fit '" + file + "' --detect-layers 50", "--detect-layers 50: must be at most 10");
 }
 
 // A sample that steps back 5 mm in the middle of the loading branch is merged into the one it
