@@ -220,6 +220,17 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
     }
     used.push_back(i);
   }
+  // Each evaluation runs the post-puncture loads at every sample (about 7 ms each): a recording
+  // of 10^5 samples took minutes per iteration. Every k-th is kept, evenly over the curve, so
+  // that at most options.max_samples are modelled (a recording that fine is smooth at that
+  // spacing; the liver curve's 140 are all kept).
+  if (options.max_samples > 0 && used.size() > options.max_samples) {
+    const std::size_t stride = (used.size() + options.max_samples - 1) / options.max_samples;
+    std::vector<std::size_t> kept;
+    for (std::size_t k = 0; k < used.size(); k += stride) kept.push_back(used[k]);
+    if (kept.back() != used.back()) kept.push_back(used.back());
+    used = std::move(kept);
+  }
   if (used.size() < options.fit.size() + 2) {
     fail(measured.source + ": " + std::to_string(used.size()) + " samples for " +
          std::to_string(options.fit.size()) + " constants");

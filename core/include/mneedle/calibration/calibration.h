@@ -48,6 +48,9 @@ struct CalibrationOptions {
   /// Travel interval whose samples are fitted; the rest is held out and reported. Empty: all
   /// samples the model covers.
   std::optional<double> fit_from_travel_m, fit_to_travel_m;
+  /// Samples the model is evaluated at, at most: beyond, every k-th is kept, evenly over the
+  /// curve (each costs the post-puncture loads at its depth per evaluation).
+  std::size_t max_samples = 1000;
   InsertionRunOptions run;  ///< fidelity and model of the pre-puncture run
 };
 
