@@ -240,8 +240,10 @@ std::string row_hash(const DesignInput& d, const std::string& scene_hash,
   } catch (const std::exception&) {
     fingerprint = d.name + d.file.string();  // unreadable: evaluation reports why
   }
-  return hex(
-      fnv1a(fingerprint + "|" + scene_hash + "|" + fidelity + "|" + material + "|" + kRowVersion));
+  // The build's source revision too: a row another build computed is not this one's result
+  // (a resumed capacity of 41.18 N was ranked beside this build's 40.71 N).
+  return hex(fnv1a(fingerprint + "|" + scene_hash + "|" + fidelity + "|" + material + "|" +
+                   kRowVersion + "|" + source_revision()));
 }
 
 json percentiles_json(const Percentiles& p) {
@@ -504,11 +506,25 @@ void rebuild_csv(const fs::path& out) {
   {
     std::ofstream csv(temporary, std::ios::trunc);
     csv << csv_preamble(out);
+    // A design that failed is evaluated again on --resume (its row then follows): the table
+    // leaves its failed rows out and keeps the last row of each design.
+    std::vector<json> rows;
+    std::map<std::string, std::size_t> last;
     for (std::string line; std::getline(in, line);) {
       try {
-        csv << csv_line(json::parse(line)) << "\n";
+        rows.push_back(json::parse(line));
       } catch (const json::exception&) {
-        // a line that is not a row was not resumed either; the design is evaluated again
+        continue;  // a line that is not a row was not resumed either; the design is evaluated again
+      }
+      const std::string hash = rows.back().value("hash", "");
+      if (!hash.empty()) last[hash] = rows.size() - 1;
+    }
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const std::string hash = rows[k].value("hash", "");
+      if (!hash.empty() && (last[hash] != k || !rows[k].value("ok", false))) continue;
+      try {
+        csv << csv_line(rows[k]) << "\n";
+      } catch (const json::exception&) {
       }
     }
     csv.flush();
@@ -652,8 +668,9 @@ std::optional<std::size_t> ScreeningBatch::claim() {
       }
     }
     if (!done_.empty()) {
+      // A design that failed is evaluated again (the cause may be gone: memory, a plugin).
       const auto previous = done_.find(hashes_[i]);
-      if (previous != done_.end()) {
+      if (previous != done_.end() && previous->second.ok) {
         ScreeningRow row = previous->second;
         record(i, std::move(row));
         continue;

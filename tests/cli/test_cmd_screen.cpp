@@ -356,6 +356,31 @@ TEST(ScreenCommand, ResultsThatCannotBeWrittenStopTheBatchAndFailIt) {
   fs::remove_all(out);
 }
 
+// A design that failed (here: out of memory under MNEEDLE_MEMORY_LIMIT) is evaluated again on
+// --resume, and the table keeps its new row only (failed rows were resumed as they were, for
+// ever).
+TEST(ScreenCommand, ResumeEvaluatesAFailedDesignAgainAndTheTableKeepsItsNewRow) {
+  const fs::path out = fs::temp_directory_path() / "mneedle_screen_retry";
+  fs::remove_all(out);
+  const std::string args = "screen '" + kRoot + "/designs/cone.stl' --scene '" + kSkin +
+                           "' --out '" + out.string() + "'";
+  const auto starved = mneedle::test::run_command("MNEEDLE_MEMORY_LIMIT='1 MB' '" +
+                                                  mneedle::test::mneedle_binary() + "' " + args);
+  EXPECT_EQ(starved.exit_code, 1) << starved.err;
+  const auto resumed = run_mneedle(args + " --resume");
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.err;
+  std::ifstream in(out / "results.csv");
+  int rows = 0, failed = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("\"cone\",", 0) != 0) continue;
+    ++rows;
+    failed += line.rfind("\"cone\",false", 0) == 0 ? 1 : 0;
+  }
+  EXPECT_EQ(rows, 1);
+  EXPECT_EQ(failed, 0);
+  fs::remove_all(out);
+}
+
 // A --report path that cannot be a folder is refused before any design runs (it was refused
 // after the whole batch, and the table was lost with it).
 TEST(ScreenCommand, AReportPathThatIsAFileIsRefusedBeforeAnyDesign) {
