@@ -58,7 +58,8 @@ class ScaledProblem {
       time_up_ = true;
       throw nlopt::forced_stop();
     }
-    if (result_.evaluations >= options_.max_evaluations) throw nlopt::forced_stop();
+    if (result_.evaluations >= std::min(options_.max_evaluations, start_limit_))
+      throw nlopt::forced_stop();
     EvaluationRecord record;
     record.values = to_si(unit);
     record.start = start_;
@@ -117,6 +118,9 @@ class ScaledProblem {
     if (caller_error_) std::rethrow_exception(caller_error_);
   }
   void set_start(int start) { start_ = start; }
+  /// Distinct designs evaluated by the end of this start, at most (its share of the budget;
+  /// NLopt's own count also counts the repeats the cache answers).
+  void set_start_limit(int limit) { start_limit_ = limit; }
 
  private:
   double penalty() const {
@@ -152,6 +156,7 @@ class ScaledProblem {
   const OptimizerOptions& options_;
   OptimizerResult& result_;
   Clock::time_point started_, last_progress_;
+  int start_limit_ = std::numeric_limits<int>::max();
   std::map<std::vector<double>, std::size_t> cache_;
   bool time_up_ = false;
   int start_ = 1;
@@ -382,11 +387,20 @@ OptimizerResult optimize_design(const std::vector<DesignVariable>& variables,
     opt.set_xtol_rel(options.relative_tolerance);
     // The budget left is shared among the starts still to run; one that converges early leaves
     // its share to the next.
-    opt.set_maxeval(std::max(1, left / static_cast<int>(points.size() - s)));
+    // Counted in distinct designs (the problem stops the start at its share); NLopt's count,
+    // which includes the repeats the cache answers, only guards against a search that repeats
+    // itself without end.
+    const int share = std::max(1, left / static_cast<int>(points.size() - s));
+    problem.set_start_limit(result.evaluations + share);
+    opt.set_maxeval(10 * share + 100);
     if (options.max_time_s > 0) opt.set_maxtime(time_left);
     problem.set_start(static_cast<int>(s) + 1);
     const int before = result.evaluations;
-    const int code = run_nlopt(opt, points[s], problem, failure);
+    int code = run_nlopt(opt, points[s], problem, failure);
+    // NLopt's own cap with the share not spent: it asked for the points it had seen, over and
+    // over (an infeasible corner), and makes no progress: not the budget.
+    if (code == NLOPT_MAXEVAL_REACHED && result.evaluations - before < share && !problem.time_up())
+      code = NLOPT_ROUNDOFF_LIMITED;
     problem.rethrow_caller_error();
     codes.push_back(code);
     result.starts.push_back(

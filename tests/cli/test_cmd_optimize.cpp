@@ -89,6 +89,19 @@ TEST(OptimizeCommand, ASceneWithoutPunctureDataOptimisesThePeakForce) {
   EXPECT_EQ(j["evaluations"].get<int>(), 3) << j.dump(2);
 }
 
+// --max-evals counts distinct designs: NLopt's own count includes the points the cache
+// answers again, and a budget of 12 stopped at 11 designs.
+TEST(OptimizeCommand, MaxEvalsIsTheNumberOfDistinctDesignsEvaluated) {
+  const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSilicone +
+                               "' --model analytic --vary bevel_angle --objective peak-force "
+                               "--max-evals 12 --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["evaluations"].get<int>(), 12);
+  EXPECT_EQ(j["history"].size(), 12u);
+  EXPECT_EQ(j["stop"], "max_evaluations");
+}
+
 TEST(OptimizeCommand, SummaryPrintsParametersInTheirUnits) {
   const auto run = run_mneedle("optimize --plugin sharp_bevel --scene '" + kSilicone +
                                "' --vary bevel_angle --bound bevel_angle=15deg:60deg"
