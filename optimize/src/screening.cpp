@@ -25,6 +25,7 @@
 #include "mneedle/design_evaluation.h"
 #include "mneedle/design_source.h"
 #include "mneedle/insertion/insertion_run.h"
+#include "mneedle/needle/mesh_io.h"
 #include "mneedle/strength/needle_material.h"
 #include "screening_batch.h"
 
@@ -542,8 +543,16 @@ void rebuild_csv(const fs::path& out) {
 std::vector<DesignInput> collect_designs(const std::vector<fs::path>& inputs,
                                          double metres_per_unit) {
   std::vector<DesignInput> out;
+  // A unit the file declares (mneedle's own STL header, `unit=um`) is its numbers' unit, as a
+  // scene's STL needle reads it; --unit is for files that say none (a 1 um file read as mm
+  // made a needle 1000 times too large).
   auto add_file = [&](const fs::path& p) {
-    out.push_back({p.stem().string(), p, metres_per_unit, std::nullopt, {}});
+    const auto declared = declared_length_unit(p);
+    out.push_back({p.stem().string(),
+                   p,
+                   declared ? length_unit_scale(*declared) : metres_per_unit,
+                   std::nullopt,
+                   {}});
   };
   for (const auto& input : inputs) {
     if (!fs::exists(input)) throw InputError(input.string() + ": no such file or folder");

@@ -381,6 +381,29 @@ TEST(ScreenCommand, ResumeEvaluatesAFailedDesignAgainAndTheTableKeepsItsNewRow) 
   fs::remove_all(out);
 }
 
+// A file that declares its unit (mneedle's STL header: `generate --unit um`) is read in it, as a
+// scene's STL needle is; it was read in --unit's mm, a needle 1000 times too large.
+TEST(ScreenCommand, AMeshFileThatDeclaresItsUnitIsReadInIt) {
+  const fs::path dir = fs::temp_directory_path() / "mneedle_screen_units";
+  fs::create_directories(dir);
+  for (const char* unit : {"um", "mm"}) {
+    const auto gen = run_mneedle("generate cone --unit " + std::string(unit) + " -o '" +
+                                 (dir / (std::string("cone_") + unit + ".stl")).string() + "'");
+    ASSERT_EQ(gen.exit_code, 0) << gen.err;
+  }
+  const auto run = run_mneedle("screen '" + (dir / "cone_um.stl").string() + "' '" +
+                               (dir / "cone_mm.stl").string() + "' --scene '" + kSkin +
+                               "' --model analytic --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto rows = nlohmann::json::parse(run.out)["designs"];
+  ASSERT_EQ(rows.size(), 2u);
+  // The same cone: the same puncture to the files' single precision.
+  const double a = rows[0]["puncture_depth_m"].get<double>();
+  const double b = rows[1]["puncture_depth_m"].get<double>();
+  EXPECT_NEAR(a / b, 1.0, 1e-5);
+  fs::remove_all(dir);
+}
+
 // A --report path that cannot be a folder is refused before any design runs (it was refused
 // after the whole batch, and the table was lost with it).
 TEST(ScreenCommand, AReportPathThatIsAFileIsRefusedBeforeAnyDesign) {
