@@ -263,16 +263,29 @@ ForceCurve read_force_curve_csv(const std::filesystem::path& file, const CurveCo
                      "depth", curve.source);
   const auto force_col =
       require_column(header, columns.force, {"force", "fz", "f"}, "force", curve.source);
-  const auto time_col = find_column(header, columns.time, {"time", "t"});
-  if (!columns.time.empty() && !time_col) {
+  const auto found_time = find_column(header, columns.time, {"time", "t"});
+  if (!columns.time.empty() && !found_time) {
     require_column(header, columns.time, {}, "time", curve.source);
   }
+  // A column found by its name alone (`time`, `time_stamp`, `t_C`) whose unit is no time is not
+  // the recording's clock: it is left unread (it blocked files whose time no command needed;
+  // one that needs the speed then asks for --speed). A column named by the caller must read.
+  const bool clock = [&] {
+    if (!found_time || !columns.time.empty()) return found_time.has_value();
+    try {
+      column_scale(header[*found_time], "", Dimension::Time, curve.source);
+      return true;
+    } catch (const InputError&) {
+      return false;
+    }
+  }();
+  const std::size_t time_index = clock ? *found_time : 0;
   const double depth_scale =
       column_scale(header[depth_col], columns.depth_unit, Dimension::Length, curve.source);
   const double force_scale =
       column_scale(header[force_col], columns.force_unit, Dimension::Force, curve.source);
   const double time_scale =
-      time_col ? column_scale(header[*time_col], "", Dimension::Time, curve.source) : 1.0;
+      clock ? column_scale(header[time_index], "", Dimension::Time, curve.source) : 1.0;
   curve.depth_column = header[depth_col];
   for (const auto& row : table.rows) {
     const auto& fields = row.fields;
@@ -281,9 +294,9 @@ ForceCurve read_force_curve_csv(const std::filesystem::path& file, const CurveCo
         parse_number(fields[depth_col], header[depth_col], curve.source, line_number, depth_scale));
     curve.force_N.push_back(
         parse_number(fields[force_col], header[force_col], curve.source, line_number, force_scale));
-    if (time_col) {
+    if (clock) {
       // Clock time (Unix seconds, 1.7e9) is a time too: only a non-finite one is refused.
-      curve.time_s.push_back(parse_number(fields[*time_col], header[*time_col], curve.source,
+      curve.time_s.push_back(parse_number(fields[time_index], header[time_index], curve.source,
                                           line_number, time_scale, false));
     }
     curve.line.push_back(line_number);

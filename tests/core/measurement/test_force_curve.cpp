@@ -60,6 +60,20 @@ TEST(ForceCurve, ReadsColumnsAndConvertsUnitsFromTheirSuffix) {
   EXPECT_EQ(c.line.front(), 2u);
 }
 
+// A column named like time whose unit is none (`time`, a temperature `t_C`) is not read as the
+// clock: the curve reads without a time (it refused the whole file, pointing at an option that
+// does not exist).
+TEST(ForceCurve, ATimeLikeColumnWithoutATimeUnitIsLeftUnread) {
+  const auto file = std::filesystem::temp_directory_path() / "mneedle_time_without_unit.csv";
+  for (const char* name : {"time", "t_C"}) {
+    std::ofstream(file) << name << ",travel_mm,fz_N\n0,0,0\n1,0.1,0.5\n2,0.2,1\n";
+    const auto c = mneedle::read_force_curve_csv(file);
+    EXPECT_EQ(c.depth_m.size(), 3u) << name;
+    EXPECT_TRUE(c.time_s.empty()) << name;
+  }
+  std::filesystem::remove(file);
+}
+
 TEST(ForceCurve, ExplicitUnitOverridesTheSuffix) {
   const mneedle::CurveColumns columns{"", "fz_N", "", "", "mN"};
   const auto c = mneedle::read_force_curve_csv(kCurves + "loading_hold_retraction.csv", columns);
