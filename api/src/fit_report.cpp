@@ -126,6 +126,9 @@ FitOutcome fit_recordings(const std::vector<std::string>& files, const FitSettin
   if (s.detect_layers > kMaxDetectedLayers)
     throw InputError("--detect-layers " + std::to_string(s.detect_layers) + ": must be at most " +
                      std::to_string(kMaxDetectedLayers));
+  if (s.layer_starts.size() + 1 > kMaxDetectedLayers)
+    throw InputError("--layer-start: " + std::to_string(s.layer_starts.size() + 1) +
+                     " layers, at most " + std::to_string(kMaxDetectedLayers));
   TriforceFitOptions options;
   options.starts = s.starts;
   for (const auto& start : s.layer_starts) {

@@ -1,6 +1,8 @@
 #include "mneedle/api/strength_report.h"
 
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <vector>
 
 #include "mneedle/api/finite_json.h"
@@ -12,6 +14,13 @@
 
 namespace mneedle {
 namespace {
+
+// An area for a message: four significant digits (a needle's section is ~1e-8 m^2).
+std::string area_text(double m2) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g m^2", m2);
+  return text;
+}
 
 // How far a plugin's section hook may differ from a slice of its mesh (relative to the larger).
 constexpr double kHookMeshTolerance = 0.2;
@@ -40,10 +49,10 @@ SectionTable section_table(const PluginRegistry& registry, const NeedleSource& n
     const double h = share * length;
     const double hook = exact(h).area_m2, mesh = slicer.slice(h).area_m2;
     if (std::abs(hook - mesh) > kHookMeshTolerance * std::max(hook, mesh))
-      throw InputError(needle.name + ": the plugin's section hook gives " + std::to_string(hook) +
-                       " m^2 at " + format_quantity(h, Dimension::Length) +
-                       " above the tip, its mesh " + std::to_string(mesh) +
-                       " m^2: the hook does not describe the shape");
+      throw InputError(needle.name + ": the plugin's section hook gives " + area_text(hook) +
+                       " at " + format_quantity(h, Dimension::Length) +
+                       " above the tip, its mesh " + area_text(mesh) +
+                       ": the hook does not describe the shape");
   }
   return SectionTable::from_profile(std::move(exact), length, samples);
 }

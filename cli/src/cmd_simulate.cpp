@@ -58,7 +58,10 @@ InsertionRunOptions run_options(const Scene& scene, const SimulateOptions& o) {
         "--vtu: the analytic model has no field to write; use --model "
         "axisymmetric or 3d");
   r.vtu_directory = o.vtu;
-  if (r.vtu_directory.empty() && scene.model.wants(Output::Fields)) {
+  if (r.vtu_directory.empty() && scene.model.wants(Output::Fields) &&
+      o.settings.model == "analytic") {
+    std::cerr << "mneedle: the scene asks for fields; the analytic model has none to write\n";
+  } else if (r.vtu_directory.empty() && scene.model.wants(Output::Fields)) {
     // The scene asks for fields: write them beside the working directory, named after it.
     r.vtu_directory = o.scene.stem().string() + "_fields";
     std::cerr << "mneedle: the scene asks for fields: writing VTU files to " << r.vtu_directory

@@ -668,20 +668,20 @@ std::optional<std::size_t> ScreeningBatch::claim() {
   std::lock_guard<std::mutex> lock(claim_mutex_);
   while (next_ < designs_.size()) {
     const std::size_t i = next_++;
-    {
-      // Out of room for results: what is evaluated now would be lost, so nothing more is.
-      std::lock_guard<std::mutex> record_lock(record_mutex_);
-      if (!write_error_.empty()) {
-        rows_[i] = error_row(designs_[i], "not evaluated: " + write_error_);
-        continue;
-      }
-    }
     if (!done_.empty()) {
       // A design that failed is evaluated again (the cause may be gone: memory, a plugin).
       const auto previous = done_.find(hashes_[i]);
       if (previous != done_.end() && previous->second.ok) {
         ScreeningRow row = previous->second;
         record(i, std::move(row));
+        continue;
+      }
+    }
+    {
+      // Out of room for results: what is evaluated now would be lost, so nothing more is.
+      std::lock_guard<std::mutex> record_lock(record_mutex_);
+      if (!write_error_.empty()) {
+        rows_[i] = error_row(designs_[i], "not evaluated: " + write_error_);
         continue;
       }
     }

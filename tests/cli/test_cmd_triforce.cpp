@@ -126,6 +126,9 @@ TEST(CmdTriforce, AnglesOutsideTheQuarterTurnMissingParametersAndFixFreeClashesA
   // Bounded work (50 detected layers ran over 90 s); 0 starts ran as 1.
   refused("fit '" + file + "' --starts 0", "--starts 0: must be 1 to 1000");
   refused("fit '" + file + "' --detect-layers 50", "--detect-layers 50: must be at most 10");
+  std::string starts;
+  for (int i = 1; i <= 10; ++i) starts += " --layer-start " + std::to_string(i) + "mm";
+  refused("fit '" + file + "'" + starts, "--layer-start: 11 layers, at most 10");
 }
 
 // A sample that steps back 5 mm in the middle of the loading branch is merged into the one it

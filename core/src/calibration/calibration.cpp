@@ -224,8 +224,10 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
   // of 10^5 samples took minutes per iteration. Every k-th is kept, evenly over the curve, so
   // that at most options.max_samples are modelled (a recording that fine is smooth at that
   // spacing; the liver curve's 140 are all kept).
-  if (options.max_samples > 0 && used.size() > options.max_samples) {
-    const std::size_t stride = (used.size() + options.max_samples - 1) / options.max_samples;
+  if (options.max_samples > 1 && used.size() > options.max_samples) {
+    // The first, every stride-th and the last: at most max_samples with the last included.
+    const std::size_t stride =
+        (used.size() - 1 + options.max_samples - 2) / (options.max_samples - 1);
     std::vector<std::size_t> kept;
     for (std::size_t k = 0; k < used.size(); k += stride) kept.push_back(used[k]);
     if (kept.back() != used.back()) kept.push_back(used.back());

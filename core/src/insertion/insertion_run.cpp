@@ -833,6 +833,11 @@ RunPoint curve_at(const std::vector<RunPoint>& curve, double depth, bool after) 
       r.beta_N = mix(before.beta_N, p.beta_N);
       r.friction_N = mix(before.friction_N, p.friction_N);
       r.collar_N = mix(before.collar_N, p.collar_N);
+      // The section too (an array's total sums it): within one stage, between the points.
+      if (i > 0 && before.stage == p.stage && p.stage == Stage::Pre) {
+        r.section_area_m2 = mix(before.section_area_m2, p.section_area_m2);
+        r.section_pressure_Pa = pressure_over(r.force_N, r.section_area_m2);
+      }
       return r;
     }
     before = p;

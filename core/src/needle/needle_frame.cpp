@@ -213,7 +213,7 @@ std::optional<Vector3d> side_face_axis(const TriangleMesh& mesh, const Vector3d&
 
 // When the faces within kSideFaceSlope of parallel to the principal axis hold more than the
 // shaft, their normals span no plane and side_face_axis finds none: a long bevel (17 deg and
-// less) tilts the principal axis by 6 deg, within which its face then counts as a side. The
+// less) tilts the principal axis by 6.5 deg, within which its face then counts as a side. The
 // shaft's faces lie on one plane of normals, the bevel's off it: drop the faces furthest off the
 // current estimate's plane (beyond half the furthest) and estimate again, while the faces kept
 // are still kTrimmedShaftShare of the first set's area (a 15 deg bevel's shaft holds 32 % of it,
