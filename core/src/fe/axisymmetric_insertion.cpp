@@ -277,7 +277,7 @@ class CondensedSurface {
     std::vector<Eigen::Index> free, fixed;
     partition(mesh, state, depth, u, free, fixed);
     if (!free.empty() && !closed.empty()) {
-      solve_closed(free, fixed, closed, u);  // no springs: pairs in contact or cohesive, not both
+      solve_closed(S, free, fixed, closed, u);
     } else if (!free.empty()) {
       Eigen::MatrixXd S_ff(free.size(), free.size());
       Eigen::VectorXd rhs = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(free.size()));
@@ -315,7 +315,8 @@ class CondensedSurface {
   // The free part of solve() with zero-gap pairs: the saddle-point system
   // [S_ff G_fᵀ; G_f 0] [u_f; μ] = [-S_fc u_c; -G_c u_c], solved by full-pivoting LU (small and
   // indefinite).
-  void solve_closed(const std::vector<Eigen::Index>& free, const std::vector<Eigen::Index>& fixed,
+  void solve_closed(const Eigen::MatrixXd& S, const std::vector<Eigen::Index>& free,
+                    const std::vector<Eigen::Index>& fixed,
                     const std::vector<std::array<int, 2>>& closed, Eigen::VectorXd& u) const {
     const auto nf = static_cast<Eigen::Index>(free.size());
     const auto k = static_cast<Eigen::Index>(closed.size());
@@ -324,8 +325,8 @@ class CondensedSurface {
     Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(nf + k, nf + k);
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nf + k);
     for (Eigen::Index a = 0; a < nf; ++a) {
-      for (Eigen::Index b = 0; b < nf; ++b) kkt(a, b) = S_(free[a], free[b]);
-      for (Eigen::Index c : fixed) rhs[a] -= S_(free[a], c) * u[c];
+      for (Eigen::Index b = 0; b < nf; ++b) kkt(a, b) = S(free[a], free[b]);
+      for (Eigen::Index c : fixed) rhs[a] -= S(free[a], c) * u[c];
     }
     for (Eigen::Index p = 0; p < k; ++p) {
       const std::array<int, 2>& dofs = closed[static_cast<std::size_t>(p)];
@@ -688,7 +689,8 @@ class NonlinearStepper : public Stepper {
 struct CohesiveRing {
   CohesiveLaw law;
   std::vector<double> area_m2, depth_m, reached_m;
-  double line_depth_m = 0.0;  // the crack line's end (the shared front node)
+  double line_depth_m = 0.0;       // the crack line's end (the shared front node)
+  std::vector<std::size_t> order;  // the pairs down the line: corner, mid, corner, ...
 };
 
 // Shares of the line r = radius, 0 >= z > -depth: the line is a column of quadratic edges whose
@@ -721,6 +723,7 @@ CohesiveRing cohesive_ring(const AxisymmetricMesh& mesh, const FacePairs& pairs,
     if (k + 2 < pairs.size()) ring.area_m2[order[k + 2]] += circumference * edge / 6.0;
   }
   for (std::size_t k = 0; k < pairs.size(); ++k) ring.depth_m[order[k]] = z[k];
+  ring.order = std::move(order);
   return ring;
 }
 
@@ -977,24 +980,32 @@ class LinearStepper : public Stepper {
     return false;
   }
 
-  // The crack's extent, process zone and dissipated energy at the committed damage.
+  // The crack's extent, process zone and dissipated energy at the committed damage. The line's
+  // edges (corner, mid, corner) are the cells: an edge with a damaged node is in the damaged
+  // zone, which reaches its lower end; one with a damaged node that has not failed is in the
+  // process zone.
   void describe_cohesive(InsertionStep& step) {
     const CohesiveRing& ring = *cohesive_;
+    std::vector<double> damage(pairs_.size());
     for (std::size_t p = 0; p < pairs_.size(); ++p) {
-      const double damage = cohesive_damage(ring.law, ring.reached_m[p]);
+      damage[p] = cohesive_damage(ring.law, ring.reached_m[p]);
       step.fracture_energy_J +=
           ring.area_m2[p] * cohesive_dissipated_energy(ring.law, ring.reached_m[p]);
-      if (damage >= 1.0) step.cohesive_crack_m = std::max(step.cohesive_crack_m, ring.depth_m[p]);
-      if (damage > 0.0) step.cohesive_zone_m = std::max(step.cohesive_zone_m, ring.depth_m[p]);
+      if (damage[p] >= 1.0)
+        step.cohesive_crack_m = std::max(step.cohesive_crack_m, ring.depth_m[p]);
     }
-    // Process-zone cells: edges (two mid-edge spacings) between the failed crack and the
-    // damaged zone's end.
-    for (std::size_t p = 0; p < pairs_.size(); ++p) {
-      const double damage = cohesive_damage(ring.law, ring.reached_m[p]);
-      if (damage > 0.0 && damage < 1.0 && ring.depth_m[p] > step.cohesive_crack_m)
-        ++step.process_zone_cells;
+    const std::size_t nodes = ring.order.size();
+    for (std::size_t k = 0; k + 1 < nodes; k += 2) {
+      bool damaged = false, softening = false;
+      for (std::size_t j = k; j <= std::min(k + 2, nodes - 1); ++j) {
+        const double d = damage[ring.order[j]];
+        damaged = damaged || d > 0.0;
+        softening = softening || (d > 0.0 && d < 1.0);
+      }
+      const double lower = k + 2 < nodes ? ring.depth_m[ring.order[k + 2]] : ring.line_depth_m;
+      if (damaged) step.cohesive_zone_m = std::max(step.cohesive_zone_m, lower);
+      if (softening) ++step.process_zone_cells;
     }
-    step.process_zone_cells /= 2;
     step.cohesive_rounds = rounds_;
     rounds_ = 0;
   }

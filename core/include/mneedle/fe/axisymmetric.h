@@ -226,10 +226,11 @@ struct InsertionStep {
   double crack_face_overlap_m = 0.0;
   int crack_face_contacts = 0;
   /// The cohesive ring crack (cohesive_depth_m > 0; docs/model.md, "Cohesive ring crack"):
-  /// depth below the surface of its deepest failed face pair (damage 1) and of its deepest
-  /// damaged one (m, reference), the cells of the process zone between them (edges of the
-  /// crack line with a damaged but unfailed end), the energy its law has dissipated (J, the
-  /// whole ring) and the damage rounds solved since the previous output.
+  /// depth below the surface of its deepest failed face pair (damage 1) and the lower end of
+  /// its deepest damaged cell (an edge of the crack line with a damaged node; m, reference),
+  /// the cells of the process zone (edges with a damaged node that has not failed), the energy
+  /// its law has dissipated (J, the whole ring) and the damage rounds solved since the previous
+  /// output.
   double cohesive_crack_m = 0.0;
   double cohesive_zone_m = 0.0;
   int process_zone_cells = 0;
