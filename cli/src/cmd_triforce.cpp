@@ -368,6 +368,10 @@ struct StatsArgs {
 };
 
 void run_stats(const StatsArgs& args) {
+  // Checked before the file is read (1e-300 ended in the range quantile's own error).
+  if (!(args.alpha >= 1e-6 && args.alpha <= 0.5))
+    throw InputError("--alpha " + (std::ostringstream() << args.alpha).str() +
+                     ": must be in [1e-6, 0.5]");
   std::vector<std::string> labels;
   std::vector<double> values;
   read_grouped_csv(args.file, args.value, args.group, labels, values);
@@ -508,6 +512,7 @@ void add_stats_command(CLI::App& app) {
   cmd->add_option("--alpha", args->alpha, "Family-wise significance level")->capture_default_str();
   cmd->add_option("--max-groups", args->max_groups,
                   "Most groups to compare (every pair is a row of the Tukey table)")
+      ->check(CLI::Range(std::size_t{2}, std::size_t{1000000}))
       ->capture_default_str();
   cmd->add_flag("--json", args->json, "Print JSON");
   cmd->callback([args] { run_stats(*args); });

@@ -155,6 +155,23 @@ TEST(CmdTriforce, FitMergesASampleThatStepsBackAndSaysSo) {
   EXPECT_NE(b.out.find("1 samples stepping back"), std::string::npos) << b.out;
 }
 
+// A blank group name and a significance level outside [1e-6, 0.5] are refused with one line
+// (a group called "" was compared; 1e-300 ended in the range quantile's own error).
+TEST(CmdTriforce, StatsRefusesABlankGroupAndAnAlphaOutOfRange) {
+  std::filesystem::create_directories(kWork);
+  const auto blank = kWork / "blank_group.csv";
+  std::ofstream(blank) << "group,value\na,1\n,2\nb,3\nb,4\n";
+  const CommandRun run = run_mneedle("stats '" + blank.string() + "'");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("blank_group.csv:3: column 'group': no group name"), std::string::npos)
+      << run.err;
+  const auto good = kWork / "two_groups.csv";
+  std::ofstream(good) << "group,value\na,1\na,2\nb,3\nb,4.5\n";
+  const CommandRun tiny = run_mneedle("stats '" + good.string() + "' --alpha 1e-300");
+  EXPECT_EQ(tiny.exit_code, 1);
+  EXPECT_NE(tiny.err.find("--alpha 1e-300: must be in [1e-6, 0.5]"), std::string::npos) << tiny.err;
+}
+
 TEST(CmdTriforce, PredictGoesInHoldsAndComesOut) {
   const auto file = write_recording();
   ASSERT_EQ(

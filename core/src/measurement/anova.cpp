@@ -366,6 +366,9 @@ void read_grouped_csv(const std::filesystem::path& file, const std::string& valu
         !std::isfinite(v)) {
       throw InputError(here + ": column '" + value_column + "': '" + text + "' is not a number");
     }
+    // A blank cell is no group's name (it became a group called "").
+    if (fields[gi].find_first_not_of(" \t") == std::string::npos)
+      throw InputError(here + ": column '" + group_column + "': no group name");
     labels.push_back(fields[gi]);
     values.push_back(v);
   }
