@@ -103,10 +103,16 @@ std::vector<DesignVariable> variables(const PluginShapeInfo& shape, const Optimi
     const auto eq = b.find('='), colon = b.find(':');
     if (eq == std::string::npos || colon == std::string::npos || colon < eq)
       throw InputError("--bound '" + b + "': expected name=low:high, e.g. bevel_angle=10deg:45deg");
-    user[b.substr(0, eq)] = {b.substr(eq + 1, colon - eq - 1), b.substr(colon + 1)};
+    // Once each: the last of two used to win in silence.
+    if (!user.emplace(b.substr(0, eq),
+                      std::pair{b.substr(eq + 1, colon - eq - 1), b.substr(colon + 1)})
+             .second)
+      throw InputError("--bound " + b.substr(0, eq) + ": given twice");
   }
   std::vector<DesignVariable> out;
   for (const auto& name : split(a.vary, ',')) {
+    if (std::any_of(out.begin(), out.end(), [&](const auto& v) { return v.name == name; }))
+      throw InputError("--vary: '" + name + "' given twice");
     const auto it = std::find_if(shape.parameters.begin(), shape.parameters.end(),
                                  [&](const PluginParameter& p) { return p.name == name; });
     if (it == shape.parameters.end())

@@ -370,7 +370,9 @@ struct StatsArgs {
 void run_stats(const StatsArgs& args) {
   // Checked before the file is read (1e-300 ended in the range quantile's own error).
   if (!(args.alpha >= 1e-6 && args.alpha <= 0.5))
-    throw InputError("--alpha " + (std::ostringstream() << args.alpha).str() +
+    throw InputError("--alpha " +
+                     (std::isfinite(args.alpha) ? (std::ostringstream() << args.alpha).str()
+                                                : std::string("not a number")) +
                      ": must be in [1e-6, 0.5]");
   std::vector<std::string> labels;
   std::vector<double> values;

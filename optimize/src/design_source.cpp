@@ -47,6 +47,7 @@ std::map<std::string, double> parse_parameter_settings(const PluginShapeInfo& sh
       throw InputError("--set '" + setting + "': expected key=value, e.g. diameter=230um");
     const std::string key = setting.substr(0, eq);
     const PluginParameter& p = find_parameter(shape, key);
+    if (si.count(key) != 0) throw InputError("--set " + key + ": given twice");  // not the last
     try {
       si[key] = parse_quantity(setting.substr(eq + 1), parameter_dimension(p));
     } catch (const InputError& e) {

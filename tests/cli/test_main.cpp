@@ -432,6 +432,16 @@ TEST(ErrorPaths, EveryBadInputGivesOneClearLineAndNoInternalText) {
        "optimize --plugin cone --scene {D}/good.toml --vary diameter --algorithm newton", 2},
       {"optimize: --local unknown",
        "optimize --plugin cone --scene {D}/good.toml --vary diameter --local lbfgs", 2},
+      {"optimize: --vary twice",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter,diameter", 1},
+      {"optimize: --bound twice",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --bound diameter=150um:250um "
+       "--bound diameter=160um:250um",
+       1},
+      {"optimize: --set twice",
+       "optimize --plugin cone --scene {D}/good.toml --vary diameter --set length=1mm --set "
+       "length=2mm",
+       1},
       {"optimize: --starts zero",
        "optimize --plugin cone --scene {D}/good.toml --vary diameter --starts 0", 2},
       {"optimize: --max-evals text",
