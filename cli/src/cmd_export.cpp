@@ -84,6 +84,21 @@ void run_export(const ExportArgs& a) {
   out["reaction_N"] = {e.reaction_N.x(), e.reaction_N.y(), e.reaction_N.z()};
   out["reductions"] = nlohmann::ordered_json::array();
   for (const Reduction& r : run.reductions) out["reductions"].push_back(r.name);
+  // Shallower than asked: the puncture ended the pre-puncture model first (the deck is its last
+  // step; it was written without a word).
+  const bool shallower = e.depth_m < scene.insertion.depth * (1.0 - 1e-9);
+  if (shallower) {
+    std::string why = "the pre-puncture model's last step before that depth";
+    for (const NeedleRun& n : run.needles)
+      if (n.puncture && n.puncture->depth_m <= scene.insertion.depth)
+        why = "needle '" + n.name + "' punctures at " +
+              format_quantity(n.puncture->depth_m, Dimension::Length) +
+              ": the pre-puncture model stops at its step past that";
+    std::cerr << "mneedle: note: the deck is at " + format_quantity(e.depth_m, Dimension::Length) +
+                     ", not " + format_quantity(scene.insertion.depth, Dimension::Length) + ": " +
+                     why + "\n";
+  }
+  out["requested_depth_m"] = scene.insertion.depth;
   require_finite_json(out, "export");
   if (a.json) {
     print_checked_json(std::cout, out, "export");

@@ -51,6 +51,22 @@ TEST(ExportCommand, WritesTheDeckAndReportsItsReaction) {
   fs::remove_all(deck.parent_path());
 }
 
+// A --depth past the puncture: the deck is the pre-puncture model's last step and the run says
+// so (it wrote a shallower deck without a word); the JSON carries both depths.
+TEST(ExportCommand, ADeckShallowerThanAskedSaysWhy) {
+  const fs::path deck = work() / "deep.inp";
+  const std::string skin = std::string(MNEEDLE_SOURCE_ROOT) + "/designs/scenes/human_skin.toml";
+  const auto run = run_mneedle("export '" + skin + "' --format inp -o '" + deck.string() +
+                               "' --fidelity fast --depth 300um --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_NEAR(j["requested_depth_m"].get<double>(), 300e-6, 1e-18);
+  EXPECT_LT(j["depth_m"].get<double>(), 100e-6);
+  EXPECT_NE(run.err.find("not 300 um: needle 'sharp_bevel' punctures at"), std::string::npos)
+      << run.err;
+  fs::remove_all(deck.parent_path());
+}
+
 TEST(ExportCommand, NonlinearSceneIsRefusedInOneLine) {
   const fs::path dir = work();
   std::string scene = text_of(kBevel);
