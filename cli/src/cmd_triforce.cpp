@@ -282,8 +282,20 @@ void run_predict(const PredictArgs& args) {
   nlohmann::json comparison;
   if (measured) {
     const double offset = mean_fitted_offset(args.params_file);
-    const auto predicted = predict_loading(model, measured->curve, offset);
-    const auto m = compare_curves(measured->curve.force_N, predicted);
+    // The measured samples as deep as the prediction goes (--depth cut nothing of them).
+    FitCurve within = measured->curve;
+    within.depth_m.clear();
+    within.force_N.clear();
+    for (std::size_t i = 0; i < measured->curve.depth_m.size(); ++i)
+      if (measured->curve.depth_m[i] <= protocol.max_depth_m * (1.0 + 1e-12)) {
+        within.depth_m.push_back(measured->curve.depth_m[i]);
+        within.force_N.push_back(measured->curve.force_N[i]);
+      }
+    if (within.depth_m.empty())
+      throw InputError("predict: --depth " + args.depth + " lies before every sample of " +
+                       measured->curve.name);
+    const auto predicted = predict_loading(model, within, offset);
+    const auto m = compare_curves(within.force_N, predicted);
     comparison = {{"file", measured->curve.name},
                   {"rmse_N", m.rmse_N},
                   {"r2", m.r2},

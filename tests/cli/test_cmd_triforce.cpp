@@ -172,6 +172,24 @@ TEST(CmdTriforce, StatsRefusesABlankGroupAndAnAlphaOutOfRange) {
   EXPECT_NE(tiny.err.find("--alpha 1e-300: must be in [1e-6, 0.5]"), std::string::npos) << tiny.err;
 }
 
+// --compare scores the prediction that is printed: with --depth, the measured samples that deep
+// only (it compared the whole curve whatever --depth said).
+TEST(CmdTriforce, PredictCompareKeepsToTheDepthAskedFor) {
+  const std::string file = write_recording();
+  const std::filesystem::path dir = kWork / "compare_depth";
+  ASSERT_EQ(run_mneedle("fit '" + file + "' --starts 2 --out '" + dir.string() + "'").exit_code, 0);
+  const auto samples = [&](const std::string& depth) {
+    const CommandRun run = run_mneedle("predict --params '" + (dir / "fit.json").string() +
+                                       "' --compare '" + file + "'" + depth + " --json");
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    return nlohmann::json::parse(run.out)["comparison"]["samples"].get<std::size_t>();
+  };
+  const std::size_t all = samples(""), shallow = samples(" --depth 5mm");
+  // The loading branch runs about 15 mm below contact in 20 um samples: 5 mm of it is a third.
+  EXPECT_LT(shallow, all / 2);
+  EXPECT_GT(shallow, 200u);
+}
+
 TEST(CmdTriforce, PredictGoesInHoldsAndComesOut) {
   const auto file = write_recording();
   ASSERT_EQ(
