@@ -7,6 +7,7 @@
 #include "../plot/svg_reader.h"
 #include "run_mneedle.h"
 
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -174,7 +175,7 @@ TEST(CmdTriforce, StatsRefusesABlankGroupAndAnAlphaOutOfRange) {
 
 // --compare scores the prediction that is printed: with --depth, the measured samples that deep
 // only (it compared the whole curve whatever --depth said).
-TEST(CmdTriforce, PredictCompareKeepsToTheDepthAskedFor) {
+TEST(CmdTriforce, PredictCompareKeepsToTheDepthAskedForAndTheSampleLimitCountsTheRows) {
   const std::string file = write_recording();
   const std::filesystem::path dir = kWork / "compare_depth";
   ASSERT_EQ(run_mneedle("fit '" + file + "' --starts 2 --out '" + dir.string() + "'").exit_code, 0);
@@ -188,6 +189,17 @@ TEST(CmdTriforce, PredictCompareKeepsToTheDepthAskedFor) {
   // The loading branch runs about 15 mm below contact in 20 um samples: 5 mm of it is a third.
   EXPECT_LT(shallow, all / 2);
   EXPECT_GT(shallow, 200u);
+  // The sample limit counts what is written: 86 mm in and out at 1 mm/s in 0.05 s steps is
+  // 3 440 steps and the three phases' closing samples (3 440 passed, and 3 443 rows came).
+  const std::string params = "predict --params '" + (dir / "fit.json").string() +
+                             "' --depth 86mm --speed 1mm/s --csv --max-samples ";
+  const CommandRun exact = run_mneedle(params + "3443");
+  ASSERT_EQ(exact.exit_code, 0) << exact.err;
+  std::istringstream rows(exact.out);
+  int count = 0;
+  for (std::string line; std::getline(rows, line);) count += std::isdigit(line[0]) ? 1 : 0;
+  EXPECT_EQ(count, 3443);
+  EXPECT_EQ(run_mneedle(params + "3442").exit_code, 1);
 }
 
 TEST(CmdTriforce, PredictGoesInHoldsAndComesOut) {
