@@ -337,7 +337,8 @@ void run_energy(const EnergyArgs& a) {
       out["block_depth_m"] = in.block_depth_m;
       out["mean_crack_width_m"] = in.mean_crack_width_m;
       if (width->fit)
-        out["crack_width_fit"] = {{"coefficients_m", width->fit->coefficients},
+        // w(z) = c0 + c1 z + c2 z^2 in SI: c0 in m, c1 in 1, c2 in 1/m (not all metres).
+        out["crack_width_fit"] = {{"coefficients_SI", width->fit->coefficients},
                                   {"min_width_m", width->fit->min_width_m},
                                   {"max_residual_m", width->fit->max_residual_m}};
       out["strain_energy_J_per_m"] = in.strain_energy_J_per_m;
