@@ -496,6 +496,8 @@ void run_optimize(const OptimizeArgs& a) {
   o.algorithm = a.algorithm;
   o.local_algorithm = a.local;
   o.starts = a.starts;
+  if (a.max_evals < 1)
+    throw InputError("--max-evals " + std::to_string(a.max_evals) + ": must be at least 1");
   o.max_evaluations = a.max_evals;
   o.seed = a.seed;
   // Recorded only when something random runs (docs/cli.md, "Provenance": null otherwise): the
