@@ -52,6 +52,18 @@ def _list(values, what: str) -> List[str]:
         raise InputError(f"{what}: a string or a list of strings, not {type(values).__name__}")
 
 
+def _count(value, name: str, low: int, high: int) -> int:
+    """A whole number in [low, high], as the CLI's option checks; an InputError naming it
+    otherwise (pybind11's TypeError listed every argument, the whole scene among them)."""
+    try:
+        number = int(value)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"{name}: a whole number, not {value!r}") from None
+    if number != value or not low <= number <= high:
+        raise InputError(f"{name}: {value!r} is not a whole number from {low} to {high}")
+    return number
+
+
 def _plain(value, where: str):
     """Scene values as the C++ side reads them: NumPy scalars as Python numbers, paths as
     strings, tuples as lists; anything else that is no scene value is an InputError naming it."""
@@ -113,7 +125,8 @@ def simulate(
     """
     file, values, name = _scene_args(scene, source)
     result = _core.simulate(
-        file, values, name, fidelity, contact, criterion, model, axis, int(max_needles),
+        file, values, name, fidelity, contact, criterion, model, axis,
+        _count(max_needles, "max_needles", 1, 100_000),
         bool(no_reductions), _list(plugin_dirs, "plugin_dirs"), bool(keep_reached),
     )
     if result.get("stopped"):
@@ -179,7 +192,8 @@ def screen(
     A design that fails is a row with ``"ok": False`` and its error; the others still run.
     """
     result = _core.screen(
-        _list(designs, "designs"), os.fspath(scene), fidelity, model, material, int(jobs),
+        _list(designs, "designs"), os.fspath(scene), fidelity, model, material,
+        _count(jobs, "jobs", 1, 1000),
         unit, axis, bool(repair), _list(plugin_dirs, "plugin_dirs"),
     )
     for text in result.get("warnings", []):
@@ -207,7 +221,7 @@ def fit(
     return _core.fit(
         _list(files, "files"), depth_col, force_col, depth_unit, force_unit, speed, angle,
         _list(fix, "fix"), _list(free, "free"), _list(layer_starts, "layer_starts"),
-        int(detect_layers), int(starts),
+        _count(detect_layers, "detect_layers", 0, 10), _count(starts, "starts", 1, 1000),
     )
 
 

@@ -76,3 +76,15 @@ def test_fit_of_a_bad_recording_is_the_cli_error(cli, source):
         mneedle.fit([bad])
     assert str(error.value) == cli.error("fit", bad)
     assert "text_in_number.csv:" in str(error.value)
+
+
+def test_counts_out_of_range_are_input_errors_naming_the_argument(source):
+    # As the CLI's --jobs 1..1000 and --starts 1..1000; pybind11's TypeError listed every
+    # argument (the whole scene), and jobs=0 was accepted.
+    scene = source / "designs" / "scenes" / "human_skin.toml"
+    with pytest.raises(mneedle.InputError, match=r"^jobs: 0 is not a whole number from 1 to 1000"):
+        mneedle.screen(source / "designs" / "cone.stl", scene, jobs=0)
+    with pytest.raises(mneedle.InputError, match=r"^max_needles: -1 is not"):
+        mneedle.simulate(scene, max_needles=-1)
+    with pytest.raises(mneedle.InputError, match=r"^starts: 100000000000000000000 is not"):
+        mneedle.fit([], starts=10**20)
