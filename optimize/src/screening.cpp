@@ -332,6 +332,12 @@ ScreeningRow evaluate_row(const DesignInput& d, const Scene& scene, const std::s
       if (const auto key = non_finite_key(j["uncertainty"]))
         throw SolverError("non-finite value of uncertainty." + *key + " (not written)");
     }
+  } catch (const OutOfMemoryError& e) {
+    row.ok = false;
+    row.retry = true;
+    row.error = e.what();
+    j["error"] = row.error;
+    j["retry"] = true;
   } catch (const std::exception& e) {
     row.ok = false;
     row.error = e.what();
@@ -362,6 +368,7 @@ ScreeningRow row_from_json(const std::string& line) {
   row.design = j.at("design").get<std::string>();
   row.hash = j.value("hash", "");  // an error row of a design that could not be read has none
   row.ok = j.at("ok").get<bool>();
+  row.retry = j.value("retry", false);
   row.resumed = true;
   row.json = line;
   if (row.ok) {
@@ -507,8 +514,8 @@ void rebuild_csv(const fs::path& out) {
   {
     std::ofstream csv(temporary, std::ios::trunc);
     csv << csv_preamble(out);
-    // A design that failed is evaluated again on --resume (its row then follows): the table
-    // leaves its failed rows out and keeps the last row of each design.
+    // A design that failed for want of memory is evaluated again on --resume (its row then
+    // follows): the table leaves such rows out and keeps the last row of each design.
     std::vector<json> rows;
     std::map<std::string, std::size_t> last;
     for (std::string line; std::getline(in, line);) {
@@ -522,7 +529,7 @@ void rebuild_csv(const fs::path& out) {
     }
     for (std::size_t k = 0; k < rows.size(); ++k) {
       const std::string hash = rows[k].value("hash", "");
-      if (!hash.empty() && (last[hash] != k || !rows[k].value("ok", false))) continue;
+      if (!hash.empty() && (last[hash] != k || rows[k].value("retry", false))) continue;
       try {
         csv << csv_line(rows[k]) << "\n";
       } catch (const json::exception&) {
@@ -669,9 +676,9 @@ std::optional<std::size_t> ScreeningBatch::claim() {
   while (next_ < designs_.size()) {
     const std::size_t i = next_++;
     if (!done_.empty()) {
-      // A design that failed is evaluated again (the cause may be gone: memory, a plugin).
+      // A design that failed for want of memory is evaluated again (the limit may be gone).
       const auto previous = done_.find(hashes_[i]);
-      if (previous != done_.end() && previous->second.ok) {
+      if (previous != done_.end() && !previous->second.retry) {
         ScreeningRow row = previous->second;
         record(i, std::move(row));
         continue;

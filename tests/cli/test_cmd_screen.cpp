@@ -356,8 +356,8 @@ TEST(ScreenCommand, ResultsThatCannotBeWrittenStopTheBatchAndFailIt) {
   fs::remove_all(out);
 }
 
-// A design that failed (here: out of memory under MNEEDLE_MEMORY_LIMIT) is evaluated again on
-// --resume, and the table keeps its new row only (failed rows were resumed as they were, for
+// A design that failed for want of memory (under MNEEDLE_MEMORY_LIMIT) is evaluated again on
+// --resume, and the table keeps its new row only (such rows were resumed as they were, for
 // ever).
 TEST(ScreenCommand, ResumeEvaluatesAFailedDesignAgainAndTheTableKeepsItsNewRow) {
   const fs::path out = fs::temp_directory_path() / "mneedle_screen_retry";

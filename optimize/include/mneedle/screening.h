@@ -65,6 +65,9 @@ struct ScreeningRow {
   std::string hash;  // of the design's bytes, the scene's bytes, fidelity and material
   bool ok = false;
   bool resumed = false;
+  /// Failed for want of memory, not for the design: --resume evaluates it again (a design that
+  /// fails for itself, such as an open mesh, keeps its row).
+  bool retry = false;
   std::string error;
   std::string json;
   std::optional<double> puncture_depth_m;  // empty: no puncture up to the target depth
