@@ -15,6 +15,15 @@
 namespace mneedle {
 namespace {
 
+// --depth (the CLI's name; Python's `depth`) with its name in a unit error.
+double depth_quantity(const std::string& text) {
+  try {
+    return parse_quantity(text, Dimension::Length);
+  } catch (const InputError& e) {
+    throw InputError(std::string("--depth: ") + e.what());
+  }
+}
+
 // An area for a message: four significant digits (a needle's section is ~1e-8 m^2).
 std::string area_text(double m2) {
   char text[32];
@@ -69,9 +78,8 @@ nlohmann::json strength_report(const PluginRegistry& registry, const NeedleSourc
   options.length_m = table.length_m();
   options.end = parse_end_condition(settings.end);
   options.lateral_ratio = settings.lateral_ratio;
-  options.load_height_m = settings.depth.empty()
-                              ? table.tip_length_m()
-                              : parse_quantity(settings.depth, Dimension::Length);
+  options.load_height_m =
+      settings.depth.empty() ? table.tip_length_m() : depth_quantity(settings.depth);
   const StrengthReport r = needle_strength(table.profile(), material, options);
 
   const nlohmann::json out = {{"needle", needle.name},

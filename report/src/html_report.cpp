@@ -542,6 +542,9 @@ std::string html_report(const ReportInput& in) {
 }
 
 void write_report(const std::filesystem::path& file, const ReportInput& input) {
+  std::error_code kind;
+  if (std::filesystem::is_directory(file, kind))
+    throw InputError(file.string() + ": is a folder, not a file (name the report's .html file)");
   const std::string page = html_report(input);
   const auto tmp = std::filesystem::path(file.string() + ".tmp");
   {
@@ -557,8 +560,9 @@ void write_report(const std::filesystem::path& file, const ReportInput& input) {
   std::error_code ec;
   std::filesystem::rename(tmp, file, ec);
   if (ec) {
+    const std::string why = ec.message();  // before remove() overwrites ec ("Success")
     std::filesystem::remove(tmp, ec);
-    throw InputError(file.string() + ": cannot write the report (" + ec.message() + ")");
+    throw InputError(file.string() + ": cannot write the report (" + why + ")");
   }
 }
 

@@ -75,8 +75,13 @@ TEST(StrengthReport, BadSettingsAreInputErrors) {
   s.lateral_ratio = -1.0;
   EXPECT_THROW(strength_report(registry, needle, s), InputError);
   s.lateral_ratio = 0.0;
-  s.depth = "300";  // no unit
-  EXPECT_THROW(strength_report(registry, needle, s), InputError);
+  s.depth = "300";  // no unit: named as the option it came from
+  try {
+    strength_report(registry, needle, s);
+    ADD_FAILURE() << "a depth without a unit was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("--depth: \"300\" needs a unit", 0), 0u) << e.what();
+  }
   s.depth = "";
   s.end = "glued";
   EXPECT_THROW(strength_report(registry, needle, s), InputError);

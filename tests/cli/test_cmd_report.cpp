@@ -124,6 +124,24 @@ TEST(ReportCommand, ResultThatIsNotJsonOrNotAResultIsOneLineNamingTheFile) {
   fs::remove_all(dir);
 }
 
+// -o naming a folder: one line saying so (it said "cannot write the report (Success)", the
+// error code read after the clean-up had reset it).
+TEST(ReportCommand, AnOutputThatIsAFolderIsNamedAsOne) {
+  const fs::path dir = work("folder");
+  const auto sim = run_mneedle("simulate '" + std::string(MNEEDLE_SOURCE_ROOT) +
+                               "/designs/scenes/silicone_phantom.toml' --model analytic --json");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  std::ofstream(dir / "result.json") << sim.out;
+  fs::create_directories(dir / "out");
+  const auto run = run_mneedle("report '" + (dir / "result.json").string() + "' -o '" +
+                               (dir / "out").string() + "'");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find((dir / "out").string() + ": is a folder, not a file"), std::string::npos)
+      << run.err;
+  EXPECT_EQ(run.err.find("Success"), std::string::npos) << run.err;
+  fs::remove_all(dir);
+}
+
 TEST(ReportCommand, OptimizeReportShowsTheHistoryAndTheBestDesign) {
   const fs::path dir = work("optimize");
   const auto run = run_mneedle(

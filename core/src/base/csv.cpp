@@ -2,6 +2,8 @@
 
 #include <fstream>
 #include <iterator>
+#include <set>
+#include <string_view>
 
 #include "mneedle/base/error.h"
 #include "mneedle/base/files.h"
@@ -112,6 +114,12 @@ CsvTable parse_csv(std::string_view text, std::string source) {
     const std::size_t record_line = line;
     auto fields = read_record(text, pos, line, table.source);
     if (table.header.empty()) {
+      // A name twice is two columns a reader cannot tell apart (the first was taken).
+      std::set<std::string_view> names;
+      for (const std::string& name : fields)
+        if (!name.empty() && !names.insert(name).second)
+          throw InputError(table.source + ":" + std::to_string(record_line) + ": column '" + name +
+                           "' appears twice in the header");
       table.header = std::move(fields);
       table.header_line = record_line;
       continue;

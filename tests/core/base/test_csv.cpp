@@ -18,6 +18,12 @@ std::string message_of(const std::string& text) {
   return "no error";
 }
 
+// Two columns of one name cannot be told apart (every reader took the first).
+TEST(Csv, AColumnNameTwiceInTheHeaderIsNamedWithItsLine) {
+  EXPECT_EQ(message_of("travel_mm,force_N,force_N\n1,2,3\n"),
+            "t.csv:1: column 'force_N' appears twice in the header");
+}
+
 TEST(Csv, QuotedFieldKeepsItsCommaAsOneField) {
   const auto t = parse_csv("value,group\n1,\"g,1\"\n", "t.csv");
   ASSERT_EQ(t.rows.size(), 1u);
