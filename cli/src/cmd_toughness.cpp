@@ -73,6 +73,9 @@ std::string format_toughness(double j) {
 CrackAreaChoice crack_area(const ToughnessArgs& a, double end_depth_m) {
   const int given = !a.area.empty() + !a.needle.empty() + !a.plugin.empty();
   if (given != 1) throw InputError("toughness: give exactly one of --area, --needle or --plugin");
+  // Options of another crack-area source would be ignored in silence.
+  if (!a.settings.empty() && a.plugin.empty())
+    throw InputError("toughness: --set needs --plugin (it sets the plugin's parameters)");
   CrackAreaChoice out;
   if (!a.area.empty()) {
     try {

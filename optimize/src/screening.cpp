@@ -645,7 +645,9 @@ ScreeningBatch::ScreeningBatch(const std::vector<DesignInput>& designs, const Sc
   const bool fresh_csv = !fs::exists(out / "results.csv");
   jsonl_.open(out / "results.jsonl", std::ios::app);
   csv_.open(out / "results.csv", std::ios::app);
-  if (!jsonl_ || !csv_) throw InputError(out.string() + ": cannot write results");
+  // Name the file that cannot be opened (a folder of its name, no permission).
+  if (!jsonl_) throw InputError((out / "results.jsonl").string() + ": cannot write results");
+  if (!csv_) throw InputError((out / "results.csv").string() + ": cannot write results");
   if (fresh_csv) csv_ << csv_preamble(out) << std::flush;
 }
 

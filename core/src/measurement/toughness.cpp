@@ -208,6 +208,7 @@ double parse_area_m2(std::string_view text) {
       char* unit_start = nullptr;
       const double number = std::strtod(t.c_str(), &unit_start);
       if (unit_start == t.c_str()) throw fail("no number");
+      if (!std::isfinite(number)) throw fail("not a finite number");  // 1e400: beyond a double
       const double metres = parse_quantity("1 " + std::string(unit_start), Dimension::Length);
       value = number * metres * metres;
     } else {

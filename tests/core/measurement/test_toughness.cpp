@@ -254,6 +254,9 @@ TEST(Toughness, AreaTextTakesASquaredLengthUnit) {
     const auto msg = error_of([bad] { mneedle::parse_area_m2(bad); });
     EXPECT_NE(msg.find("area '" + std::string(bad) + "'"), std::string::npos) << msg;
   }
+  // Beyond a double: said so (it said "must be positive").
+  EXPECT_NE(error_of([] { mneedle::parse_area_m2("1e400mm^2"); }).find("not a finite number"),
+            std::string::npos);
 }
 
 // A bare number would be m^2 (0.0415 read so is 10^6 times the 0.0415 mm^2 meant, and J 10^6
