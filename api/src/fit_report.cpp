@@ -126,8 +126,11 @@ FitOutcome fit_recordings(const std::vector<std::string>& files, const FitSettin
   if (s.detect_layers > kMaxDetectedLayers)
     throw InputError("--detect-layers " + std::to_string(s.detect_layers) + ": must be at most " +
                      std::to_string(kMaxDetectedLayers));
-  if (s.layer_starts.size() + 1 > kMaxDetectedLayers)
-    throw InputError("--layer-start: " + std::to_string(s.layer_starts.size() + 1) +
+  // The total, given and detected (detect_layers N adds up to N - 1 boundaries).
+  const std::size_t layers =
+      1 + s.layer_starts.size() + (s.detect_layers > 1 ? s.detect_layers - 1 : 0);
+  if (layers > kMaxDetectedLayers)
+    throw InputError("--layer-start and --detect-layers: up to " + std::to_string(layers) +
                      " layers, at most " + std::to_string(kMaxDetectedLayers));
   TriforceFitOptions options;
   options.starts = s.starts;

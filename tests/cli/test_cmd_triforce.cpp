@@ -129,7 +129,10 @@ TEST(CmdTriforce, AnglesOutsideTheQuarterTurnMissingParametersAndFixFreeClashesA
   refused("fit '" + file + "' --detect-layers 50", "--detect-layers 50: must be at most 10");
   std::string starts;
   for (int i = 1; i <= 10; ++i) starts += " --layer-start " + std::to_string(i) + "mm";
-  refused("fit '" + file + "'" + starts, "--layer-start: 11 layers, at most 10");
+  refused("fit '" + file + "'" + starts,
+          "--layer-start and --detect-layers: up to 11 layers, at most 10");
+  refused("fit '" + file + "' --layer-start 1mm --detect-layers 10",
+          "--layer-start and --detect-layers: up to 11 layers, at most 10");
 }
 
 // A sample that steps back 5 mm in the middle of the loading branch is merged into the one it
