@@ -54,6 +54,12 @@ nlohmann::json point_json(const RunPoint& p, std::optional<PunctureCriterion> cr
     }
     if (criterion == PunctureCriterion::Penetration)
       j["penetration_force_N"] = p.penetration_force_N;
+    if (criterion == PunctureCriterion::Cohesive) {
+      j["cohesive_crack_m"] = p.cohesive_crack_m;
+      j["cohesive_zone_m"] = p.cohesive_zone_m;
+      j["process_zone_cells"] = p.process_zone_cells;
+      j["fracture_energy_J"] = p.fracture_energy_J;
+    }
   } else {
     j["alpha_N"] = p.alpha_N;
     j["beta_N"] = p.beta_N;
@@ -138,6 +144,12 @@ nlohmann::json run_json(const InsertionRun& run, const Scene& scene) {
   if (run.criterion) {
     criterion = {{"name", to_string(*run.criterion)}, {"threshold", *run.threshold}};
     if (*run.criterion == PunctureCriterion::Energy) criterion["crack_depth_m"] = run.crack_depth_m;
+    if (*run.criterion == PunctureCriterion::Cohesive) {
+      const Fracture& f = *scene.tissue.layers.front().fracture;
+      criterion["crack_depth_m"] = run.crack_depth_m;
+      criterion["cohesive_strength_Pa"] = *f.cohesive_strength;
+      criterion["cohesive_peak_ratio"] = f.cohesive_peak_ratio;
+    }
   }
   return {{"needles", needles},
           {"mesh", mesh},
@@ -165,7 +177,8 @@ nlohmann::json run_json(const InsertionRun& run, const Scene& scene) {
 void apply_simulate_settings(Scene& scene, const SimulateSettings& s) {
   check_choice("fidelity", s.fidelity, {"fast", "standard", "fine"}, true);
   check_choice("contact", s.contact, {"sticking", "frictionless"}, true);
-  check_choice("criterion", s.criterion, {"pressure", "energy", "stress", "penetration"}, true);
+  check_choice("criterion", s.criterion,
+               {"pressure", "energy", "stress", "penetration", "cohesive"}, true);
   check_choice("model", s.model, {"auto", "analytic", "axisymmetric", "3d"}, false);
   if (s.max_needles < 1 || s.max_needles > 100000)
     throw InputError("simulate: max_needles " + std::to_string(s.max_needles) +
@@ -188,6 +201,7 @@ InsertionRunOptions simulate_run_options(const Scene& scene, const SimulateSetti
   if (s.criterion == "energy") r.criterion = PunctureCriterion::Energy;
   if (s.criterion == "stress") r.criterion = PunctureCriterion::Stress;
   if (s.criterion == "penetration") r.criterion = PunctureCriterion::Penetration;
+  if (s.criterion == "cohesive") r.criterion = PunctureCriterion::Cohesive;
   r.model = s.model == "analytic"       ? PreModel::Analytic
             : s.model == "axisymmetric" ? PreModel::Axisymmetric
             : s.model == "3d"           ? PreModel::Full3d

@@ -74,7 +74,12 @@ Json material_json(const TissueMaterial& m) {
 
 Json fracture_json(const std::optional<Fracture>& f) {
   if (!f) return nullptr;
-  return Json{{"toughness_J_per_m2", f->toughness}, {"critical_pressure_Pa", f->critical_pressure}};
+  Json j{{"toughness_J_per_m2", f->toughness}, {"critical_pressure_Pa", f->critical_pressure}};
+  if (f->cohesive_strength) {
+    j["cohesive_strength_Pa"] = *f->cohesive_strength;
+    j["cohesive_peak_ratio"] = f->cohesive_peak_ratio;
+  }
+  return j;
 }
 
 Json layer_json(const TissueLayer& layer) {
@@ -197,8 +202,11 @@ std::string layer_line(std::size_t i, const TissueLayer& l) {
   }
   if (l.fracture) {
     s << "; fracture J " << q(l.fracture->toughness, Dimension::Toughness) << ", P_c "
-      << q(l.fracture->critical_pressure, Dimension::Pressure)
-      << (l.fracture_is_own ? "" : " (from tissue)");
+      << q(l.fracture->critical_pressure, Dimension::Pressure);
+    if (l.fracture->cohesive_strength)
+      s << ", cohesive sigma_c " << q(*l.fracture->cohesive_strength, Dimension::Pressure)
+        << " (delta_y/delta_0 " << l.fracture->cohesive_peak_ratio << ")";
+    s << (l.fracture_is_own ? "" : " (from tissue)");
   } else {
     s << "; no fracture data";
   }

@@ -131,10 +131,12 @@ void print_table(const InsertionRun& run) {
     const bool stress = run.criterion == PunctureCriterion::Stress;
     const bool energy = run.criterion == PunctureCriterion::Energy;
     const bool penetration = run.criterion == PunctureCriterion::Penetration;
+    const bool cohesive = run.criterion == PunctureCriterion::Cohesive;
     std::cout << "  depth [um]  stage   force [mN]   F/A_sec [MPa]"
               << (stress        ? "   tip stress [MPa]"
                   : energy      ? "   G [J/m^2]"
                   : penetration ? "   F_p [mN]"
+                  : cohesive    ? "   crack [um]   damaged [um]   zone cells"
                                 : "")
               << "\n";
     for (const RunPoint& p : n.curve) {
@@ -146,6 +148,10 @@ void print_table(const InsertionRun& run) {
         std::cout << std::setw(13) << p.energy_release_rate_J_per_m2;
       if (penetration && p.stage == Stage::Pre)
         std::cout << std::setw(12) << p.penetration_force_N * 1e3;
+      if (cohesive && p.stage == Stage::Pre)
+        std::cout << std::setprecision(2) << std::setw(13) << p.cohesive_crack_m * 1e6
+                  << std::setw(15) << p.cohesive_zone_m * 1e6 << std::setw(13)
+                  << p.process_zone_cells;
       std::cout << "\n";
     }
     std::cout.unsetf(std::ios::fixed);
@@ -259,7 +265,7 @@ void add_simulate_command(CLI::App& app) {
       ->check(CLI::IsMember({"sticking", "frictionless"}));
   cmd->add_option("--criterion", options->settings.criterion,
                   "puncture criterion (default: the scene's)")
-      ->check(CLI::IsMember({"pressure", "energy", "stress", "penetration"}));
+      ->check(CLI::IsMember({"pressure", "energy", "stress", "penetration", "cohesive"}));
   cmd->add_option("--axis", options->settings.axis,
                   "Axis of the scene's STL needles (overrides their axis key): auto, x, y, z or "
                   "a tip direction a,b,c");

@@ -135,6 +135,35 @@ TEST(CmdSimulate, PunctureJsonHasStagesPunctureAndPlannerKeys) {
   EXPECT_EQ(j["total_curve"].size(), needle["curve"].size());
 }
 
+// The cohesive criterion from the command line (docs/model.md, "The cohesive criterion"): the
+// puncture is the force's peak, and the curve carries the ring crack's state up to it.
+TEST(CmdSimulate, CohesiveCriterionReportsThePeakAndTheRingCracksState) {
+  const CommandRun run = run_mneedle("simulate '" + scene("cohesive_punch.toml") + "' --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["criterion"]["name"], "cohesive");
+  EXPECT_EQ(j["criterion"]["threshold"], 19.0);
+  EXPECT_EQ(j["criterion"]["cohesive_strength_Pa"], 356e3);
+  EXPECT_NEAR(j["criterion"]["crack_depth_m"].get<double>(), 200e-6, 1e-15);  // the diameter
+  const auto& needle = j["needles"].at(0);
+  const auto& p = needle["puncture"];
+  ASSERT_TRUE(p.is_object());
+  EXPECT_EQ(p["criterion"], "cohesive");
+  // As tests/core/insertion/test_insertion_run.cpp's punch (the same gel and law).
+  EXPECT_GT(p["depth_m"].get<double>(), 330e-6);
+  EXPECT_LT(p["depth_m"].get<double>(), 410e-6);
+  double fracture = 0.0;
+  for (const auto& point : needle["curve"]) {
+    if (point["stage"] != "pre") continue;
+    for (const char* key :
+         {"cohesive_crack_m", "cohesive_zone_m", "process_zone_cells", "fracture_energy_J"})
+      ASSERT_TRUE(point.contains(key)) << key;
+    fracture = point["fracture_energy_J"].get<double>();
+  }
+  EXPECT_GT(fracture, 0.0);
+  EXPECT_TRUE(j["energy_check"]["passes"].get<bool>()) << j["energy_check"].dump();
+}
+
 TEST(CmdSimulate, SceneWithoutFractureDataHasNullPuncture) {
   const CommandRun run = run_mneedle("simulate '" + scene("axisymmetric_punch.toml") + "' --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;

@@ -549,6 +549,10 @@ TEST(ErrorPaths, EveryBadInputGivesOneClearLineAndNoInternalText) {
       {"simulate: --fidelity unknown", "simulate {D}/good.toml --fidelity ultra", 2},
       {"simulate: --contact unknown", "simulate {D}/good.toml --contact glue", 2},
       {"simulate: --criterion unknown", "simulate {D}/good.toml --criterion luck", 2},
+      {"simulate: --criterion cohesive without its data",
+       "simulate {D}/good.toml --criterion "
+       "cohesive",
+       1},
       {"simulate: --model unknown", "simulate {D}/good.toml --model fem", 2},
       {"simulate: --axis unknown", "simulate {D}/good.toml --axis w", 1},
       {"simulate: --max-needles text", "simulate {D}/good.toml --max-needles abc", 2},

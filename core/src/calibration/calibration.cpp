@@ -158,6 +158,13 @@ Calibration calibrate(const Scene& scene, const PreparedNeedle& needle, const Fo
         "the penetration criterion is not supported (use the pressure or energy criterion, or "
         "give the puncture with --puncture-at)");
   }
+  // The cohesive crack softens the pre-puncture force itself: a run whose criterion never fires
+  // is not the run that punctures.
+  if (criterion == PunctureCriterion::Cohesive) {
+    fail(
+        "the cohesive criterion is not supported (its crack changes the force before the "
+        "puncture; use the pressure or energy criterion)");
+  }
   if (fits_pc && criterion != PunctureCriterion::Pressure) {
     fail("critical_pressure is the pressure criterion's; the run uses another criterion");
   }

@@ -1142,6 +1142,12 @@ std::unique_ptr<Stepper> make_stepper(AxisymmetricModel& model, const Axisymmetr
 
 }  // namespace
 
+double cohesive_ring_radius(const AxisymmetricNeedle& needle) {
+  const double r = needle.max_radius();
+  if (!(r > 0.0)) throw InputError("cohesive ring crack: the needle has no radius");
+  return r;
+}
+
 double ring_crack_radius(const AxisymmetricNeedle& needle, double depth_m) {
   const auto& H = needle.heights_m;
   const auto& R = needle.radii_m;
@@ -1185,7 +1191,7 @@ InsertionResult insert_needle(AxisymmetricModel& model, const AxisymmetricNeedle
     if (!(law.toughness_J_per_m2 > 0.0) || !(law.peak_opening_m > 0.0) ||
         !(law.failure_opening_m > law.peak_opening_m) || !std::isfinite(law.failure_opening_m))
       throw InputError("cohesive ring crack: the law needs G_c > 0 and 0 < delta_y < delta_0");
-    const double radius = ring_crack_radius(needle, options.depth_m);
+    const double radius = cohesive_ring_radius(needle);
     FacePairs pairs;
     cohesive_model = std::make_unique<AxisymmetricModel>(
         crack_axisymmetric_mesh(model.mesh(), radius, options.cohesive_depth_m, nullptr, &pairs),
@@ -1384,7 +1390,7 @@ AxisymmetricMeshOptions mesh_options_for(const AxisymmetricProblem& problem) {
   // A cohesive ring crack: the fine cells run down its whole line, where the process zone may
   // travel (docs/model.md, "Cohesive ring crack").
   if (problem.cohesive_depth_m > 0.0) {
-    const double r_c = ring_crack_radius(needle, problem.depth_m);
+    const double r_c = cohesive_ring_radius(needle);
     o.radial_breaks_m.push_back(r_c);
     o.fine_radius_m = std::max(o.fine_radius_m, 1.5 * r_c);
     o.fine_depth_m = std::max(o.fine_depth_m, problem.cohesive_depth_m);

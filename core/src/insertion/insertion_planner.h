@@ -34,7 +34,9 @@ struct RunPlan {
   /// horizon"), as a run asked for that depth ends; 0: they end with the run.
   double shown_depth_m = 0.0;
   double horizon_m = 0.0;  ///< the pre-puncture model's depth (a rung of pre_puncture_horizon)
-  int steps = 0;           ///< pre-puncture depth steps over the horizon
+  /// The cohesive criterion's ring crack: its line's depth below the surface (run_pre sets it)
+  double cohesive_depth_m = 0.0;
+  int steps = 0;                 ///< pre-puncture depth steps over the horizon
   double needle_radius_m = 0.0;  ///< largest needle radius reaching the horizon
   std::string vtu_directory;
   std::string vtu_comment;  ///< the run's provenance, into every VTU file

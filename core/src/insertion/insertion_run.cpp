@@ -136,23 +136,37 @@ fe::ContactMode to_fe(Contact c) {
 // Tracks the criterion during a pre-puncture run: it stops once every needle has crossed, or
 // at the first step at or beyond the requested depth (the model itself is built for the
 // horizon, so where it stops changes nothing before that step).
+//
+// The cohesive criterion fires on the step after the force's peak (force_peak): its run goes one
+// step beyond the requested depth, so that a peak in the last step before it is confirmed.
 class CrossingWatch {
  public:
   CrossingWatch(std::size_t needles, const RunPlan& plan)
       : crossed_(needles, false),
+        past_depth_(needles, false),
+        last_force_(needles, 0.0),
         threshold_(plan.stop_at_crossing ? plan.threshold : std::nullopt),
         depth_m_(plan.depth_m) {}
   // False once every needle's criterion has reached the threshold.
   bool keep_going(std::size_t needle, const CriterionSample& s) {
-    if (threshold_ && criterion_value(threshold_->criterion, s) >= threshold_->threshold)
-      crossed_[needle] = true;
-    if (s.depth_m >= depth_m_ * (1.0 - 1e-12)) return false;
+    const bool peak = threshold_ && threshold_->criterion == PunctureCriterion::Cohesive;
+    if (peak) {
+      if (force_drop_step({last_force_[needle], s.force_N})) crossed_[needle] = true;
+      last_force_[needle] = s.force_N;
+      if (past_depth_[needle]) return false;
+      if (s.depth_m >= depth_m_ * (1.0 - 1e-12)) past_depth_[needle] = true;
+    } else {
+      if (threshold_ && criterion_value(threshold_->criterion, s) >= threshold_->threshold)
+        crossed_[needle] = true;
+      if (s.depth_m >= depth_m_ * (1.0 - 1e-12)) return false;
+    }
     if (!threshold_) return true;
     return !std::all_of(crossed_.begin(), crossed_.end(), [](bool c) { return c; });
   }
 
  private:
-  std::vector<bool> crossed_;
+  std::vector<bool> crossed_, past_depth_;
+  std::vector<double> last_force_;
   std::optional<PunctureThreshold> threshold_;
   double depth_m_ = 0.0;
 };
@@ -167,6 +181,7 @@ CriterionSample sample_of(double depth, const NeedleState& n, const SectionArea&
   s.tip_stress_Pa = n.tip_stress_Pa;
   s.energy_release_rate_J_per_m2 = n.energy_release_rate_J_per_m2;
   s.penetration_ratio = area.penetration_ratio(n.force_N, depth);
+  s.force_N = n.force_N;
   return s;
 }
 
@@ -308,6 +323,44 @@ Reduction mirror_reduction(const RunPlan& plan) {
           std::nullopt};
 }
 
+// Cells of the cohesive ring per characteristic length E G_c / sigma_c^2 of its law, by fidelity
+// (docs/model.md, "The cohesive criterion"): the process zone then spans about 3 / 6 / 12 cells
+// at the force's peak; kMinProcessZoneCells is checked there.
+double cohesive_cells_per_length(fe::Fidelity f) {
+  return f == fe::Fidelity::Fast ? 4.0 : f == fe::Fidelity::Fine ? 16.0 : 8.0;
+}
+constexpr int kMinProcessZoneCells = 3;
+// Work limit: cells along the cohesive ring's line. The condensed surface holds every node of
+// the line, and its damage rounds solve it again and again; a law whose length needs more cells
+// than this is refused before any mesh is built.
+constexpr double kMaxCohesiveCells = 400.0;
+
+// The cohesive criterion's ring: the top layer's law, the line `depth` long, its cells sized from
+// the law's characteristic length unless the caller fixed the tip size.
+void set_cohesive_ring(const RunPlan& plan, const InsertionRunOptions& options, double depth,
+                       fe::AxisymmetricProblem& p) {
+  const PunctureThreshold& t = *plan.threshold;
+  p.cohesive_depth_m = depth;
+  p.cohesive.toughness_J_per_m2 = t.threshold;
+  p.cohesive.failure_opening_m = 2.0 * t.threshold / t.cohesive_strength_Pa;
+  p.cohesive.peak_opening_m = t.cohesive_peak_ratio * p.cohesive.failure_opening_m;
+  if (options.overrides.tip_size_m) return;
+  const double E = plan.full_layers.front().material.E;
+  const double length = E * t.threshold / (t.cohesive_strength_Pa * t.cohesive_strength_Pa);
+  const double cell = length / cohesive_cells_per_length(options.fidelity);
+  const double own = fe::mesh_options_for(p).h_m;
+  if (cell < own) p.overrides.tip_size_m = cell;
+  const double cells = depth / std::min(cell, own);
+  if (cells > kMaxCohesiveCells)
+    throw InputError(
+        "cohesive criterion: the law's length E G_c / sigma_c^2 = " +
+        format_quantity(length, Dimension::Length) + " needs " +
+        std::to_string(static_cast<long long>(std::ceil(cells))) + " cells along the " +
+        format_quantity(depth, Dimension::Length) + " ring crack, above the limit of " +
+        std::to_string(static_cast<int>(kMaxCohesiveCells)) +
+        " (a lower cohesive_strength lengthens it; docs/model.md, \"The cohesive criterion\")");
+}
+
 // keep_reached: a stop after the first step returns what was reached (InsertionRunOptions).
 PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
                            const SectionArea& area, const InsertionRunOptions& options,
@@ -328,6 +381,9 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
   if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
     p.crack_depth_m = crack_depth;
   p.crack_face_contact = options.crack_face_contact;
+  if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Cohesive &&
+      crack_depth > 0.0)
+    set_cohesive_ring(plan, options, crack_depth, p);
   CrossingWatch watch(1, plan);
   int step_index = 0;
   std::vector<fe::InsertionStep> reached;  // kept for a run that stops (keep_reached)
@@ -379,6 +435,10 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
     pt.tip_stress_Pa = st.tip_stress_Pa;
     pt.energy_release_rate_J_per_m2 = st.energy_release_rate_J_per_m2;
     pt.crack_face_overlap_m = st.crack_face_overlap_m;
+    pt.cohesive_crack_m = st.cohesive_crack_m;
+    pt.cohesive_zone_m = st.cohesive_zone_m;
+    pt.process_zone_cells = st.process_zone_cells;
+    pt.fracture_energy_J = st.fracture_energy_J;
     set_section(pt, area);
     out.needles[0].points.push_back(pt);
     out.needles[0].samples.push_back(sample_of(st.depth_m, st, area));
@@ -404,6 +464,10 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
     throw InputError(
         "simulate: the analytic model gives no energy release rate; the energy criterion needs "
         "--model axisymmetric or 3d");
+  if (has_criterion && criterion == PunctureCriterion::Cohesive)
+    throw InputError(
+        "simulate: the analytic model has no crack; the cohesive criterion needs --model "
+        "axisymmetric");
   // The stress criterion in closed form: the top layer as a plate on the layer beneath, pressed
   // at one point by a pointed tip (docs/model.md, "The stress criterion on the analytic path").
   // Its force replaces the indentation law's: the stress is the plate's.
@@ -458,6 +522,7 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
       c.depth_m = st.depth_m;
       c.contact_pressure_Pa = p.section_pressure_Pa;
       c.penetration_ratio = areas[i].penetration_ratio(p.force_N, p.depth_m);
+      c.force_N = p.force_N;
       if (plate) p.tip_stress_Pa = c.tip_stress_Pa = contact.stress_per_force_Pa_per_N * p.force_N;
       series.points.push_back(p);
       series.samples.push_back(c);
@@ -513,7 +578,11 @@ void check_layer_merge(const RunPlan& plan, const PreparedNeedle& needle, const 
   full.stop_at_crossing = false;  // same steps and mesh, no early stop: the reduced run's end
   full.vtu_directory.clear();
   full.depth_m = reduced.needles[0].points.back().depth_m;
-  const PreResult reference = run_axisymmetric(full, needle, area, options, 0.0);
+  // The cohesive criterion's force is the cracked tissue's: its reference has the same ring (the
+  // energy criterion's force is the intact model's, its crack a twin beside it).
+  const bool cohesive = plan.threshold && plan.threshold->criterion == PunctureCriterion::Cohesive;
+  const PreResult reference =
+      run_axisymmetric(full, needle, area, options, cohesive ? crack_depth : 0.0);
   if (keep_reduction(*merge, reduced.needles[0].points.back().force_N,
                      reference.needles[0].points.back().force_N, options,
                      "the scene's own layers were used"))
@@ -595,7 +664,11 @@ void check_axisymmetric_domain_cut(RunPlan& plan, const PreparedNeedle& needle,
                                    std::vector<Reduction>& reductions) {
   if (reduced.needles[0].points.empty()) return;
   const RunPoint& last = reduced.needles[0].points.back();
-  if (measure_domain_cut(plan, {needle}, {area}, options, last.depth_m, last.force_N, reductions))
+  // The cut truncates the far field: under the cohesive criterion it is measured on the intact
+  // tissue, both blocks run again (the run's own force is the cracked tissue's).
+  const bool cohesive = plan.threshold && plan.threshold->criterion == PunctureCriterion::Cohesive;
+  if (measure_domain_cut(plan, {needle}, {area}, options, last.depth_m,
+                         cohesive ? std::nullopt : std::optional<double>(last.force_N), reductions))
     return;
   reduced = run_axisymmetric(plan, needle, area, options, crack_depth, options.keep_reached);
 }
@@ -660,6 +733,10 @@ RunPoint interpolated_point(const std::vector<RunPoint>& points, double depth) {
       r.energy_release_rate_J_per_m2 =
           mix(before.energy_release_rate_J_per_m2, p.energy_release_rate_J_per_m2);
       r.crack_face_overlap_m = mix(before.crack_face_overlap_m, p.crack_face_overlap_m);
+      r.cohesive_crack_m = mix(before.cohesive_crack_m, p.cohesive_crack_m);
+      r.cohesive_zone_m = mix(before.cohesive_zone_m, p.cohesive_zone_m);
+      r.process_zone_cells = p.process_zone_cells;
+      r.fracture_energy_J = mix(before.fracture_energy_J, p.fracture_energy_J);
       return r;
     }
     before = p;
@@ -700,12 +777,47 @@ RunPoint gripped_point(const SurfaceLoadModel& model, double depth, double punct
   return p;
 }
 
+// The cohesive criterion's peak is a puncture only where the model resolves it (docs/model.md,
+// "The cohesive criterion"): the process zone spans kMinProcessZoneCells cells or more at the
+// highest step, and the damaged cells stop short of the crack line's end unless that end is the
+// top layer's bottom (then the layer has broken through: a puncture).
+void check_cohesive_peak(const RunPlan& plan, const RunPoint& at, double depth) {
+  const std::string where = "cohesive criterion: at the force's peak (" +
+                            format_quantity(depth, Dimension::Length) + ") ";
+  if (at.process_zone_cells < kMinProcessZoneCells)
+    throw SolverError(where + "the process zone spans " + std::to_string(at.process_zone_cells) +
+                      " cell(s) of the ring crack, fewer than " +
+                      std::to_string(kMinProcessZoneCells) +
+                      ": the peak is not mesh-converged (raise [model] fidelity)");
+  const double line = plan.cohesive_depth_m;
+  const double layer = plan.full_layers.front().thickness;
+  if (line < layer * (1.0 - 1e-9) && at.cohesive_zone_m >= line * (1.0 - 1e-9))
+    throw SolverError(where + "the damage has reached the end of the " +
+                      format_quantity(line, Dimension::Length) +
+                      " ring crack: the peak is the line's, not the tissue's");
+}
+
 NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const RunPlan& plan,
                           const SectionArea& area, const SurfaceLoadModel* post) {
   NeedleRun run;
   run.name = name;
   std::optional<Crossing> crossing;
-  if (plan.threshold) {
+  std::optional<double> peak_force;  // the cohesive criterion's force at its peak
+  if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Cohesive) {
+    std::vector<double> depths, forces;
+    for (const RunPoint& p : pre.points) {
+      depths.push_back(p.depth_m);
+      forces.push_back(p.force_N);
+    }
+    double force = 0.0;
+    crossing = force_peak(depths, forces, &force);
+    if (crossing) {
+      // The highest step is the one before the drop.
+      check_cohesive_peak(plan, pre.points[*force_drop_step(forces) - 1], crossing->depth_m);
+      peak_force = force;
+    }
+    if (crossing && crossing->depth_m > plan.depth_m * (1.0 + 1e-12)) crossing.reset();
+  } else if (plan.threshold) {
     std::vector<double> depths, values;
     for (const CriterionSample& s : pre.samples) {
       depths.push_back(s.depth_m);
@@ -753,6 +865,7 @@ NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const R
     for (const RunPoint& p : pre.points)
       if (p.depth_m < crossing->depth_m) run.curve.push_back(p);
     RunPoint at = interpolated_point(pre.points, crossing->depth_m);
+    if (peak_force) at.force_N = *peak_force;
     set_section(at, area);
     run.curve.push_back(at);
     Puncture puncture;
@@ -870,7 +983,10 @@ std::vector<RunPoint> total_curve(const std::vector<NeedleRun>& needles) {
         sum.beta_N += p.beta_N;
         sum.friction_N += p.friction_N;
         sum.collar_N += p.collar_N;
-        if (i == 0) sum.strain_energy_J = p.strain_energy_J;  // one tissue: the system's energy
+        if (i == 0) {  // one tissue: the system's energy
+          sum.strain_energy_J = p.strain_energy_J;
+          sum.fracture_energy_J = p.fracture_energy_J;
+        }
       }
       sum.contact_pressure_Pa = sum.contact_area_m2 > 0.0 ? sum.force_N / sum.contact_area_m2 : 0.0;
       // Before any puncture the sections carry the whole force (the post-puncture force is not
@@ -886,6 +1002,14 @@ std::vector<RunPoint> total_curve(const std::vector<NeedleRun>& needles) {
   return total;
 }
 
+// The cohesive criterion's ring crack runs down the top layer from the surface at the needle's
+// outer radius (docs/model.md, "The cohesive criterion"): the needle's diameter deep, as the
+// energy criterion's crack, or to the top layer's bottom, where the layer beneath holds it. A
+// property of the needle and the tissue: the same line on every rung.
+double cohesive_line_depth(const RunPlan& plan, const fe::AxisymmetricNeedle& needle) {
+  return std::min(plan.full_layers.front().thickness, 2.0 * needle.max_radius());
+}
+
 // One rung of the pre-puncture model: the FE (or analytic) run for plan.horizon_m, with the
 // planner's reductions checked. Fills the run's mesh summary and crack depth.
 PreResult run_pre(RunPlan& plan, const Scene& scene, const std::vector<PreparedNeedle>& needles,
@@ -895,6 +1019,11 @@ PreResult run_pre(RunPlan& plan, const Scene& scene, const std::vector<PreparedN
   run.crack_depth_m = 0.0;
   switch (plan.pre) {
     case PreKind::Full3d:
+      if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Cohesive)
+        throw InputError(scene.source_name +
+                         ": model.criterion: \"cohesive\" runs on the "
+                         "axisymmetric model only (one needle of revolution on the block's axis); "
+                         "these needles need the 3-D model, which has no cohesive crack yet");
       if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
         run.crack_depth_m = crack_depth_for(plan.needle_radius_m, tip_size_3d(plan, options));
       measure_domain_cut(plan, needles, areas, options, plan.horizon_m, std::nullopt,
@@ -906,6 +1035,12 @@ PreResult run_pre(RunPlan& plan, const Scene& scene, const std::vector<PreparedN
       if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
         run.crack_depth_m =
             crack_depth_for(plan.needle_radius_m, axisymmetric_tip_size(plan, needles[0], options));
+      if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Cohesive)
+        run.crack_depth_m = cohesive_line_depth(plan, *needles[0].axisymmetric);
+      plan.cohesive_depth_m =
+          plan.threshold && plan.threshold->criterion == PunctureCriterion::Cohesive
+              ? run.crack_depth_m
+              : 0.0;
       pre = run_axisymmetric(plan, needles[0], areas[0], options, run.crack_depth_m,
                              options.keep_reached);
       if (pre.stopped) {
@@ -930,14 +1065,28 @@ PreResult run_pre(RunPlan& plan, const Scene& scene, const std::vector<PreparedN
   return pre;
 }
 
-// True when every needle's criterion reached its threshold within the requested depth.
+// The step at which a needle's criterion fired: the first at or above its threshold, or for the
+// cohesive criterion the step that confirms the force's peak (force_drop_step).
+std::optional<std::size_t> fired_step(const PunctureThreshold& t, const PreSeries& s) {
+  if (t.criterion == PunctureCriterion::Cohesive) {
+    std::vector<double> forces;
+    for (const CriterionSample& c : s.samples) forces.push_back(c.force_N);
+    return force_drop_step(forces);
+  }
+  for (std::size_t i = 0; i < s.samples.size(); ++i)
+    if (criterion_value(t.criterion, s.samples[i]) >= t.threshold) return i;
+  return std::nullopt;
+}
+
+// True when every needle's criterion reached its threshold within the requested depth (the
+// cohesive criterion: a peak anywhere in the run, which went a step beyond the depth to confirm
+// one; a deeper rung would find the same peak).
 bool every_needle_crossed(const RunPlan& plan, const PreResult& pre) {
   if (!plan.threshold) return false;
+  const bool peak = plan.threshold->criterion == PunctureCriterion::Cohesive;
   return std::all_of(pre.needles.begin(), pre.needles.end(), [&](const PreSeries& s) {
-    return std::any_of(s.samples.begin(), s.samples.end(), [&](const CriterionSample& c) {
-      return c.depth_m <= plan.depth_m * (1.0 + 1e-12) &&
-             criterion_value(plan.threshold->criterion, c) >= plan.threshold->threshold;
-    });
+    const auto at = fired_step(*plan.threshold, s);
+    return at && (peak || s.samples[*at].depth_m <= plan.depth_m * (1.0 + 1e-12));
   });
 }
 
@@ -1001,11 +1150,9 @@ int first_rung(const Scene& scene, const std::vector<PreparedNeedle>& needles,
 double deepest_first_crossing(const RunPlan& plan, const PreResult& pre) {
   double deepest = 0.0;
   for (const PreSeries& s : pre.needles) {
-    const auto at = std::find_if(s.samples.begin(), s.samples.end(), [&](const CriterionSample& c) {
-      return criterion_value(plan.threshold->criterion, c) >= plan.threshold->threshold;
-    });
-    if (at == s.samples.end()) return 0.0;
-    deepest = std::max(deepest, at->depth_m);
+    const auto at = fired_step(*plan.threshold, s);
+    if (!at) return 0.0;
+    deepest = std::max(deepest, s.samples[*at].depth_m);
   }
   return deepest;
 }
@@ -1053,6 +1200,24 @@ bool top_layer_grips(PunctureCriterion criterion, const std::vector<double>& lay
   return criterion == PunctureCriterion::Stress && layer_moduli_Pa.size() >= 2 &&
          layer_moduli_Pa[0] > layer_moduli_Pa[1];
 }
+
+namespace {
+
+// The cohesive ring crack is solved on the linear model's condensed surface (docs/model.md,
+// "Cohesive ring crack"): linear layers and sticking contact only.
+void check_cohesive_tissue(const Scene& scene, const InsertionRunOptions& options) {
+  for (const TissueLayer& layer : scene.tissue.layers)
+    if (layer.material.model != MaterialModel::Linear)
+      throw InputError(scene.source_name + ":" + std::to_string(layer.line) + ": tissue.layers '" +
+                       layer.name + "': material.model: \"" +
+                       std::string(to_string(layer.material.model)) +
+                       "\"; the cohesive criterion needs linear layers");
+  if (options.contact != Contact::Sticking)
+    throw InputError(scene.source_name +
+                     ": model.contact: the cohesive criterion needs sticking contact");
+}
+
+}  // namespace
 
 InsertionRunOptions scene_run_options(const Scene& scene) {
   InsertionRunOptions r;
@@ -1102,9 +1267,20 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
   // rung k is built for 100 um x 2^k whatever depth was asked, and the first rung on which every
   // criterion fires (or that covers the requested depth) gives the answer. The same needle and
   // tissue thus give the same puncture for any requested depth beyond it.
-  const int last_rung = detail::rung_covering(scene.insertion.depth);
+  int last_rung = detail::rung_covering(scene.insertion.depth);
   RunPlan plan =
       detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(last_rung));
+  // The cohesive criterion confirms a peak on the step after it: the last rung reaches a step
+  // beyond the requested depth.
+  const bool cohesive = plan.threshold && plan.threshold->criterion == PunctureCriterion::Cohesive;
+  if (cohesive) {
+    check_cohesive_tissue(scene, options);
+    if (plan.horizon_m < scene.insertion.depth + plan.horizon_m / std::max(plan.steps, 1)) {
+      ++last_rung;
+      plan =
+          detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(last_rung));
+    }
+  }
   InsertionRun run;
   run.fidelity = options.fidelity;
   if (plan.threshold) {
@@ -1211,7 +1387,7 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
     if (p.stage != Stage::Pre) break;
     depth.push_back(p.depth_m);
     force.push_back(p.force_N);
-    energy.push_back(p.strain_energy_J);
+    energy.push_back(p.strain_energy_J + p.fracture_energy_J);  // W = U + W_d (cohesive)
   }
   run.energy_check = check_energy(depth, force, energy);
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -35,6 +35,11 @@ void check_sequence(const std::vector<double>& depths, const std::vector<double>
   }
 }
 
+// A force that falls by less than this fraction of itself between two steps has not fallen: the
+// solver's round-off (the condensed solve's 1e-14, the cohesive rounds' 1e-12) is far below it,
+// and a crack's run drops the force by percents.
+constexpr double kDropTolerance = 1e-9;
+
 // Bisection on [lo, hi], value(lo) < threshold <= value(hi): the criterion need not be linear
 // between the steps, so the located depth is as exact as the tolerance asks.
 double bisect(const std::function<double(double)>& resolve, double lo, double hi, double threshold,
@@ -92,6 +97,15 @@ PunctureThreshold puncture_threshold(const Scene& scene, PunctureCriterion crite
       t.threshold = top.strength->strength;
       t.average_length_m = top.strength->length;
       break;
+    case PunctureCriterion::Cohesive:
+      if (!top.fracture || !(top.fracture->toughness > 0.0))
+        missing(scene, fracture_key + ".toughness", criterion);
+      if (!top.fracture->cohesive_strength)
+        missing(scene, fracture_key + ".cohesive_strength", criterion);
+      t.threshold = top.fracture->toughness;
+      t.cohesive_strength_Pa = *top.fracture->cohesive_strength;
+      t.cohesive_peak_ratio = top.fracture->cohesive_peak_ratio;
+      break;
   }
   return t;
 }
@@ -106,6 +120,8 @@ double criterion_value(PunctureCriterion criterion, const CriterionSample& sampl
       return sample.tip_stress_Pa;
     case PunctureCriterion::Penetration:
       return sample.penetration_ratio;
+    case PunctureCriterion::Cohesive:
+      return 0.0;  // no threshold to reach: force_peak reads the force itself
   }
   return 0.0;
 }
@@ -136,6 +152,41 @@ std::optional<Crossing> first_crossing(const std::vector<double>& depths_m,
     previous_value = values[i];
   }
   return std::nullopt;
+}
+
+std::optional<std::size_t> force_drop_step(const std::vector<double>& forces_N) {
+  for (std::size_t i = 1; i < forces_N.size(); ++i)
+    if (forces_N[i] < forces_N[i - 1] * (1.0 - kDropTolerance)) return i;
+  return std::nullopt;
+}
+
+std::optional<Crossing> force_peak(const std::vector<double>& depths_m,
+                                   const std::vector<double>& forces_N, double* peak_force_N) {
+  // Any positive threshold passes the check: the sequence is what is checked here.
+  check_sequence(depths_m, forces_N, 1.0);
+  const auto drop = force_drop_step(forces_N);
+  if (!drop) return std::nullopt;
+  // The highest step is the one before the drop; its neighbours bracket the vertex (before the
+  // first step, the origin: no contact, no force).
+  const std::size_t top = *drop - 1;
+  const double x0 = top > 0 ? depths_m[top - 1] : 0.0, y0 = top > 0 ? forces_N[top - 1] : 0.0;
+  const double x1 = depths_m[top], y1 = forces_N[top];
+  const double x2 = depths_m[*drop], y2 = forces_N[*drop];
+  // Divided differences: y = y1 + b (x - x1) + c (x - x1)^2 with c < 0, since y1 >= y0 and
+  // y1 > y2 make the parabola concave.
+  const double s01 = (y1 - y0) / (x1 - x0), s12 = (y2 - y1) / (x2 - x1);
+  const double c = (s12 - s01) / (x2 - x0);
+  const double b = s01 + c * (x1 - x0);
+  double vertex = c < 0.0 ? x1 - b / (2.0 * c) : x1;
+  vertex = std::clamp(vertex, x0, x2);
+  Crossing crossing;
+  crossing.depth_m = vertex;
+  crossing.step = vertex <= x1 ? top : *drop;
+  const double from = vertex <= x1 ? x0 : x1, to = vertex <= x1 ? x1 : x2;
+  crossing.fraction = to > from ? std::clamp((vertex - from) / (to - from), 0.0, 1.0) : 1.0;
+  if (peak_force_N != nullptr)
+    *peak_force_N = y1 + b * (vertex - x1) + c * (vertex - x1) * (vertex - x1);
+  return crossing;
 }
 
 double interpolate_at(const std::vector<double>& depths_m, const std::vector<double>& values,

@@ -393,6 +393,15 @@ std::optional<Fracture> read_fracture(Table& parent) {
   Fracture f;
   f.toughness = t->required_positive("toughness", Dimension::Toughness);
   f.critical_pressure = t->required_positive("critical_pressure", Dimension::Pressure);
+  f.cohesive_strength = t->optional_positive("cohesive_strength", Dimension::Pressure);
+  if (const auto ratio = t->optional_quantity("cohesive_peak_ratio", Dimension::Dimensionless)) {
+    if (!f.cohesive_strength)
+      t->fail_key("cohesive_peak_ratio", "shapes the cohesive law: give cohesive_strength too");
+    if (!(*ratio > 0.0 && *ratio < 1.0))
+      t->fail_key("cohesive_peak_ratio", "delta_y / delta_0 must lie in (0, 1), got " +
+                                             format_quantity(*ratio, Dimension::Dimensionless));
+    f.cohesive_peak_ratio = *ratio;
+  }
   t->finish();
   return f;
 }
@@ -778,6 +787,10 @@ void check_criterion_inputs(Table& t, PunctureCriterion c, const Tissue& tissue)
     t.fail_key("criterion", "\"" + std::string(to_string(c)) + "\" needs fracture data on " +
                                 layer + " or in [tissue.fracture]");
   }
+  if (c == PunctureCriterion::Cohesive && !top.fracture->cohesive_strength) {
+    t.fail_key("criterion", "\"cohesive\" needs fracture.cohesive_strength on " + layer +
+                                " or in [tissue.fracture]");
+  }
 }
 
 ModelOptions read_model(std::optional<Table> t, const Tissue& tissue) {
@@ -792,7 +805,8 @@ ModelOptions read_model(std::optional<Table> t, const Tissue& tissue) {
       "criterion", {{"pressure", PunctureCriterion::Pressure},
                     {"energy", PunctureCriterion::Energy},
                     {"stress", PunctureCriterion::Stress},
-                    {"penetration", PunctureCriterion::Penetration}});
+                    {"penetration", PunctureCriterion::Penetration},
+                    {"cohesive", PunctureCriterion::Cohesive}});
   if (criterion) {
     check_criterion_inputs(*t, *criterion, tissue);
     m.criterion = *criterion;
@@ -1046,6 +1060,8 @@ std::string_view to_string(PunctureCriterion c) {
       return "stress";
     case PunctureCriterion::Penetration:
       return "penetration";
+    case PunctureCriterion::Cohesive:
+      return "cohesive";
   }
   return "?";
 }

@@ -318,6 +318,23 @@ TEST(Calibration, PenetrationCriterionWithoutAGivenPunctureIsRefused) {
   }
 }
 
+// Its crack softens the force before the puncture: the criterion-free run calibrate fits on is
+// not the run that punctures.
+TEST(Calibration, CohesiveCriterionIsRefused) {
+  CalibrationOptions options;
+  options.fit = {CalibratedConstant::scale};
+  options.contact_travel_m = 0.0;
+  options.run.criterion = PunctureCriterion::Cohesive;
+  const ForceCurve curve = noisy({1e-4, 2e-4, 3e-4, 4e-4}, {1e-3, 2e-3, 3e-3, 4e-3});
+  try {
+    calibrate(silicone_scene(), bevel_needle(), curve, options);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cohesive criterion is not supported"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Calibration, FrictionCoefficientWithoutCoulombFrictionIsRefused) {
   Scene scene = silicone_scene();
   scene.loads.friction = FrictionLaw::None;

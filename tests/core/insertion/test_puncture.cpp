@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "mneedle/base/error.h"
@@ -162,10 +163,50 @@ TEST(CriterionValue, PicksTheCriterionsQuantity) {
   s.tip_stress_Pa = 2.0;
   s.energy_release_rate_J_per_m2 = 3.0;
   s.penetration_ratio = 4.0;
+  s.force_N = 5.0;
   EXPECT_EQ(criterion_value(PunctureCriterion::Penetration, s), 4.0);
+  EXPECT_EQ(criterion_value(PunctureCriterion::Cohesive, s), 0.0);  // it reads the force's peak
   EXPECT_EQ(criterion_value(PunctureCriterion::Pressure, s), 1.0);
   EXPECT_EQ(criterion_value(PunctureCriterion::Stress, s), 2.0);
   EXPECT_EQ(criterion_value(PunctureCriterion::Energy, s), 3.0);
+}
+
+// A force sampled from a parabola F = 5 - (d - 3.3)^2 peaks where the parabola does: the vertex
+// of the three steps around the highest is exact (to round-off) wherever the peak lies between
+// the steps, and so moves continuously with it.
+TEST(ForcePeak, TheVertexOfASampledParabolaIsItsPeak) {
+  for (double peak : {2.6, 3.0, 3.3, 3.9}) {
+    std::vector<double> d, f;
+    for (int k = 1; k <= 6; ++k) {
+      d.push_back(k);
+      f.push_back(5.0 - (k - peak) * (k - peak));
+    }
+    double force = 0.0;
+    const auto c = force_peak(d, f, &force);
+    ASSERT_TRUE(c) << peak;
+    EXPECT_NEAR(c->depth_m, peak, 1e-12) << peak;
+    EXPECT_NEAR(force, 5.0, 1e-12) << peak;
+    EXPECT_LT(d[c->step] - 1.0, peak);  // the step's interval holds the peak
+    EXPECT_GE(d[c->step], peak);
+  }
+}
+
+TEST(ForcePeak, AForceThatNeverFallsHasNoPeakAndRoundOffIsNoFall) {
+  EXPECT_FALSE(force_peak({1.0, 2.0, 3.0}, {1.0, 2.0, 2.5}));
+  // A plateau's round-off (1e-12 of the force) is not a drop; 1e-6 is.
+  EXPECT_FALSE(force_peak({1.0, 2.0, 3.0}, {1.0, 2.0, 2.0 * (1.0 - 1e-12)}));
+  EXPECT_EQ(force_drop_step({1.0, 2.0, 2.0 * (1.0 - 1e-6)}), std::optional<std::size_t>(2));
+  EXPECT_THROW(force_peak({1.0, 2.0}, {1.0}), InputError);
+}
+
+TEST(ForcePeak, APeakInTheFirstStepIsPlacedWithTheOrigin) {
+  // F = 4 d - 2 d^2 peaks at d = 1 (2), sampled at 1.5 and 3: through (0, 0) the vertex is exact.
+  double force = 0.0;
+  const auto c = force_peak({1.5, 3.0}, {4 * 1.5 - 2 * 2.25, 4 * 3.0 - 2 * 9.0}, &force);
+  ASSERT_TRUE(c);
+  EXPECT_NEAR(c->depth_m, 1.0, 1e-12);
+  EXPECT_NEAR(force, 2.0, 1e-12);
+  EXPECT_EQ(c->step, 0u);
 }
 
 // G is a secant over its crack, so the crack must not follow the mesh: paper A's 115 um needle

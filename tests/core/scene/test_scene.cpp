@@ -201,6 +201,32 @@ TEST(Scene, LayerFractureOverridesTheTissueDefault) {
   EXPECT_TRUE(s.tissue.layers[1].fracture_is_own);
 }
 
+TEST(Scene, ACohesiveLawIsReadWithItsStrengthAndShape) {
+  const std::string pc = "critical_pressure = \"0.663 MPa\"\n";
+  const Scene plain = parse(std::string(kBase));
+  EXPECT_FALSE(plain.tissue.layers[0].fracture->cohesive_strength);
+  const Scene s =
+      parse(with(pc, pc + "cohesive_strength = \"356 kPa\"\ncohesive_peak_ratio = 0.1\n"));
+  EXPECT_DOUBLE_EQ(*s.tissue.layers[0].fracture->cohesive_strength, 356e3);
+  EXPECT_DOUBLE_EQ(s.tissue.layers[0].fracture->cohesive_peak_ratio, 0.1);
+  // Copied to every layer from [tissue.fracture], as the rest of it.
+  EXPECT_DOUBLE_EQ(*s.tissue.layers[1].fracture->cohesive_strength, 356e3);
+  const Scene defaulted = parse(with(pc, pc + "cohesive_strength = \"356 kPa\"\n"));
+  EXPECT_DOUBLE_EQ(defaulted.tissue.layers[0].fracture->cohesive_peak_ratio, 0.01);
+}
+
+TEST(SceneErrors, ACohesiveLawNeedsItsStrengthAUnitAndARatioBelowOne) {
+  const std::string pc = "critical_pressure = \"0.663 MPa\"\n";
+  expect_error(with(pc, pc + "cohesive_strength = 356000\n"),
+               {"tissue.fracture.cohesive_strength", "unit"});
+  expect_error(with(pc, pc + "cohesive_peak_ratio = 0.1\n"),
+               {"tissue.fracture.cohesive_peak_ratio", "give cohesive_strength too"});
+  expect_error(with(pc, pc + "cohesive_strength = \"356 kPa\"\ncohesive_peak_ratio = 1\n"),
+               {"tissue.fracture.cohesive_peak_ratio", "(0, 1)"});
+  expect_error(with("fidelity = \"standard\"", "criterion = \"cohesive\""),
+               {"test.toml:30:", "model.criterion", "cohesive_strength"});
+}
+
 TEST(Scene, WithoutAnyFractureDataLayersHaveNone) {
   const Scene s = parse(with(
       "[tissue.fracture]\ntoughness = \"0.019 N/mm\"\ncritical_pressure = \"0.663 MPa\"\n", ""));

@@ -255,7 +255,7 @@ struct InsertionOptions {
   /// contact the faces stay free and only their overlap is reported); false leaves them free.
   bool crack_face_contact = true;
   /// A cohesive ring crack (docs/model.md, "Cohesive ring crack"): when cohesive_depth_m > 0 the
-  /// tissue is split along r = ring_crack_radius(needle, depth_m) from the surface down this
+  /// tissue is split along r = cohesive_ring_radius(needle) from the surface down this
   /// deep and its faces held by `cohesive` (paper C's bilinear law on the mixed-mode opening;
   /// in compression a penalty of the law's initial stiffness). Linear layers and sticking
   /// contact only; the mesh needs the node column and row as for crack_depth_m.
@@ -325,5 +325,9 @@ double equal_area_radius(double width_m);
 /// needle's footprint on the undeformed surface at that depth), at least kRingCrackMinFraction
 /// of the needle's largest radius so that a sharp cone still gets a resolvable ring.
 double ring_crack_radius(const AxisymmetricNeedle& needle, double depth_m);
+
+/// Radius of the cohesive ring crack: the needle's outer radius, a property of the needle alone
+/// (a flat punch's rim; the outline a tapered tip's full section pushes ahead of it).
+double cohesive_ring_radius(const AxisymmetricNeedle& needle);
 
 }  // namespace mneedle::fe

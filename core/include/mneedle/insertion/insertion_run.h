@@ -104,6 +104,13 @@ struct RunPoint {
   double crack_face_overlap_m = 0.0;
   /// penetration: F_p of the section at the surface (docs/model.md, "Penetration criterion")
   double penetration_force_N = 0.0;
+  /// cohesive (docs/model.md, "The cohesive criterion"): the ring crack's failed depth, the lower
+  /// end of its damaged cells (m below the surface), the cells of its process zone and the
+  /// energy its law has dissipated (J)
+  double cohesive_crack_m = 0.0;
+  double cohesive_zone_m = 0.0;
+  int process_zone_cells = 0;
+  double fracture_energy_J = 0.0;
   // Post-puncture split (paper A eqs. 18-20, friction); zero before puncture.
   double alpha_N = 0.0;
   double beta_N = 0.0;
@@ -115,7 +122,7 @@ struct RunPoint {
 };
 
 struct Puncture {
-  double depth_m = 0.0;       ///< located between steps (interpolated or bisected)
+  double depth_m = 0.0;       ///< located between steps (interpolated, bisected or a force's peak)
   double force_N = 0.0;       ///< pre-puncture force at that depth
   double post_force_N = 0.0;  ///< post-puncture model's force at that depth
   PunctureCriterion criterion = PunctureCriterion::Pressure;
@@ -178,7 +185,8 @@ struct InsertionRun {
   /// or no pre-puncture model ran.
   std::optional<PunctureCriterion> criterion;
   std::optional<double> threshold;  ///< the criterion's threshold (Pa or J/m^2)
-  double crack_depth_m = 0.0;       ///< energy criterion: depth of the crack G is computed with
+  /// energy criterion: depth of the crack G is computed with; cohesive: of the ring crack's line
+  double crack_depth_m = 0.0;
   /// Depth the pre-puncture model was built for (docs/model.md, "Pre-puncture horizon"): a rung
   /// of 100 um x 2^k, the first whose run fired the criterion or covered the requested depth.
   double horizon_m = 0.0;

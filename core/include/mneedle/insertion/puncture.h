@@ -21,6 +21,10 @@ struct PunctureThreshold {
   double threshold = 0.0;  ///< Pa (pressure, stress), J/m^2 (energy) or 1 (penetration: F/F_p)
   double average_length_m = 0.0;  ///< stress: the layer's strength length; else 0
   std::size_t layer = 0;          ///< index of the layer the data comes from
+  /// cohesive: the law's peak traction sigma_c (Pa) and delta_y / delta_0 (the threshold is
+  /// G_c, J/m^2, reported; the criterion itself is the force's first peak)
+  double cohesive_strength_Pa = 0.0;
+  double cohesive_peak_ratio = 0.0;
 };
 
 /// True when the top layer has any puncture data (fracture or strength). Without any, a run stays
@@ -40,6 +44,7 @@ struct CriterionSample {
   /// F / F_p: the force over the steady mode-I penetration force of the needle's section at
   /// the surface (penetration_force.h); dimensionless, the criterion fires at 1.
   double penetration_ratio = 0.0;
+  double force_N = 0.0;  ///< the axial force (the cohesive criterion reads its peak)
 };
 
 /// The sample's value of the quantity the criterion compares with its threshold.
@@ -61,6 +66,21 @@ std::optional<Crossing> first_crossing(const std::vector<double>& depths_m,
                                        const std::vector<double>& values, double threshold,
                                        const std::function<double(double)>& resolve = {},
                                        double depth_tolerance_m = 0.0);
+
+/// The cohesive criterion's puncture (docs/model.md, "The cohesive criterion"): the force's first
+/// peak, where the crack's growth turns unstable. A peak is confirmed by the first step whose
+/// force falls below the one before (by more than 1e-9 of it); it is placed at the vertex of the
+/// parabola through the highest step and its two neighbours (0 at depth 0 before the first step),
+/// so that it moves continuously with the design. `step` is the step whose interval (previous
+/// step, step] holds the vertex; `peak_force_N`, when given, receives the parabola's value there.
+/// nullopt: the force never fell. Throws InputError as first_crossing for bad sequences.
+std::optional<Crossing> force_peak(const std::vector<double>& depths_m,
+                                   const std::vector<double>& forces_N,
+                                   double* peak_force_N = nullptr);
+
+/// Index of the step that confirms a force peak (force_peak): the first whose force falls below
+/// the one before by more than 1e-9 of it; nullopt when none does.
+std::optional<std::size_t> force_drop_step(const std::vector<double>& forces_N);
 
 /// Linear interpolation of a quantity tabulated at ascending depths (0 before the first step, the
 /// last value beyond the last step).

@@ -39,6 +39,11 @@ struct TissueMaterial {
 struct Fracture {
   double toughness = 0.0;          ///< J/m^2 (= N/m), Griffith energy per crack area
   double critical_pressure = 0.0;  ///< Pa, pressure-criterion threshold P_c
+  /// The cohesive criterion's traction-separation law (docs/model.md, "The cohesive
+  /// criterion"): its peak traction sigma_c (Pa; absent: the layer has no cohesive law) and the
+  /// opening at the peak as a fraction of the opening at failure, delta_y / delta_0 in (0, 1).
+  std::optional<double> cohesive_strength;
+  double cohesive_peak_ratio = 0.01;
 };
 
 /// For the stress puncture criterion: the strength the averaged maximum principal stress must
@@ -111,7 +116,7 @@ struct Insertion {
 
 enum class Fidelity { Fast, Standard, Fine };
 enum class Output { Puncture, ForceCurve, Fields };
-enum class PunctureCriterion { Pressure, Energy, Stress, Penetration };
+enum class PunctureCriterion { Pressure, Energy, Stress, Penetration, Cohesive };
 enum class Contact { Sticking, Frictionless };
 /// The energy criterion's crack faces: in frictionless contact, or free to pass through each
 /// other (for comparison, or where held faces stop Newton; docs/model.md "Crack faces in contact").
@@ -195,12 +200,13 @@ Scene load_scene(const std::filesystem::path& file);
 /// paths.
 Scene parse_scene(std::string_view toml, std::string source_name);
 
-std::string_view to_string(Boundary b);           ///< "fixed"
-std::string_view to_string(Fidelity f);           ///< "fast", "standard", "fine"
-std::string_view to_string(Output o);             ///< "puncture", "force_curve", "fields"
-std::string_view to_string(PunctureCriterion c);  ///< "pressure", "energy", "stress", "penetration"
-std::string_view to_string(Contact c);            ///< "sticking", "frictionless"
-std::string_view to_string(CrackFaces c);         ///< "contact", "free"
-std::string_view to_string(FrictionLaw f);        ///< "coulomb", "linear_growth", "none"
+std::string_view to_string(Boundary b);  ///< "fixed"
+std::string_view to_string(Fidelity f);  ///< "fast", "standard", "fine"
+std::string_view to_string(Output o);    ///< "puncture", "force_curve", "fields"
+/// "pressure", "energy", "stress", "penetration", "cohesive"
+std::string_view to_string(PunctureCriterion c);
+std::string_view to_string(Contact c);      ///< "sticking", "frictionless"
+std::string_view to_string(CrackFaces c);   ///< "contact", "free"
+std::string_view to_string(FrictionLaw f);  ///< "coulomb", "linear_growth", "none"
 
 }  // namespace mneedle
