@@ -333,7 +333,7 @@ constexpr int kMinProcessZoneCells = 3;
 // Work limit: cells along the cohesive ring's line. The condensed surface holds every node of
 // the line, and its damage rounds solve it again and again; a law whose length needs more cells
 // than this is refused before any mesh is built.
-constexpr double kMaxCohesiveCells = 400.0;
+constexpr double kMaxCohesiveCells = 150.0;
 
 // The cohesive criterion's ring: the top layer's law, the line `depth` long, its cells sized from
 // the law's characteristic length unless the caller fixed the tip size.

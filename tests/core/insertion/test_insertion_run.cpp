@@ -617,7 +617,7 @@ TEST(CohesiveCriterion, ALawTooShortForTheRingIsRefusedBeforeAnyWork) {
   } catch (const InputError& e) {
     const std::string m = e.what();
     EXPECT_NE(m.find("348.944 nm"), std::string::npos) << m;
-    EXPECT_NE(m.find("above the limit of 400"), std::string::npos) << m;
+    EXPECT_NE(m.find("above the limit of 150"), std::string::npos) << m;
   }
 }
 
