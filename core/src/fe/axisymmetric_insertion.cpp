@@ -1339,6 +1339,9 @@ void check_geometry(const AxisymmetricProblem& problem) {
 
 }  // namespace
 
+// The cohesive ring's band: the mesh's own cells at most this many times the band's.
+constexpr double kMaxBandRatio = 4.0;
+
 AxisymmetricMeshOptions mesh_options_for(const AxisymmetricProblem& problem) {
   check_overrides(problem.overrides);
   const AxisymmetricNeedle& needle = problem.needle;
@@ -1395,6 +1398,16 @@ AxisymmetricMeshOptions mesh_options_for(const AxisymmetricProblem& problem) {
     o.fine_radius_m = std::max(o.fine_radius_m, 1.5 * r_c);
     o.fine_depth_m = std::max(o.fine_depth_m, problem.cohesive_depth_m);
     o.depth_breaks_m.push_back(problem.cohesive_depth_m);
+    // Finer cells along the ring only, graded to the mesh's own on either side; the mesh's own
+    // at most kMaxBandRatio times the band's, so that the band's rows stay well shaped away
+    // from it.
+    const double cell = problem.cohesive_cell_m;
+    if (cell > 0.0 && cell < o.h_m) {
+      o.h_m = std::min(o.h_m, kMaxBandRatio * cell);
+      o.band_radius_m = r_c;
+      o.band_size_m = cell;
+      o.band_depth_m = problem.cohesive_depth_m;
+    }
   }
   return o;
 }

@@ -48,6 +48,25 @@ double append_graded(std::vector<double>& points, double a, double b, double h, 
   return h;
 }
 
+// Offsets from a band's edge across a segment `length` long: cells from `band` growing by
+// `growth` while below h, then equal cells of at most h for the rest (so the far end has the
+// mesh's own size, not a remainder). Ends at `length`.
+std::vector<double> band_offsets(double length, double band, double h, double growth) {
+  std::vector<double> x;
+  double at = 0.0, cell = band;
+  while (cell < h && at + cell < length * (1.0 - 1e-9)) {
+    x.push_back(at += cell);
+    cell *= growth;
+  }
+  const double rest = length - at;
+  if (rest > 1e-9 * length) {
+    const int n = uniform_count(rest, h, 1);
+    for (int i = 1; i <= n; ++i) x.push_back(at + rest * i / n);
+  }
+  x.back() = length;
+  return x;
+}
+
 std::vector<double> radial_grid(const AxisymmetricMeshOptions& o) {
   const double fine = std::min(o.fine_radius_m, o.radius_m);
   std::vector<double> breaks{0.0, fine};
@@ -58,8 +77,20 @@ std::vector<double> radial_grid(const AxisymmetricMeshOptions& o) {
                            [](double x, double y) { return std::abs(x - y) < 1e-12; }),
                breaks.end());
   std::vector<double> r{0.0};
-  for (std::size_t i = 1; i < breaks.size(); ++i)
-    append_uniform(r, breaks[i - 1], breaks[i], uniform_count(breaks[i] - breaks[i - 1], o.h_m, 1));
+  const bool band = o.band_size_m > 0.0 && o.band_size_m < o.h_m;
+  auto at_band = [&](double x) { return band && std::abs(x - o.band_radius_m) < 1e-12; };
+  for (std::size_t i = 1; i < breaks.size(); ++i) {
+    const double a = breaks[i - 1], b = breaks[i];
+    if (at_band(a)) {  // from the band outward: band_size_m growing to h_m
+      for (double x : band_offsets(b - a, o.band_size_m, o.h_m, o.growth)) r.push_back(a + x);
+    } else if (at_band(b)) {  // towards the band: the same grading, mirrored
+      const std::vector<double> x = band_offsets(b - a, o.band_size_m, o.h_m, o.growth);
+      for (std::size_t k = x.size() - 1; k-- > 0;) r.push_back(b - x[k]);
+      r.push_back(b);
+    } else {
+      append_uniform(r, a, b, uniform_count(b - a, o.h_m, 1));
+    }
+  }
   if (fine < o.radius_m) append_graded(r, fine, o.radius_m, o.h_m, o.growth, o.max_size_m, 1);
   return r;
 }
@@ -92,7 +123,16 @@ std::vector<double> depth_grid(const std::vector<AxisymmetricLayer>& layers,
       const double snap = 1e-9 * (bottom - top);
       if (bottom - fine_end <= snap) fine_end = bottom;
       if (fine_end - top <= snap) fine_end = top;
-      if (fine_end > top) {
+      // The band's rows: band_size_m apart down to band_depth_m, then grading to h_m.
+      const bool band = o.band_size_m > 0.0 && o.band_size_m < o.h_m && o.band_depth_m > top;
+      if (fine_end > top && band) {
+        const double band_end = std::min(o.band_depth_m, fine_end);
+        append_uniform(
+            s, top, band_end,
+            uniform_count(band_end - top, o.band_size_m, fine_end >= bottom ? minimum : 1));
+        h = o.band_size_m;
+        if (fine_end > band_end) h = append_graded(s, band_end, fine_end, h, o.growth, o.h_m, 1);
+      } else if (fine_end > top) {
         const bool whole = fine_end >= bottom;
         append_uniform(s, top, fine_end, uniform_count(fine_end - top, o.h_m, whole ? minimum : 1));
         h = o.h_m;

@@ -349,7 +349,7 @@ void set_cohesive_ring(const RunPlan& plan, const InsertionRunOptions& options, 
   const double length = E * t.threshold / (t.cohesive_strength_Pa * t.cohesive_strength_Pa);
   const double cell = length / cohesive_cells_per_length(options.fidelity);
   const double own = fe::mesh_options_for(p).h_m;
-  if (cell < own) p.overrides.tip_size_m = cell;
+  if (cell < own) p.cohesive_cell_m = cell;
   const double cells = depth / std::min(cell, own);
   if (cells > kMaxCohesiveCells)
     throw InputError(

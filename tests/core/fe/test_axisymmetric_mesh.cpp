@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -81,6 +82,61 @@ TEST(AxisymmetricMesh, DepthBreakWithinRoundOffOfTheFineZoneEndAddsNoSliverRow) 
     const Eigen::Vector2d b = mesh.nodes[e[2]] - mesh.nodes[e[0]];
     ASSERT_GT(a.x() * b.y() - a.y() * b.x(), 1e-6 * o.h_m * o.h_m);
   }
+}
+
+// The cohesive ring's band: 2 um cells at r = 100 um down to 200 um, the mesh's own 10 um
+// elsewhere in the fine zone, graded in between by the growth (1.3: 2, 2.6, 3.38, ... up to 10).
+TEST(AxisymmetricMesh, ABandRefinesTheCellsAlongItsColumnOnly) {
+  AxisymmetricMeshOptions o;
+  o.radius_m = 2e-3;
+  o.h_m = 10e-6;
+  o.fine_radius_m = 150e-6;
+  o.fine_depth_m = 200e-6;
+  o.growth = 1.3;
+  o.radial_breaks_m = {100e-6};
+  o.depth_breaks_m = {200e-6};
+  o.band_radius_m = 100e-6;
+  o.band_size_m = 2e-6;
+  o.band_depth_m = 200e-6;
+  const AxisymmetricMesh mesh =
+      make_axisymmetric_mesh({{2e-3, material(MaterialModel::Linear, 1e5, 0.45)}}, o);
+  // Corner columns on the surface (every second surface node: quadratic edges).
+  std::vector<double> r;
+  for (std::size_t k = 0; k < mesh.surface_nodes.size(); k += 2)
+    r.push_back(mesh.nodes[mesh.surface_nodes[k]].x());
+  const auto ring =
+      std::find_if(r.begin(), r.end(), [](double x) { return std::abs(x - 100e-6) < 1e-15; });
+  ASSERT_NE(ring, r.end());
+  const std::size_t i = static_cast<std::size_t>(ring - r.begin());
+  EXPECT_NEAR(r[i + 1] - r[i], 2e-6, 1e-12);  // the band on either side
+  EXPECT_NEAR(r[i] - r[i - 1], 2e-6, 1e-12);
+  EXPECT_NEAR(r[i + 2] - r[i + 1], 2.6e-6, 1e-12);  // graded by 1.3
+  EXPECT_NEAR(r[i - 1] - r[i - 2], 2.6e-6, 1e-12);
+  // The mesh's own at the axis: 35.2 um of grading leaves 64.8 um in 7 cells of 9.26 um.
+  EXPECT_NEAR(r[1] - r[0], 64.8e-6 / 7, 0.01e-6);
+  // Rows 2 um apart down the band (100 of them to 200 um), then coarser.
+  std::vector<double> depth;
+  for (const Eigen::Vector2d& x : mesh.nodes)
+    if (x.x() == 0.0) depth.push_back(-x.y());
+  std::sort(depth.begin(), depth.end());
+  const auto rows_above =
+      std::count_if(depth.begin(), depth.end(), [](double d) { return d < 200e-6 - 1e-12; });
+  EXPECT_EQ(rows_above, 200);  // corners and mid-edge nodes of 100 rows of 2 um
+  // Within the fine zone the band's 2 um rows meet columns of at most 10 um: no corner below
+  // atan(2 / 10), 11.3 degrees. (Outside it a tensor grid's fine rows and columns meet coarse
+  // ones in slivers, band or not: the band's 2 um columns run down to the bottom.)
+  double smallest = 180.0;
+  for (const auto& e : mesh.elements) {
+    const Eigen::Vector2d p[3] = {mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]]};
+    if (std::max({p[0].x(), p[1].x(), p[2].x()}) > 150e-6 + 1e-12 ||
+        std::min({p[0].y(), p[1].y(), p[2].y()}) < -200e-6 - 1e-12)
+      continue;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector2d u = p[(k + 1) % 3] - p[k], v = p[(k + 2) % 3] - p[k];
+      smallest = std::min(smallest, std::acos(u.dot(v) / (u.norm() * v.norm())) * 180.0 / M_PI);
+    }
+  }
+  EXPECT_GE(smallest, 11.3 - 1e-9);
 }
 
 TEST(AxisymmetricMesh, RejectsEmptyLayersAndBadSizes) {

@@ -58,6 +58,13 @@ struct AxisymmetricMeshOptions {
   std::vector<double> radial_breaks_m;  ///< radii that must be node columns (punch edge, bore)
   std::vector<double> depth_breaks_m;   ///< depths below the surface that must be node rows
   int elements_through_top = 0;         ///< minimum elements through layer 0 (0: the general one)
+  /// A band of finer cells (band_size_m < h_m; 0: none) along the column r = band_radius_m (a
+  /// radial break) down to the depth break band_depth_m: the node columns on either side grade
+  /// from band_size_m to h_m by `growth`, and the rows above band_depth_m are band_size_m apart
+  /// (the cohesive ring's process zone, docs/model.md "The cohesive criterion").
+  double band_radius_m = 0.0;
+  double band_size_m = 0.0;
+  double band_depth_m = 0.0;
 };
 
 /// Reference coordinates (r, z): z = 0 is the free surface, tissue at z < 0, axis at r = 0.
@@ -303,6 +310,9 @@ struct AxisymmetricProblem {
   bool crack_face_contact = true;        ///< as InsertionOptions
   double cohesive_depth_m = 0.0;         ///< as InsertionOptions
   CohesiveLaw cohesive;                  ///< as InsertionOptions
+  /// The cohesive ring's cells (m; 0: the mesh's own): a band of them along the ring, graded to
+  /// the mesh's own size on either side (AxisymmetricMeshOptions::band_size_m).
+  double cohesive_cell_m = 0.0;
   std::function<bool(const InsertionStep&)> on_step;
   /// Called once the mesh is built, before the first step, with the result's nodes, elements and
   /// mesh_seconds filled and no steps: a caller that keeps what a run reached before it stopped
