@@ -59,6 +59,7 @@ nlohmann::json point_json(const RunPoint& p, std::optional<PunctureCriterion> cr
       j["cohesive_zone_m"] = p.cohesive_zone_m;
       j["process_zone_cells"] = p.process_zone_cells;
       j["fracture_energy_J"] = p.fracture_energy_J;
+      j["cohesive_failed_fraction"] = p.cohesive_failed_fraction;
     }
   } else {
     j["alpha_N"] = p.alpha_N;

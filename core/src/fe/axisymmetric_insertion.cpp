@@ -987,8 +987,11 @@ class LinearStepper : public Stepper {
   void describe_cohesive(InsertionStep& step) {
     const CohesiveRing& ring = *cohesive_;
     std::vector<double> damage(pairs_.size());
+    double area = 0.0, failed = 0.0;
     for (std::size_t p = 0; p < pairs_.size(); ++p) {
       damage[p] = cohesive_damage(ring.law, ring.reached_m[p]);
+      area += ring.area_m2[p];
+      if (damage[p] >= 1.0) failed += ring.area_m2[p];
       step.fracture_energy_J +=
           ring.area_m2[p] * cohesive_dissipated_energy(ring.law, ring.reached_m[p]);
       if (damage[p] >= 1.0)
@@ -1007,6 +1010,7 @@ class LinearStepper : public Stepper {
       if (softening) ++step.process_zone_cells;
     }
     step.cohesive_rounds = rounds_;
+    step.cohesive_failed_fraction = area > 0.0 ? failed / area : 0.0;
     rounds_ = 0;
   }
 

@@ -34,8 +34,11 @@ struct RunPlan {
   /// horizon"), as a run asked for that depth ends; 0: they end with the run.
   double shown_depth_m = 0.0;
   double horizon_m = 0.0;  ///< the pre-puncture model's depth (a rung of pre_puncture_horizon)
-  /// The cohesive criterion's ring crack: its line's depth below the surface (run_pre sets it)
+  /// The cohesive criterion's ring crack: its line's depth below the surface, and whether it
+  /// ends at the top layer's bottom, so that its failing throughout is a puncture (run_pre sets
+  /// both)
   double cohesive_depth_m = 0.0;
+  bool cohesive_through_layer = false;
   int steps = 0;                 ///< pre-puncture depth steps over the horizon
   double needle_radius_m = 0.0;  ///< largest needle radius reaching the horizon
   std::string vtu_directory;

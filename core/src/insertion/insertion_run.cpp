@@ -146,12 +146,15 @@ class CrossingWatch {
         past_depth_(needles, false),
         last_force_(needles, 0.0),
         threshold_(plan.stop_at_crossing ? plan.threshold : std::nullopt),
-        depth_m_(plan.depth_m) {}
+        depth_m_(plan.depth_m),
+        through_(plan.cohesive_through_layer) {}
   // False once every needle's criterion has reached the threshold.
   bool keep_going(std::size_t needle, const CriterionSample& s) {
     const bool peak = threshold_ && threshold_->criterion == PunctureCriterion::Cohesive;
     if (peak) {
-      if (force_drop_step({last_force_[needle], s.force_N})) crossed_[needle] = true;
+      if (force_drop_step({last_force_[needle], s.force_N}) ||
+          (through_ && s.cohesive_failed_fraction >= kCutThrough))
+        crossed_[needle] = true;
       last_force_[needle] = s.force_N;
       if (past_depth_[needle]) return false;
       if (s.depth_m >= depth_m_ * (1.0 - 1e-12)) past_depth_[needle] = true;
@@ -169,6 +172,7 @@ class CrossingWatch {
   std::vector<double> last_force_;
   std::optional<PunctureThreshold> threshold_;
   double depth_m_ = 0.0;
+  bool through_ = false;  // the cohesive ring ends at the top layer's bottom
 };
 
 // The criterion's view of one needle at one depth: a 3-D NeedleStep3d or an axisymmetric
@@ -182,6 +186,8 @@ CriterionSample sample_of(double depth, const NeedleState& n, const SectionArea&
   s.energy_release_rate_J_per_m2 = n.energy_release_rate_J_per_m2;
   s.penetration_ratio = area.penetration_ratio(n.force_N, depth);
   s.force_N = n.force_N;
+  if constexpr (requires { n.cohesive_failed_fraction; })
+    s.cohesive_failed_fraction = n.cohesive_failed_fraction;
   return s;
 }
 
@@ -347,7 +353,8 @@ void set_cohesive_ring(const RunPlan& plan, const InsertionRunOptions& options, 
   if (options.overrides.tip_size_m) return;
   const double E = plan.full_layers.front().material.E;
   const double length = E * t.threshold / (t.cohesive_strength_Pa * t.cohesive_strength_Pa);
-  const double cell = length / cohesive_cells_per_length(options.fidelity);
+  // A line shorter than the law's length (a thin top layer) gets as many cells down itself.
+  const double cell = std::min(length, depth) / cohesive_cells_per_length(options.fidelity);
   const double own = fe::mesh_options_for(p).h_m;
   if (cell < own) p.cohesive_cell_m = cell;
   const double cells = depth / std::min(cell, own);
@@ -439,6 +446,7 @@ PreResult run_axisymmetric(const RunPlan& plan, const PreparedNeedle& needle,
     pt.cohesive_zone_m = st.cohesive_zone_m;
     pt.process_zone_cells = st.process_zone_cells;
     pt.fracture_energy_J = st.fracture_energy_J;
+    pt.cohesive_failed_fraction = st.cohesive_failed_fraction;
     set_section(pt, area);
     out.needles[0].points.push_back(pt);
     out.needles[0].samples.push_back(sample_of(st.depth_m, st, area));
@@ -737,6 +745,7 @@ RunPoint interpolated_point(const std::vector<RunPoint>& points, double depth) {
       r.cohesive_zone_m = mix(before.cohesive_zone_m, p.cohesive_zone_m);
       r.process_zone_cells = p.process_zone_cells;
       r.fracture_energy_J = mix(before.fracture_energy_J, p.fracture_energy_J);
+      r.cohesive_failed_fraction = mix(before.cohesive_failed_fraction, p.cohesive_failed_fraction);
       return r;
     }
     before = p;
@@ -797,6 +806,20 @@ void check_cohesive_peak(const RunPlan& plan, const RunPoint& at, double depth) 
                       " ring crack: the peak is the line's, not the tissue's");
 }
 
+// Without a peak the damage must not have reached the end of a line that stops inside the top
+// layer: the force would then be the line's, not the tissue's.
+void check_cohesive_line(const RunPlan& plan, const std::vector<RunPoint>& points) {
+  if (plan.cohesive_through_layer || points.empty()) return;
+  const double line = plan.cohesive_depth_m;
+  for (const RunPoint& p : points)
+    if (p.cohesive_zone_m >= line * (1.0 - 1e-9))
+      throw SolverError("cohesive criterion: the damage reached the end of the " +
+                        format_quantity(line, Dimension::Length) + " ring crack at " +
+                        format_quantity(p.depth_m, Dimension::Length) +
+                        " with no force peak before it: the run cannot say where the tissue "
+                        "punctures");
+}
+
 NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const RunPlan& plan,
                           const SectionArea& area, const SurfaceLoadModel* post) {
   NeedleRun run;
@@ -811,10 +834,22 @@ NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const R
     }
     double force = 0.0;
     crossing = force_peak(depths, forces, &force);
-    if (crossing) {
+    // The ring cut through the top layer (where it ends there): the failed share reaches 1,
+    // located linearly between the steps as the energy criterion's G.
+    std::optional<Crossing> through;
+    if (plan.cohesive_through_layer) {
+      std::vector<double> failed;
+      for (const RunPoint& p : pre.points) failed.push_back(p.cohesive_failed_fraction);
+      through = first_crossing(depths, failed, kCutThrough);
+    }
+    if (through && (!crossing || through->depth_m < crossing->depth_m)) {
+      crossing = through;
+    } else if (crossing) {
       // The highest step is the one before the drop.
       check_cohesive_peak(plan, pre.points[*force_drop_step(forces) - 1], crossing->depth_m);
       peak_force = force;
+    } else {
+      check_cohesive_line(plan, pre.points);
     }
     if (crossing && crossing->depth_m > plan.depth_m * (1.0 + 1e-12)) crossing.reset();
   } else if (plan.threshold) {
@@ -1041,6 +1076,9 @@ PreResult run_pre(RunPlan& plan, const Scene& scene, const std::vector<PreparedN
           plan.threshold && plan.threshold->criterion == PunctureCriterion::Cohesive
               ? run.crack_depth_m
               : 0.0;
+      plan.cohesive_through_layer =
+          plan.cohesive_depth_m > 0.0 &&
+          plan.cohesive_depth_m >= plan.full_layers.front().thickness * (1.0 - 1e-9);
       pre = run_axisymmetric(plan, needles[0], areas[0], options, run.crack_depth_m,
                              options.keep_reached);
       if (pre.stopped) {
@@ -1067,11 +1105,19 @@ PreResult run_pre(RunPlan& plan, const Scene& scene, const std::vector<PreparedN
 
 // The step at which a needle's criterion fired: the first at or above its threshold, or for the
 // cohesive criterion the step that confirms the force's peak (force_drop_step).
-std::optional<std::size_t> fired_step(const PunctureThreshold& t, const PreSeries& s) {
+std::optional<std::size_t> fired_step(const RunPlan& plan, const PreSeries& s) {
+  const PunctureThreshold& t = *plan.threshold;
   if (t.criterion == PunctureCriterion::Cohesive) {
     std::vector<double> forces;
     for (const CriterionSample& c : s.samples) forces.push_back(c.force_N);
-    return force_drop_step(forces);
+    std::optional<std::size_t> at = force_drop_step(forces);
+    // Or the ring cut through the top layer, whichever comes first.
+    for (std::size_t i = 0; plan.cohesive_through_layer && i < s.samples.size(); ++i)
+      if (s.samples[i].cohesive_failed_fraction >= kCutThrough) {
+        if (!at || i < *at) at = i;
+        break;
+      }
+    return at;
   }
   for (std::size_t i = 0; i < s.samples.size(); ++i)
     if (criterion_value(t.criterion, s.samples[i]) >= t.threshold) return i;
@@ -1085,7 +1131,7 @@ bool every_needle_crossed(const RunPlan& plan, const PreResult& pre) {
   if (!plan.threshold) return false;
   const bool peak = plan.threshold->criterion == PunctureCriterion::Cohesive;
   return std::all_of(pre.needles.begin(), pre.needles.end(), [&](const PreSeries& s) {
-    const auto at = fired_step(*plan.threshold, s);
+    const auto at = fired_step(plan, s);
     return at && (peak || s.samples[*at].depth_m <= plan.depth_m * (1.0 + 1e-12));
   });
 }
@@ -1150,7 +1196,7 @@ int first_rung(const Scene& scene, const std::vector<PreparedNeedle>& needles,
 double deepest_first_crossing(const RunPlan& plan, const PreResult& pre) {
   double deepest = 0.0;
   for (const PreSeries& s : pre.needles) {
-    const auto at = fired_step(*plan.threshold, s);
+    const auto at = fired_step(plan, s);
     if (!at) return 0.0;
     deepest = std::max(deepest, s.samples[*at].depth_m);
   }
@@ -1271,11 +1317,14 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
   RunPlan plan =
       detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(last_rung));
   // The cohesive criterion confirms a peak on the step after it: the last rung reaches a step
-  // beyond the requested depth.
+  // beyond the requested depth, where the block is deep enough for that rung (else a peak in the
+  // last step before the requested depth stays unconfirmed: docs/model.md, "The cohesive
+  // criterion").
   const bool cohesive = plan.threshold && plan.threshold->criterion == PunctureCriterion::Cohesive;
   if (cohesive) {
     check_cohesive_tissue(scene, options);
-    if (plan.horizon_m < scene.insertion.depth + plan.horizon_m / std::max(plan.steps, 1)) {
+    if (plan.horizon_m < scene.insertion.depth + plan.horizon_m / std::max(plan.steps, 1) &&
+        detail::pre_puncture_horizon(last_rung + 1) < scene.tissue.depth()) {
       ++last_rung;
       plan =
           detail::plan_insertion(scene, needles, options, detail::pre_puncture_horizon(last_rung));

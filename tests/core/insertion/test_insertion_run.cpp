@@ -566,6 +566,41 @@ TEST(CohesiveCriterion, TheRequestedDepthDoesNotMoveThePuncture) {
               1e-12 * b.needles[0].puncture->force_N);
 }
 
+// Paper A's skin under the punch: the ring ends at the 20 um stratum corneum's bottom, and the
+// layer punctures where the ring has failed throughout (the force keeps rising: the layers
+// beneath carry the plug). l_ch = 1 GPa x 10 J/m^2 / (21.6 MPa)^2 = 21 um: the line's own 20 um
+// sets the cells (5 um at fast).
+TEST(CohesiveCriterion, ARingThroughAThinTopLayerPuncturesWhereItIsCutThrough) {
+  const std::string fracture =
+      "[tissue.fracture]\ntoughness = \"10 J/m^2\"\ncritical_pressure = \"3 MPa\"\n"
+      "cohesive_strength = \"21.6 MPa\"\n";
+  std::string text =
+      scene_text(kPaperASkinLayers, fracture, kOnePunch, "[\"puncture\", \"force_curve\"]",
+                 "[\"3000 um\", \"3000 um\", \"1150 um\"]", "800 um");
+  // scene_text's own silicone layer goes first: drop it, the skin's three layers remain.
+  const auto from = text.find("[[tissue.layers]]\nname = \"silicone\"");
+  text.erase(from, text.find("[[tissue.layers]]", from + 1) - from);
+  const InsertionRun run =
+      run_insertion(parse_scene(text, "skin.toml"), {punch("punch", 115e-6)}, cohesive_fast());
+  EXPECT_NEAR(run.crack_depth_m, 20e-6, 1e-15);  // the layer, not the diameter
+  const NeedleRun& n = run.needles.front();
+  ASSERT_TRUE(n.puncture.has_value());
+  // Measured 480 um at fast (80 um steps on the 800 um rung); standard and fine read 440 um.
+  EXPECT_GT(n.puncture->depth_m, 400e-6);
+  EXPECT_LE(n.puncture->depth_m, 480e-6 + 1e-12);
+  double last = 0.0;
+  for (const RunPoint& p : n.curve)
+    if (p.stage == Stage::Pre) {
+      EXPECT_GE(p.force_N, last);  // no peak: the cut, not a force drop, fires it
+      last = p.force_N;
+    }
+  const RunPoint& at = *std::find_if(n.curve.begin(), n.curve.end(), [&](const RunPoint& p) {
+    return p.depth_m >= n.puncture->depth_m;
+  });
+  // Interpolated to kCutThrough, 1 - 1e-9 (to the interpolation's round-off).
+  EXPECT_NEAR(at.cohesive_failed_fraction, kCutThrough, 1e-12);
+}
+
 // Cells of 50 um hold the process zone in one or two: the peak would follow the mesh.
 TEST(CohesiveCriterion, AProcessZoneOfFewerThanThreeCellsIsRefused) {
   InsertionRunOptions o = cohesive_fast();

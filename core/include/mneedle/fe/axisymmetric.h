@@ -243,6 +243,9 @@ struct InsertionStep {
   int process_zone_cells = 0;
   double fracture_energy_J = 0.0;
   int cohesive_rounds = 0;
+  /// The share of the ring's face area whose pairs have failed (0..1; 1: the line is cut through
+  /// but for its front node, which stays shared).
+  double cohesive_failed_fraction = 0.0;
 };
 
 struct InsertionOptions {

@@ -111,6 +111,7 @@ struct RunPoint {
   double cohesive_zone_m = 0.0;
   int process_zone_cells = 0;
   double fracture_energy_J = 0.0;
+  double cohesive_failed_fraction = 0.0;  ///< share of the ring's face area failed (0..1)
   // Post-puncture split (paper A eqs. 18-20, friction); zero before puncture.
   double alpha_N = 0.0;
   double beta_N = 0.0;

@@ -45,7 +45,13 @@ struct CriterionSample {
   /// the surface (penetration_force.h); dimensionless, the criterion fires at 1.
   double penetration_ratio = 0.0;
   double force_N = 0.0;  ///< the axial force (the cohesive criterion reads its peak)
+  /// cohesive: the share of the ring crack's face area failed (1: cut through)
+  double cohesive_failed_fraction = 0.0;
 };
+
+/// The cohesive criterion's second event: its ring, cut down to the top layer's bottom, has
+/// failed throughout (a share of its face area of at least this).
+inline constexpr double kCutThrough = 1.0 - 1e-9;  // the sum of shares, to round-off
 
 /// The sample's value of the quantity the criterion compares with its threshold.
 double criterion_value(PunctureCriterion criterion, const CriterionSample& sample);
