@@ -341,8 +341,21 @@ constexpr int kMinProcessZoneCells = 3;
 // than this is refused before any mesh is built.
 constexpr double kMaxCohesiveCells = 150.0;
 
+// The law's characteristic length E G_c / sigma_c^2 (m), E the top layer's modulus.
+double cohesive_length(const PunctureThreshold& t, double E) {
+  return E * t.threshold / (t.cohesive_strength_Pa * t.cohesive_strength_Pa);
+}
+
+// The ring's cells: the softening part of the law's length (1 - delta_y / delta_0 of it: the
+// process zone shortens as the peak moves towards failure), or of a line shorter than it (a
+// thin top layer), over the fidelity's cells per length.
+double cohesive_ring_cell(const PunctureThreshold& t, double E, double line, fe::Fidelity f) {
+  return std::min(cohesive_length(t, E) * (1.0 - t.cohesive_peak_ratio), line) /
+         cohesive_cells_per_length(f);
+}
+
 // The cohesive criterion's ring: the top layer's law, the line `depth` long, its cells sized from
-// the law's characteristic length unless the caller fixed the tip size.
+// the law (or the caller's cohesive_cell_m) where finer than the mesh's own.
 void set_cohesive_ring(const RunPlan& plan, const InsertionRunOptions& options, double depth,
                        fe::AxisymmetricProblem& p) {
   const PunctureThreshold& t = *plan.threshold;
@@ -350,22 +363,9 @@ void set_cohesive_ring(const RunPlan& plan, const InsertionRunOptions& options, 
   p.cohesive.toughness_J_per_m2 = t.threshold;
   p.cohesive.failure_opening_m = 2.0 * t.threshold / t.cohesive_strength_Pa;
   p.cohesive.peak_opening_m = t.cohesive_peak_ratio * p.cohesive.failure_opening_m;
-  if (options.overrides.tip_size_m) return;
-  const double E = plan.full_layers.front().material.E;
-  const double length = E * t.threshold / (t.cohesive_strength_Pa * t.cohesive_strength_Pa);
-  // A line shorter than the law's length (a thin top layer) gets as many cells down itself.
-  const double cell = std::min(length, depth) / cohesive_cells_per_length(options.fidelity);
-  const double own = fe::mesh_options_for(p).h_m;
-  if (cell < own) p.cohesive_cell_m = cell;
-  const double cells = depth / std::min(cell, own);
-  if (cells > kMaxCohesiveCells)
-    throw InputError(
-        "cohesive criterion: the law's length E G_c / sigma_c^2 = " +
-        format_quantity(length, Dimension::Length) + " needs " +
-        std::to_string(static_cast<long long>(std::ceil(cells))) + " cells along the " +
-        format_quantity(depth, Dimension::Length) + " ring crack, above the limit of " +
-        std::to_string(static_cast<int>(kMaxCohesiveCells)) +
-        " (a lower cohesive_strength lengthens it; docs/model.md, \"The cohesive criterion\")");
+  const double cell = options.cohesive_cell_m.value_or(
+      cohesive_ring_cell(t, plan.full_layers.front().material.E, depth, options.fidelity));
+  if (cell < fe::mesh_options_for(p).h_m) p.cohesive_cell_m = cell;
 }
 
 // keep_reached: a stop after the first step returns what was reached (InsertionRunOptions).
@@ -473,9 +473,9 @@ PreResult run_analytic(const RunPlan& plan, const Scene& scene,
         "simulate: the analytic model gives no energy release rate; the energy criterion needs "
         "--model axisymmetric or 3d");
   if (has_criterion && criterion == PunctureCriterion::Cohesive)
-    throw InputError(
-        "simulate: the analytic model has no crack; the cohesive criterion needs --model "
-        "axisymmetric");
+    throw InputError(scene.source_name +
+                     ": model.criterion: \"cohesive\": the analytic model has no crack; the "
+                     "cohesive criterion needs --model axisymmetric (or auto)");
   // The stress criterion in closed form: the top layer as a plate on the layer beneath, pressed
   // at one point by a pointed tip (docs/model.md, "The stress criterion on the analytic path").
   // Its force replaces the indentation law's: the stress is the plate's.
@@ -812,7 +812,7 @@ void check_cohesive_line(const RunPlan& plan, const std::vector<RunPoint>& point
   if (plan.cohesive_through_layer || points.empty()) return;
   const double line = plan.cohesive_depth_m;
   for (const RunPoint& p : points)
-    if (p.cohesive_zone_m >= line * (1.0 - 1e-9))
+    if (p.depth_m <= plan.depth_m * (1.0 + 1e-12) && p.cohesive_zone_m >= line * (1.0 - 1e-9))
       throw SolverError("cohesive criterion: the damage reached the end of the " +
                         format_quantity(line, Dimension::Length) + " ring crack at " +
                         format_quantity(p.depth_m, Dimension::Length) +
@@ -844,14 +844,19 @@ NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const R
     }
     if (through && (!crossing || through->depth_m < crossing->depth_m)) {
       crossing = through;
+      peak_force.reset();
     } else if (crossing) {
-      // The highest step is the one before the drop.
-      check_cohesive_peak(plan, pre.points[*force_drop_step(forces) - 1], crossing->depth_m);
       peak_force = force;
-    } else {
-      check_cohesive_line(plan, pre.points);
     }
-    if (crossing && crossing->depth_m > plan.depth_m * (1.0 + 1e-12)) crossing.reset();
+    // Beyond the requested depth nothing is reported, so nothing there is checked: the step the
+    // run took past it only confirms a peak before it.
+    if (crossing && crossing->depth_m > plan.depth_m * (1.0 + 1e-12)) {
+      crossing.reset();
+      peak_force.reset();
+    }
+    if (crossing && peak_force)  // the highest step is the one before the drop
+      check_cohesive_peak(plan, pre.points[*force_drop_step(forces) - 1], crossing->depth_m);
+    if (!crossing) check_cohesive_line(plan, pre.points);
   } else if (plan.threshold) {
     std::vector<double> depths, values;
     for (const CriterionSample& s : pre.samples) {
@@ -900,7 +905,10 @@ NeedleRun assemble_needle(const std::string& name, const PreSeries& pre, const R
     for (const RunPoint& p : pre.points)
       if (p.depth_m < crossing->depth_m) run.curve.push_back(p);
     RunPoint at = interpolated_point(pre.points, crossing->depth_m);
-    if (peak_force) at.force_N = *peak_force;
+    if (peak_force) {
+      at.force_N = *peak_force;
+      at.contact_pressure_Pa = at.contact_area_m2 > 0.0 ? at.force_N / at.contact_area_m2 : 0.0;
+    }
     set_section(at, area);
     run.curve.push_back(at);
     Puncture puncture;
@@ -1058,7 +1066,8 @@ PreResult run_pre(RunPlan& plan, const Scene& scene, const std::vector<PreparedN
         throw InputError(scene.source_name +
                          ": model.criterion: \"cohesive\" runs on the "
                          "axisymmetric model only (one needle of revolution on the block's axis); "
-                         "these needles need the 3-D model, which has no cohesive crack yet");
+                         "this run is on the 3-D model (asked for with --model 3d, or needed by "
+                         "these needles), which has no cohesive crack yet");
       if (plan.threshold && plan.threshold->criterion == PunctureCriterion::Energy)
         run.crack_depth_m = crack_depth_for(plan.needle_radius_m, tip_size_3d(plan, options));
       measure_domain_cut(plan, needles, areas, options, plan.horizon_m, std::nullopt,
@@ -1251,7 +1260,8 @@ namespace {
 
 // The cohesive ring crack is solved on the linear model's condensed surface (docs/model.md,
 // "Cohesive ring crack"): linear layers and sticking contact only.
-void check_cohesive_tissue(const Scene& scene, const InsertionRunOptions& options) {
+void check_cohesive_tissue(const Scene& scene, const std::vector<PreparedNeedle>& needles,
+                           const PunctureThreshold& t, const InsertionRunOptions& options) {
   for (const TissueLayer& layer : scene.tissue.layers)
     if (layer.material.model != MaterialModel::Linear)
       throw InputError(scene.source_name + ":" + std::to_string(layer.line) + ": tissue.layers '" +
@@ -1261,6 +1271,29 @@ void check_cohesive_tissue(const Scene& scene, const InsertionRunOptions& option
   if (options.contact != Contact::Sticking)
     throw InputError(scene.source_name +
                      ": model.contact: the cohesive criterion needs sticking contact");
+  // Work limit, before any mesh: the ring's cells down its line (the line and its cells are the
+  // needle's and the top layer's; a 3-D needle is refused by the run itself).
+  if (needles.size() != 1 || !needles.front().axisymmetric) return;
+  const TissueLayer& top = scene.tissue.layers.front();
+  const double E = top.material.youngs_modulus;
+  const double line = std::min(top.thickness, 2.0 * needles.front().axisymmetric->max_radius());
+  const double cells =
+      line / (options.cohesive_cell_m.value_or(cohesive_ring_cell(t, E, line, options.fidelity)));
+  if (!(cells <= kMaxCohesiveCells)) {
+    const std::string key = top.fracture_is_own ? "tissue.layers[0].fracture.cohesive_strength"
+                                                : "tissue.fracture.cohesive_strength";
+    throw InputError(scene.source_name + ":" + std::to_string(top.line) + ": " + key + ": " +
+                     format_quantity(t.cohesive_strength_Pa, Dimension::Pressure) +
+                     " makes the law's length E G_c / sigma_c^2 " +
+                     format_quantity(cohesive_length(t, E), Dimension::Length) + ", which needs " +
+                     (std::isfinite(cells)
+                          ? std::to_string(static_cast<long long>(std::ceil(cells)))
+                          : std::string("unboundedly many")) +
+                     " cells down the " + format_quantity(line, Dimension::Length) +
+                     " ring crack at " + fe::to_string(options.fidelity) + ", above the limit of " +
+                     std::to_string(static_cast<int>(kMaxCohesiveCells)) +
+                     " (a lower strength lengthens it; docs/model.md, \"The cohesive criterion\")");
+  }
 }
 
 }  // namespace
@@ -1322,7 +1355,7 @@ InsertionRun run_insertion(const Scene& scene, const std::vector<PreparedNeedle>
   // criterion").
   const bool cohesive = plan.threshold && plan.threshold->criterion == PunctureCriterion::Cohesive;
   if (cohesive) {
-    check_cohesive_tissue(scene, options);
+    check_cohesive_tissue(scene, needles, *plan.threshold, options);
     if (plan.horizon_m < scene.insertion.depth + plan.horizon_m / std::max(plan.steps, 1) &&
         detail::pre_puncture_horizon(last_rung + 1) < scene.tissue.depth()) {
       ++last_rung;

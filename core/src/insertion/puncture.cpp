@@ -174,6 +174,14 @@ std::optional<Crossing> force_peak(const std::vector<double>& depths_m,
   const double x2 = depths_m[*drop], y2 = forces_N[*drop];
   // Divided differences: y = y1 + b (x - x1) + c (x - x1)^2 with c < 0, since y1 >= y0 and
   // y1 > y2 make the parabola concave.
+  if (!(x1 > x0)) {  // a first step at depth 0: no interval before it to place a vertex in
+    Crossing at;
+    at.depth_m = x1;
+    at.step = top;
+    at.fraction = 1.0;
+    if (peak_force_N != nullptr) *peak_force_N = y1;
+    return at;
+  }
   const double s01 = (y1 - y0) / (x1 - x0), s12 = (y2 - y1) / (x2 - x1);
   const double c = (s12 - s01) / (x2 - x0);
   const double b = s01 + c * (x1 - x0);

@@ -397,8 +397,11 @@ std::optional<Fracture> read_fracture(Table& parent) {
   if (const auto ratio = t->optional_quantity("cohesive_peak_ratio", Dimension::Dimensionless)) {
     if (!f.cohesive_strength)
       t->fail_key("cohesive_peak_ratio", "shapes the cohesive law: give cohesive_strength too");
-    if (!(*ratio > 0.0 && *ratio < 1.0))
-      t->fail_key("cohesive_peak_ratio", "delta_y / delta_0 must lie in (0, 1), got " +
+    // Below 1e-4 the initial stiffness sigma_c / delta_y swamps the tissue's (the puncture
+    // drifted by 10 % at 1e-7, the stiffness lost its definiteness at 1e-20); above 0.9 the
+    // process zone needs ten times the cells (docs/model.md, "The cohesive criterion").
+    if (!(*ratio >= 1e-4 && *ratio <= 0.9))
+      t->fail_key("cohesive_peak_ratio", "delta_y / delta_0 must lie in [1e-4, 0.9], got " +
                                              format_quantity(*ratio, Dimension::Dimensionless));
     f.cohesive_peak_ratio = *ratio;
   }
@@ -788,8 +791,12 @@ void check_criterion_inputs(Table& t, PunctureCriterion c, const Tissue& tissue)
                                 layer + " or in [tissue.fracture]");
   }
   if (c == PunctureCriterion::Cohesive && !top.fracture->cohesive_strength) {
-    t.fail_key("criterion", "\"cohesive\" needs fracture.cohesive_strength on " + layer +
-                                " or in [tissue.fracture]");
+    // A layer's own fracture table replaces [tissue.fracture] whole: name the one that counts.
+    t.fail_key("criterion", top.fracture_is_own
+                                ? "\"cohesive\" needs cohesive_strength in the fracture table of " +
+                                      layer + " (its own table replaces [tissue.fracture])"
+                                : "\"cohesive\" needs fracture.cohesive_strength on " + layer +
+                                      " or in [tissue.fracture]");
   }
 }
 

@@ -35,7 +35,7 @@ struct PunctureSummary {
   double depth_m = 0.0;
   double force_N = 0.0;       // pre-puncture force at that depth
   double post_force_N = 0.0;  // post-puncture model's force at that depth
-  std::string criterion;      // pressure | energy | stress | penetration
+  std::string criterion;      // pressure | energy | stress | penetration | cohesive
   /// The criterion fired at the first depth step (docs/model.md, "Criteria"): the depth is the
   /// step's, not the tissue's; ranked after every resolved puncture, never an objective.
   bool at_first_contact = false;

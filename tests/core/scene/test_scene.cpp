@@ -222,7 +222,7 @@ TEST(SceneErrors, ACohesiveLawNeedsItsStrengthAUnitAndARatioBelowOne) {
   expect_error(with(pc, pc + "cohesive_peak_ratio = 0.1\n"),
                {"tissue.fracture.cohesive_peak_ratio", "give cohesive_strength too"});
   expect_error(with(pc, pc + "cohesive_strength = \"356 kPa\"\ncohesive_peak_ratio = 1\n"),
-               {"tissue.fracture.cohesive_peak_ratio", "(0, 1)"});
+               {"tissue.fracture.cohesive_peak_ratio", "[1e-4, 0.9]"});
   expect_error(with("fidelity = \"standard\"", "criterion = \"cohesive\""),
                {"test.toml:30:", "model.criterion", "cohesive_strength"});
 }

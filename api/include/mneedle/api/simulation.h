@@ -20,7 +20,7 @@ namespace mneedle {
 struct SimulateSettings {
   std::string fidelity;        // fast | standard | fine
   std::string contact;         // sticking | frictionless
-  std::string criterion;       // pressure | energy | stress | penetration
+  std::string criterion;       // pressure | energy | stress | penetration | cohesive
   std::string model = "auto";  // auto | analytic | axisymmetric | 3d
   std::string axis;            // the scene's STL needles' axis (parse_axis_choice)
   std::size_t max_needles = 16;

@@ -59,6 +59,9 @@ struct InsertionRunOptions {
   /// (fast 5 %, standard 2 %, fine 1 %).
   std::optional<double> reduction_tolerance;
   int steps = 0;  ///< output depth steps; 0: from the fidelity
+  /// The cohesive criterion's ring cells (m); empty: from its law and the fidelity (docs/model.md,
+  /// "The cohesive criterion"). For convergence studies and tests; `tip_size_m` does not set them.
+  std::optional<double> cohesive_cell_m;
   /// Work limit checked before any FE is built: more needles in one FE model than this is an
   /// InputError (a 10 x 10 array needs GBs of memory and tens of minutes at fast).
   std::size_t max_fe_needles = 16;
@@ -189,7 +192,8 @@ struct InsertionRun {
   /// energy criterion: depth of the crack G is computed with; cohesive: of the ring crack's line
   double crack_depth_m = 0.0;
   /// Depth the pre-puncture model was built for (docs/model.md, "Pre-puncture horizon"): a rung
-  /// of 100 um x 2^k, the first whose run fired the criterion or covered the requested depth.
+  /// of 100 um x 2^k, the first whose run fired the criterion or covered the requested depth (for
+  /// the cohesive criterion: a step beyond it, inside the block).
   double horizon_m = 0.0;
   double first_step_m = 0.0;  ///< the pre-puncture model's depth step on that rung
   /// Every rung's horizon that ran, in order (docs/model.md, "Pre-puncture horizon"): from rung 0
