@@ -611,6 +611,20 @@ TEST(CohesiveCriterion, ARingThroughAThinTopLayerPuncturesWhereItIsCutThrough) {
   EXPECT_NEAR(at.cohesive_failed_fraction, kCutThrough, 1e-12);
 }
 
+// optimize fixes the mesh's tip size over a search (25 um here, fast's own for this punch): the
+// ring keeps its own cells, so the run is the default's, to the last digit (it was refused, its
+// ring given the tip's 25 um cells).
+TEST(CohesiveCriterion, AFixedTipSizeKeepsTheRingsOwnCells) {
+  InsertionRunOptions o = cohesive_fast();
+  o.overrides.tip_size_m = 25e-6;
+  const InsertionRun fixed = run_insertion(cohesive_scene(), {punch("punch", 100e-6)}, o);
+  const InsertionRun own =
+      run_insertion(cohesive_scene(), {punch("punch", 100e-6)}, cohesive_fast());
+  ASSERT_TRUE(fixed.needles[0].puncture && own.needles[0].puncture);
+  EXPECT_EQ(fixed.nodes, own.nodes);
+  EXPECT_EQ(fixed.needles[0].puncture->depth_m, own.needles[0].puncture->depth_m);
+}
+
 // Cells of 50 um hold the process zone in one or two: the peak would follow the mesh.
 TEST(CohesiveCriterion, AProcessZoneOfFewerThanThreeCellsIsRefused) {
   InsertionRunOptions o = cohesive_fast();
