@@ -330,8 +330,8 @@ Reduction mirror_reduction(const RunPlan& plan) {
 }
 
 // Cells of the cohesive ring per characteristic length E G_c / sigma_c^2 of its law, by fidelity
-// (docs/model.md, "The cohesive criterion"): the process zone then spans about 3 / 6 / 12 cells
-// at the force's peak; kMinProcessZoneCells is checked there.
+// (docs/model.md, "The cohesive criterion"): the process zone then spanned 3 / 9 / 13 cells at
+// the force's peak under the validation's punch; kMinProcessZoneCells is checked there.
 double cohesive_cells_per_length(fe::Fidelity f) {
   return f == fe::Fidelity::Fast ? 4.0 : f == fe::Fidelity::Fine ? 16.0 : 8.0;
 }
@@ -797,7 +797,8 @@ void check_cohesive_peak(const RunPlan& plan, const RunPoint& at, double depth) 
     throw SolverError(where + "the process zone spans " + std::to_string(at.process_zone_cells) +
                       " cell(s) of the ring crack, fewer than " +
                       std::to_string(kMinProcessZoneCells) +
-                      ": the peak is not mesh-converged (raise [model] fidelity)");
+                      ": the peak is not mesh-converged (raise [model] fidelity; at fine, a "
+                      "lower cohesive_strength lengthens the process zone)");
   const double line = plan.cohesive_depth_m;
   const double layer = plan.full_layers.front().thickness;
   if (line < layer * (1.0 - 1e-9) && at.cohesive_zone_m >= line * (1.0 - 1e-9))
